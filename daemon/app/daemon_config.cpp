@@ -1,0 +1,184 @@
+#include "daemon/app/daemon_config.h"
+
+#include <cerrno>
+#include <cstring>
+#include <toml++/toml.h>
+
+#include <fstream>
+#include <sstream>
+
+#ifndef RESOLVER_DEFAULT_DBC
+#define RESOLVER_DEFAULT_DBC "proto/resolver_bench.dbc"
+#endif
+
+namespace resolver {
+
+std::string default_dbc_path() { return RESOLVER_DEFAULT_DBC; }
+
+namespace {
+
+std::string where(const std::string& source, const toml::node& node) {
+  const auto& src = node.source();
+  return source + ":" + std::to_string(src.begin.line);
+}
+
+/// Rejects keys of `table` that are not in `allowed` (typos must not be silent).
+void check_keys(const toml::table& table, const std::string& section, std::initializer_list<std::string_view> allowed,
+                const std::string& source) {
+  for (const auto& [key, node] : table) {
+    bool ok = false;
+    for (auto a : allowed) ok = ok || a == key.str();
+    if (!ok) {
+      std::string list;
+      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      throw ConfigError(where(source, node) + ": unknown key '" + std::string(key.str()) + "' in [" + section +
+                        "]; valid keys: " + list);
+    }
+  }
+}
+
+template <typename T>
+void read(const toml::table& table, std::string_view key, T& out, const std::string& source,
+          const std::string& section) {
+  const toml::node* node = table.get(key);
+  if (node == nullptr) return;
+  if constexpr (std::is_same_v<T, std::string>) {
+    if (auto v = node->value<std::string>()) { out = *v; return; }
+    throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " must be a string");
+  } else if constexpr (std::is_same_v<T, bool>) {
+    if (auto v = node->value<bool>()) { out = *v; return; }
+    throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " must be true or false");
+  } else if constexpr (std::is_same_v<T, int>) {
+    if (node->is_integer()) { out = static_cast<int>(*node->value<std::int64_t>()); return; }
+    throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " must be an integer");
+  } else {
+    if (auto v = node->value<double>()) { out = *v; return; }
+    throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " must be a number");
+  }
+}
+
+void require_positive(int value, const char* name, const std::string& source) {
+  if (value < 1) throw ConfigError(source + ": " + name + " must be >= 1, got " + std::to_string(value));
+}
+
+}  // namespace
+
+DaemonConfig parse_daemon_config(std::string_view text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(source_name + ":" + std::to_string(e.source().begin.line) + ":" +
+                      std::to_string(e.source().begin.column) + ": TOML syntax error: " + std::string(e.description()));
+  }
+  DaemonConfig c;
+  c.source = source_name;
+  const std::string& s = source_name;
+  check_keys(root, "top level", {"lcm", "channels", "output", "bench", "layout", "estimator", "compensation"}, s);
+
+  auto section = [&root, &s](const char* name) -> const toml::table* {
+    const toml::node* n = root.get(name);
+    if (n == nullptr) return nullptr;
+    if (!n->is_table()) throw ConfigError(where(s, *n) + ": '" + name + "' must be a table ([" + name + "])");
+    return n->as_table();
+  };
+
+  if (const auto* t = section("lcm")) {
+    check_keys(*t, "lcm", {"url"}, s);
+    read(*t, "url", c.lcm_url, s, "lcm");
+  }
+  if (const auto* t = section("channels")) {
+    check_keys(*t, "channels", {"angle", "dq", "estimate", "model_fit", "health"}, s);
+    read(*t, "angle", c.channels.angle, s, "channels");
+    read(*t, "dq", c.channels.dq, s, "channels");
+    read(*t, "estimate", c.channels.estimate, s, "channels");
+    read(*t, "model_fit", c.channels.model_fit, s, "channels");
+    read(*t, "health", c.channels.health, s, "channels");
+  }
+  if (const auto* t = section("output")) {
+    check_keys(*t, "output", {"angle_decimation", "dq_decimation"}, s);
+    read(*t, "angle_decimation", c.angle_decimation, s, "output");
+    read(*t, "dq_decimation", c.dq_decimation, s, "output");
+    require_positive(c.angle_decimation, "[output] angle_decimation", s);
+    require_positive(c.dq_decimation, "[output] dq_decimation", s);
+  }
+  if (const auto* t = section("bench")) {
+    check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info"}, s);
+    read(*t, "p_r", c.bench.p_r, s, "bench");
+    read(*t, "p", c.bench.p, s, "bench");
+    read(*t, "rd_bits", c.bench.rd_bits, s, "bench");
+    read(*t, "use_bench_info", c.bench.use_bench_info, s, "bench");
+    require_positive(c.bench.p_r, "[bench] p_r", s);
+    require_positive(c.bench.p, "[bench] p", s);
+    if (c.bench.rd_bits < 1 || c.bench.rd_bits > 16) {
+      throw ConfigError(s + ": [bench] rd_bits must be 1..16 (the rd_angle signal is 16 bits), got " +
+                        std::to_string(c.bench.rd_bits));
+    }
+  }
+  if (const auto* t = section("layout")) {
+    check_keys(*t, "layout",
+               {"dbc", "counter_signal", "crc_signal", "crc", "bench_info_message", "max_counter_delta", "signals"}, s);
+    read(*t, "dbc", c.dbc_path, s, "layout");
+    read(*t, "counter_signal", c.signal_map.counter_signal, s, "layout");
+    read(*t, "crc_signal", c.signal_map.crc_signal, s, "layout");
+    read(*t, "bench_info_message", c.signal_map.bench_info_message, s, "layout");
+    read(*t, "max_counter_delta", c.max_counter_delta, s, "layout");
+    require_positive(c.max_counter_delta, "[layout] max_counter_delta", s);
+    std::string crc = "j1850_bench";
+    read(*t, "crc", crc, s, "layout");
+    if (crc == "j1850_bench") {
+      c.signal_map.crc = CrcAlgorithm::kBenchJ1850;
+    } else if (crc == "none") {
+      c.signal_map.crc = CrcAlgorithm::kNone;
+    } else {
+      throw ConfigError(where(s, *t->get("crc")) + ": [layout] crc must be \"j1850_bench\" or \"none\", got \"" + crc + "\"");
+    }
+    if (const toml::node* sig = t->get("signals")) {
+      if (!sig->is_table()) throw ConfigError(where(s, *sig) + ": [layout.signals] must be a table");
+      // A user map replaces the default one entirely: roles not named are unmapped.
+      c.signal_map.roles = {};
+      for (const auto& [key, node] : *sig->as_table()) {
+        const auto role = role_from_name(key.str());
+        if (!role) {
+          throw ConfigError(where(s, node) + ": [layout.signals] unknown role '" + std::string(key.str()) +
+                            "'; valid roles: sin, cos, rd_angle, i_a, i_b, i_c, ref_angle");
+        }
+        const auto value = node.value<std::string>();
+        const auto dot = value ? value->find('.') : std::string::npos;
+        if (!value || dot == std::string::npos || dot == 0 || dot + 1 == value->size()) {
+          throw ConfigError(where(s, node) + ": [layout.signals] " + std::string(key.str()) +
+                            " must be \"MESSAGE.signal\" as named in the DBC");
+        }
+        c.signal_map.roles[static_cast<std::size_t>(*role)] = SignalRef{value->substr(0, dot), value->substr(dot + 1)};
+      }
+    }
+  }
+  if (const auto* t = section("estimator")) {
+    check_keys(*t, "estimator", {"method", "min_revolutions", "max_speed_change", "min_samples_per_revolution"}, s);
+    read(*t, "method", c.estimator_method, s, "estimator");
+    read(*t, "min_revolutions", c.hwang.min_revolutions, s, "estimator");
+    read(*t, "max_speed_change", c.hwang.max_speed_change, s, "estimator");
+    read(*t, "min_samples_per_revolution", c.hwang.min_samples_per_revolution, s, "estimator");
+    if (c.estimator_method != "hwang_integral") {
+      throw ConfigError(s + ": [estimator] method \"" + c.estimator_method +
+                        "\" is not available; available: hwang_integral");
+    }
+    require_positive(c.hwang.min_revolutions, "[estimator] min_revolutions", s);
+    if (!(c.hwang.max_speed_change > 0.0)) throw ConfigError(s + ": [estimator] max_speed_change must be > 0");
+  }
+  if (const auto* t = section("compensation")) {
+    check_keys(*t, "compensation", {"enabled"}, s);
+    read(*t, "enabled", c.compensation_enabled, s, "compensation");
+  }
+  return c;
+}
+
+DaemonConfig load_daemon_config(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError("cannot read config file " + path + ": " + std::strerror(errno));
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_daemon_config(text.str(), path);
+}
+
+}  // namespace resolver

@@ -1,0 +1,91 @@
+// resolverd's configuration: defaults, TOML file, validation.
+//
+// Every field has a default that works on the bundled default layout, so the
+// daemon runs with no config file at all. A config file only overrides.
+// Example (all keys optional):
+//
+//   [lcm]
+//   url = "udpm://239.255.76.67:7667?ttl=0"
+//   [channels]
+//   angle = "RESOLVER_ANGLE"   # also dq, estimate, model_fit, health
+//   [output]
+//   angle_decimation = 1       # publish angle_t every Nth sample
+//   dq_decimation = 10
+//   [bench]                    # used until a BENCH_INFO frame says otherwise
+//   p_r = 3
+//   p = 3
+//   rd_bits = 16
+//   use_bench_info = true
+//   [layout]
+//   dbc = "/path/to/inverter.dbc"
+//   counter_signal = "counter"
+//   crc_signal = "crc"
+//   crc = "j1850_bench"        # or "none"
+//   bench_info_message = "BENCH_INFO"
+//   max_counter_delta = 8
+//   [layout.signals]           # role = "MESSAGE.signal"
+//   sin = "RESOLVER_SAMPLE.sin"
+//   [estimator]
+//   method = "hwang_integral"
+//   min_revolutions = 3
+//   max_speed_change = 0.02
+//   [compensation]
+//   enabled = true
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/decode/signal_map.h"
+
+namespace resolver {
+
+struct LcmChannels {
+  std::string angle = "RESOLVER_ANGLE";
+  std::string dq = "RESOLVER_DQ";
+  std::string estimate = "RESOLVER_ESTIMATE";
+  std::string model_fit = "RESOLVER_MODEL_FIT";
+  std::string health = "RESOLVER_HEALTH";
+};
+
+struct BenchDefaults {
+  int p_r = 3;                 ///< resolver pole pairs
+  int p = 3;                   ///< motor pole pairs
+  int rd_bits = 16;            ///< R/D resolution [bits]
+  bool use_bench_info = true;  ///< let BENCH_INFO frames override p_r, p, rd_bits
+};
+
+struct DaemonConfig {
+  std::string source;  ///< file the config came from ("" = built-in defaults)
+  std::string lcm_url;  ///< "" = LCM's default (udpm multicast)
+  LcmChannels channels;
+  int angle_decimation = 1;
+  int dq_decimation = 1;
+  BenchDefaults bench;
+  std::string dbc_path;  ///< "" = the bundled proto/resolver_bench.dbc
+  SignalMap signal_map = SignalMap::bench_default();
+  int max_counter_delta = 8;
+  std::string estimator_method = "hwang_integral";
+  HwangIntegralConfig hwang;
+  bool compensation_enabled = true;
+};
+
+/// Thrown for unreadable or invalid configuration; what() names the file,
+/// the line where known, the key and what is expected.
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads a TOML config over the defaults. Unknown keys are errors (a typo
+/// must not silently fall back to a default). Throws ConfigError.
+DaemonConfig load_daemon_config(const std::string& path);
+/// Parses TOML text (source_name is used in messages). Throws ConfigError.
+DaemonConfig parse_daemon_config(std::string_view text, const std::string& source_name);
+
+/// The DBC the daemon uses when the config names none.
+std::string default_dbc_path();
+
+}  // namespace resolver

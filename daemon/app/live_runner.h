@@ -1,0 +1,25 @@
+// Reads a SocketCAN interface until SIGINT/SIGTERM. Interface problems never
+// end the daemon: a downed link (ENETDOWN) keeps the socket and goes on
+// reading; a vanished interface (ENODEV) closes it and re-opens with backoff.
+// Every such event is counted in health_t and printed once per episode.
+#pragma once
+
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include "daemon/app/pipeline.h"
+#include "daemon/app/stop_flag.h"
+
+namespace resolver {
+
+struct LiveOptions {
+  std::string iface;
+};
+
+/// `current` returns the pipeline to feed (it may be rebuilt on SIGHUP by
+/// `on_reload`, called from the loop when flags.reload is set).
+void run_live(const LiveOptions& options, const std::function<Pipeline&()>& current,
+              const std::function<void()>& on_reload, StopFlags& flags, std::ostream& err);
+
+}  // namespace resolver

@@ -1,0 +1,131 @@
+// resolverd — resolver bench daemon. Wiring only: parse options, load the
+// config, build the pipeline with an LCM output, run a source, print a report.
+#include <CLI/CLI.hpp>
+
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include "daemon/app/daemon_config.h"
+#include "daemon/app/lcm_output.h"
+#include "daemon/app/live_runner.h"
+#include "daemon/app/pipeline.h"
+#include "daemon/app/replay_runner.h"
+#include "daemon/app/run_report.h"
+#include "daemon/app/stop_flag.h"
+
+namespace {
+
+constexpr const char* kDescription = R"(resolverd: reads resolver sin/cos, R/D angle and phase currents from CAN,
+estimates the resolver's amplitude imbalance (Hwang et al. 2009 integral method),
+compensates the angle and publishes angle_t, dq_t, estimate_t and health_t on LCM.
+
+Examples:
+  # offline, as fast as possible, then print a report and exit
+  resolverd --replay demo.log --once --fast --lcm 'file:///tmp/out.lcmlog?mode=w'
+  # replay in the log's own timing, publishing on the default LCM multicast
+  resolverd --replay demo.log
+  # live from SocketCAN
+  resolverd --can can0 --config /etc/resolverd/resolverd.toml
+
+Watch the output with: resolver-echo --lcm '' --count 10   (or lcm-spy, lcm-logger)
+Channels (configurable in [channels]): RESOLVER_ANGLE, RESOLVER_DQ, RESOLVER_ESTIMATE,
+RESOLVER_MODEL_FIT, RESOLVER_HEALTH. Signals: SIGTERM/SIGINT exit cleanly (with --replay,
+after printing the report), SIGHUP reloads the config (a bad config keeps the old one).
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace resolver;
+  CLI::App app{kDescription, "resolverd"};
+  std::string config_path, replay_path, can_iface, report_path;
+  std::optional<std::string> lcm_url;
+  bool once = false, fast = false, quiet = false;
+  app.add_option("--config", config_path, "TOML config file (see README; every key optional)")->check(CLI::ExistingFile);
+  auto* replay = app.add_option("--replay", replay_path, "replay a candump -l log file instead of reading CAN")
+                     ->check(CLI::ExistingFile);
+  auto* can = app.add_option("--can", can_iface, "read live frames from this SocketCAN interface (can0, vcan0)");
+  replay->excludes(can);
+  app.add_flag("--once", once, "with --replay: stop at the end of the log (default: loop it)")->needs(replay);
+  app.add_flag("--fast", fast, "with --replay: as fast as possible instead of the log's timing")->needs(replay);
+  app.add_option("--lcm", lcm_url,
+                 "LCM URL, overrides the config (default: LCM's udpm multicast; "
+                 "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
+  app.add_option("--report", report_path, "also write the end-of-run report as JSON to this file");
+  app.add_flag("--quiet", quiet, "no progress lines on stderr");
+  CLI11_PARSE(app, argc, argv);
+  if (replay_path.empty() && can_iface.empty()) {
+    std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
+    return 2;
+  }
+
+  DaemonConfig config;
+  try {
+    if (!config_path.empty()) config = load_daemon_config(config_path);
+  } catch (const ConfigError& e) {
+    std::cerr << "resolverd: " << e.what() << "\n";
+    return 2;
+  }
+  if (lcm_url) config.lcm_url = *lcm_url;
+
+  std::unique_ptr<LcmOutput> output;
+  std::unique_ptr<Pipeline> pipeline;
+  try {
+    output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
+    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr);
+  } catch (const std::exception& e) {
+    std::cerr << "resolverd: " << e.what() << "\n";
+    return 2;
+  }
+
+  StopFlags flags;
+  install_signal_handlers(flags);
+  RunInfo info;
+  try {
+    if (!replay_path.empty()) {
+      ReplayOptions ro;
+      ro.path = replay_path;
+      ro.fast = fast;
+      ro.once = once;
+      ro.progress = !quiet;
+      const ReplayResult rr = run_replay(ro, *pipeline, flags, std::cerr);
+      info.source = replay_path;
+      info.wall_seconds = rr.wall_seconds;
+    } else {
+      auto reload = [&]() {
+        // SIGHUP: a new config replaces the pipeline only if it is valid.
+        try {
+          DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
+          if (lcm_url) fresh.lcm_url = *lcm_url;
+          auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr);
+          pipeline->finish();
+          pipeline = std::move(rebuilt);
+          config = fresh;
+          std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path) << "\n";
+        } catch (const std::exception& e) {
+          std::cerr << "resolverd: reload failed, keeping the running config: " << e.what() << "\n";
+        }
+      };
+      run_live(LiveOptions{can_iface}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
+      info.source = can_iface;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "resolverd: " << e.what() << "\n";
+    return 1;
+  }
+
+  print_run_report(std::cout, *pipeline, info);
+  if (output->publish_failures() > 0) {
+    std::cerr << "resolverd: " << output->publish_failures() << " LCM publish calls failed\n";
+  }
+  if (!report_path.empty()) {
+    std::ofstream out(report_path);
+    out << run_report_json(*pipeline, info);
+    if (!out) {
+      std::cerr << "resolverd: cannot write report " << report_path << "\n";
+      return 1;
+    }
+  }
+  return 0;
+}

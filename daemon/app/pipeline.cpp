@@ -1,0 +1,211 @@
+#include "daemon/app/pipeline.h"
+
+#include <cmath>
+#include <limits>
+#include <variant>
+
+#include "daemon/dbc/dbc_parser.h"
+
+namespace resolver {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // DESIGN 5: health_t at 1 Hz
+
+std::shared_ptr<const FrameDecoder> make_decoder(const DaemonConfig& config) {
+  const std::string path = config.dbc_path.empty() ? default_dbc_path() : config.dbc_path;
+  auto loaded = dbc::load_dbc_file(path);
+  if (auto* err = std::get_if<dbc::DbcError>(&loaded)) throw ConfigError(err->what());
+  auto db = std::make_shared<const dbc::Database>(std::move(std::get<dbc::Database>(loaded)));
+  try {
+    return std::make_shared<const FrameDecoder>(db, config.signal_map);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError((config.source.empty() ? std::string("built-in config") : config.source) + " with " + path +
+                      ": " + e.what());
+  }
+}
+
+ProcessorConfig processor_config(const DaemonConfig& c) {
+  ProcessorConfig p;
+  p.p_r = c.bench.p_r;
+  p.p = c.bench.p;
+  p.hwang = c.hwang;
+  p.compensate = c.compensation_enabled;
+  return p;
+}
+
+SampleInput to_input(const BenchSample& s) {
+  SampleInput in;
+  in.t = static_cast<double>(s.timestamp_us) * 1e-6;
+  in.has_rd = s.has(Role::kRdAngle);
+  in.theta_rd = s.get(Role::kRdAngle);
+  in.has_sincos = s.has(Role::kSin) && s.has(Role::kCos);
+  in.sin = s.get(Role::kSin);
+  in.cos = s.get(Role::kCos);
+  in.has_currents = s.has(Role::kIA) && s.has(Role::kIB) && s.has(Role::kIC);
+  in.i_a = s.get(Role::kIA);
+  in.i_b = s.get(Role::kIB);
+  in.i_c = s.get(Role::kIC);
+  in.has_ref = s.has(Role::kRefAngle);
+  in.theta_m_ref = s.get(Role::kRefAngle);
+  return in;
+}
+
+void copy3(double (&dst)[3], const std::array<double, 3>& src, bool valid) {
+  for (std::size_t k = 0; k < 3; ++k) dst[k] = valid ? src[k] : kNaN;
+}
+
+}  // namespace
+
+Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics)
+    : config_(config),
+      sink_(sink),
+      problems_(diagnostics, "resolverd: "),
+      intake_(make_decoder(config), config.max_counter_delta,
+              FrameIntake::Callbacks{
+                  [this](const BenchSample& s) { on_sample(s); },
+                  [this](const BenchInfo& i) { on_bench_info(i); },
+                  [this](std::string_view reason, const std::string& msg) { problems_.report(reason, msg); }}),
+      processor_(processor_config(config)) {}
+
+void Pipeline::count_problem(std::string_view reason, const std::string& message) {
+  intake_.count_problem(reason, message);
+}
+
+void Pipeline::feed(const CanFrame& frame, std::uint64_t line, Clock::time_point arrival) {
+  last_frame_us_ = frame.timestamp_us;
+  if (health_window_start_us_ < 0) health_window_start_us_ = frame.timestamp_us;
+  intake_.feed(frame, line);
+  if (frame.timestamp_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(frame.timestamp_us);
+  const double us = std::chrono::duration<double, std::micro>(Clock::now() - arrival).count();
+  latency_window_.add(us);
+  latency_total_.add(us);
+}
+
+void Pipeline::tick(std::int64_t now_us) {
+  if (health_window_start_us_ < 0) {
+    health_window_start_us_ = now_us;
+    return;
+  }
+  if (now_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(now_us);
+}
+
+void Pipeline::finish() {
+  intake_.flush();
+  publish_health(last_frame_us_);
+}
+
+void Pipeline::on_bench_info(const BenchInfo& info) {
+  if (!config_.bench.use_bench_info) return;
+  const ProcessorConfig& pc = processor_.config();
+  if (info.p_r < 1 || info.p < 1) {
+    problems_.report("bench_info_invalid", "BENCH_INFO with p_r=" + std::to_string(info.p_r) +
+                                               ", p=" + std::to_string(info.p) + " ignored (pole pairs must be >= 1)");
+    return;
+  }
+  if (info.p_r != pc.p_r || info.p != pc.p) {
+    if (bench_info_seen_ || samples_ > 0) {
+      problems_.report("bench_info_changed", "BENCH_INFO changed pole pairs to p_r=" + std::to_string(info.p_r) +
+                                                 ", p=" + std::to_string(info.p) + ": estimation restarts");
+    }
+    processor_.set_pole_pairs(info.p_r, info.p);
+  }
+  bench_info_seen_ = true;
+}
+
+void Pipeline::on_sample(const BenchSample& sample) {
+  ++samples_;
+  last_sample_index_ = sample.index;
+  last_counter_ = sample.counter;
+  const SampleOutput out = processor_.process(to_input(sample));
+  summary_.add(out, processor_);
+  if (!out.has_angle) return;
+
+  const bool angle_due = sample.index % config_.angle_decimation == 0;
+  if (angle_due) {
+    angle_t a;
+    a.utime = sample.timestamp_us;
+    a.sample_index = sample.index;
+    a.counter = sample.counter;
+    a.theta_rd = out.theta_rd;
+    a.theta_sincos = out.theta_sincos;
+    a.theta_comp = out.theta_comp;
+    a.theta_ref = out.theta_ref;
+    a.speed_mech_rad_s = out.speed_mech;
+    a.eps_hat = out.eps_hat;
+    a.eps_ref = out.eps_ref;
+    sink_.publish(a);
+  }
+  if (out.has_dq && sample.index % config_.dq_decimation == 0) {
+    const RippleSet& r = processor_.ripple();
+    dq_t d;
+    d.utime = sample.timestamp_us;
+    d.sample_index = sample.index;
+    d.counter = sample.counter;
+    d.electrical_freq_hz = out.electrical_freq_hz;
+    d.i_d_raw = out.i_d_raw;
+    d.i_q_raw = out.i_q_raw;
+    d.i_d_comp = out.i_d_comp;
+    d.i_q_comp = out.i_q_comp;
+    d.i_d_ref = out.i_d_ref;
+    d.i_q_ref = out.i_q_ref;
+    for (std::size_t k = 0; k < 3; ++k) d.ripple_order[k] = static_cast<int16_t>(kRippleOrders[k]);
+    copy3(d.i_d_ripple_raw, r.raw.d, r.raw_valid);
+    copy3(d.i_q_ripple_raw, r.raw.q, r.raw_valid);
+    copy3(d.i_d_ripple_comp, r.comp.d, r.comp_valid);
+    copy3(d.i_q_ripple_comp, r.comp.q, r.comp_valid);
+    copy3(d.i_d_ripple_ref, r.ref.d, r.ref_valid);
+    copy3(d.i_q_ripple_ref, r.ref.q, r.ref_valid);
+    d.ripple_valid = r.raw_valid;
+    sink_.publish(d);
+  }
+  if (out.revolution) publish_estimate(sample.timestamp_us, sample);
+}
+
+void Pipeline::publish_estimate(std::int64_t utime, const BenchSample& sample) {
+  const HwangIntegralEstimator& est = processor_.estimator();
+  estimate_t e;
+  e.utime = utime;
+  e.sample_index = sample.index;
+  e.counter = sample.counter;
+  e.method = "hwang_integral";
+  e.num_params = 1;
+  e.param_name = {"amplitude_imbalance.alpha"};
+  e.value = {est.alpha()};
+  e.std_error = {est.alpha_stderr()};
+  e.samples_used = est.samples_used();
+  e.revolutions_used = static_cast<double>(est.revolutions());
+  e.converged = est.converged();
+  sink_.publish(e);
+}
+
+void Pipeline::publish_health(std::int64_t utime) {
+  const IntakeStats& st = intake_.stats();
+  health_t h;
+  h.utime = utime;
+  h.sample_index = last_sample_index_;
+  h.counter = last_counter_;
+  h.frames_seen = st.frames_seen;
+  h.frames_decoded = st.frames_decoded;
+  for (const auto& [reason, count] : intake_.rejects().all()) {
+    h.reject_reason.push_back(reason);
+    h.reject_count.push_back(count);
+  }
+  h.num_reasons = static_cast<int32_t>(h.reject_reason.size());
+  h.samples_complete = st.samples_complete;
+  h.samples_incomplete = st.samples_incomplete;
+  h.bus_errors = st.bus_errors;
+  h.kernel_drops = kernel_drops_;
+  const double window_s = static_cast<double>(utime - health_window_start_us_) * 1e-6;
+  h.frame_rate_hz = window_s > 0.0 ? static_cast<double>(st.frames_seen - frames_at_window_start_) / window_s : 0.0;
+  h.latency_p50_us = latency_window_.percentile(0.50);
+  h.latency_p99_us = latency_window_.percentile(0.99);
+  h.latency_max_us = latency_window_.max();
+  sink_.publish(h);
+  latency_window_.clear();
+  health_window_start_us_ = utime;
+  frames_at_window_start_ = st.frames_seen;
+}
+
+}  // namespace resolver

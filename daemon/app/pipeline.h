@@ -1,0 +1,89 @@
+// resolverd's data flow — start reading here.
+//
+//   source (candump log replay | SocketCAN)          daemon/app/main.cpp
+//     │ CanFrame
+//     ▼
+//   FrameIntake: DBC decode, CRC, counters, join     daemon/decode/
+//     │ BenchSample (one control period)
+//     ▼
+//   SampleProcessor: estimate, compensate, dq, ripple daemon/core/estimation/ (pure)
+//     │ SampleOutput
+//     ▼
+//   Pipeline: build angle_t / dq_t / estimate_t / health_t, decimate, publish
+//     │
+//     ▼
+//   OutputSink (LcmOutput on LCM, or a recorder in tests)
+//
+// The pipeline is single-threaded and purely reactive: every call to feed()
+// runs the whole chain for that frame. Time is frame time (log or kernel
+// timestamps); the caller passes the frame's arrival time only for latency.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <ostream>
+
+#include "daemon/app/daemon_config.h"
+#include "daemon/app/latency_histogram.h"
+#include "daemon/app/output_sink.h"
+#include "daemon/app/problem_log.h"
+#include "daemon/app/run_summary.h"
+#include "daemon/core/estimation/sample_processor.h"
+#include "daemon/decode/frame_intake.h"
+
+namespace resolver {
+
+class Pipeline {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// Loads the DBC and builds the chain. Throws ConfigError (bad DBC, signal map).
+  Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics);
+
+  /// Runs one frame through the chain. `line` is its log line (0 live),
+  /// `arrival` when it was read (for latency). Cannot fail.
+  void feed(const CanFrame& frame, std::uint64_t line, Clock::time_point arrival);
+  /// Counts a problem found before a frame existed (malformed log line).
+  void count_problem(std::string_view reason, const std::string& message);
+  /// End of input: emit the open sample, publish a final health_t.
+  void finish();
+  /// Log loop: counters and joins restart, estimates and statistics stay.
+  void restart_sequence() { intake_.restart_sequence(); }
+  /// Live idle time: publishes health_t when a second has passed since the
+  /// last one even if no frame arrived. now_us [us] on the frames' clock.
+  void tick(std::int64_t now_us);
+  /// Cumulative frames dropped by the kernel (SO_RXQ_OVFL), for health_t.
+  void set_kernel_drops(std::int64_t drops) { kernel_drops_ = drops; }
+
+  [[nodiscard]] const FrameIntake& intake() const { return intake_; }
+  [[nodiscard]] const SampleProcessor& processor() const { return processor_; }
+  [[nodiscard]] const RunSummary& summary() const { return summary_; }
+  [[nodiscard]] const LatencyHistogram& latency_total() const { return latency_total_; }
+  [[nodiscard]] std::int64_t samples() const { return samples_; }
+
+ private:
+  void on_sample(const BenchSample& sample);
+  void on_bench_info(const BenchInfo& info);
+  void publish_estimate(std::int64_t utime, const BenchSample& sample);
+  void publish_health(std::int64_t utime);
+
+  DaemonConfig config_;
+  OutputSink& sink_;
+  ProblemLog problems_;
+  FrameIntake intake_;
+  SampleProcessor processor_;
+  RunSummary summary_;
+  LatencyHistogram latency_window_;
+  LatencyHistogram latency_total_;
+  std::int64_t samples_ = 0;
+  std::int64_t last_frame_us_ = 0;
+  std::int64_t health_window_start_us_ = -1;
+  std::int64_t frames_at_window_start_ = 0;
+  std::int64_t last_sample_index_ = 0;
+  std::uint8_t last_counter_ = 0;
+  bool bench_info_seen_ = false;
+  std::int64_t kernel_drops_ = 0;
+};
+
+}  // namespace resolver

@@ -1,0 +1,33 @@
+// Replays a candump -l log through the pipeline: in the log's own timing
+// (frame i is fed at t0 + (ts_i - ts_0)) or as fast as possible, once or in a
+// loop. Malformed lines are counted and reported with file:line:column.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+#include <string>
+
+#include "daemon/app/pipeline.h"
+#include "daemon/app/stop_flag.h"
+
+namespace resolver {
+
+struct ReplayOptions {
+  std::string path;
+  bool fast = false;   ///< ignore log timing
+  bool once = true;    ///< stop at the end of the log (else loop)
+  bool progress = true;  ///< progress lines on stderr for long runs
+};
+
+struct ReplayResult {
+  std::uint64_t frames = 0;
+  std::uint64_t bad_lines = 0;
+  std::uint64_t passes = 0;
+  double wall_seconds = 0.0;
+};
+
+/// Runs until the end of the log (once) or until flags.stop. Throws
+/// std::runtime_error when the log cannot be opened.
+ReplayResult run_replay(const ReplayOptions& options, Pipeline& pipeline, StopFlags& flags, std::ostream& err);
+
+}  // namespace resolver

@@ -1,0 +1,104 @@
+#include "daemon/app/run_report.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "daemon/core/angles.h"
+
+namespace resolver {
+
+namespace {
+
+double ratio_db(double before, double after) {
+  if (!(before > 0.0) || !(after > 0.0)) return std::nan("");
+  return 20.0 * std::log10(after / before);
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  return fmt::format("{:.9g}", v);
+}
+
+}  // namespace
+
+void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info) {
+  const IntakeStats& st = p.intake().stats();
+  const HwangIntegralEstimator& est = p.processor().estimator();
+  const RunSummary& s = p.summary();
+  out << fmt::format("resolverd report: {}\n", info.source);
+  out << fmt::format("  frames     {} seen, {} decoded, {} CAN error frames; {:.0f} frames/s processed\n",
+                     st.frames_seen, st.frames_decoded, st.bus_errors,
+                     info.wall_seconds > 0 ? static_cast<double>(st.frames_seen) / info.wall_seconds : 0.0);
+  out << fmt::format("  samples    {} complete, {} incomplete\n", st.samples_complete, st.samples_incomplete);
+  if (p.intake().rejects().all().empty()) {
+    out << "  rejected   none\n";
+  } else {
+    out << "  rejected  ";
+    for (const auto& [reason, n] : p.intake().rejects().all()) out << fmt::format(" {}={}", reason, n);
+    out << "\n";
+  }
+  const ProcessorConfig& pc = p.processor().config();
+  out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
+  out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.6f} (std. error; spread {:.6f} over {} revolutions) {}\n",
+                     est.alpha(), est.alpha_stderr(), est.alpha_spread(), est.revolutions(),
+                     est.converged() ? "converged" : "NOT converged");
+  out << fmt::format("             revolutions rejected: speed not constant {}, too few samples {}, too slow {}\n",
+                     est.rejected(HwangRejection::kSpeedNotConstant), est.rejected(HwangRejection::kTooFewSamples),
+                     est.rejected(HwangRejection::kTooSlow));
+  if (s.eps_raw.n > 1) {
+    out << fmt::format("  position   error vs reference, RMS about the mean: raw {:.3f} arcmin -> compensated {:.3f} arcmin ({:+.1f} dB)\n",
+                       rad_to_arcmin(s.eps_raw.stddev()), rad_to_arcmin(s.eps_comp.stddev()),
+                       ratio_db(s.eps_raw.stddev(), s.eps_comp.stddev()));
+  } else {
+    out << "  position   no reference angle (or no converged estimate): error vs reference not measured\n";
+  }
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (s.id_raw[k].n == 0) continue;
+    out << fmt::format("  dq ripple  {}x theta_e: i_d raw {:.2f} mA -> comp {:.2f} mA ({:+.1f} dB); i_q raw {:.2f} -> comp {:.2f} mA",
+                       kRippleOrders[k], 1e3 * s.id_raw[k].mean, 1e3 * s.id_comp[k].mean,
+                       ratio_db(s.id_raw[k].mean, s.id_comp[k].mean), 1e3 * s.iq_raw[k].mean, 1e3 * s.iq_comp[k].mean);
+    if (s.id_ref[k].n > 0) out << fmt::format("; with reference angle i_d {:.2f} mA", 1e3 * s.id_ref[k].mean);
+    out << "\n";
+  }
+  if (s.id_raw[0].n == 0) out << "  dq ripple  not measured (no phase currents, or no converged estimate)\n";
+  const LatencyHistogram& lat = p.latency_total();
+  out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us\n",
+                     lat.percentile(0.5), lat.percentile(0.99), lat.max());
+}
+
+std::string run_report_json(const Pipeline& p, const RunInfo& info) {
+  const IntakeStats& st = p.intake().stats();
+  const HwangIntegralEstimator& est = p.processor().estimator();
+  const RunSummary& s = p.summary();
+  std::string j = "{";
+  j += fmt::format("\"source\":\"{}\",\"wall_seconds\":{},", info.source, json_number(info.wall_seconds));
+  j += fmt::format("\"frames_seen\":{},\"frames_decoded\":{},\"bus_errors\":{},\"samples_complete\":{},\"samples_incomplete\":{},",
+                   st.frames_seen, st.frames_decoded, st.bus_errors, st.samples_complete, st.samples_incomplete);
+  j += "\"rejects\":{";
+  bool first = true;
+  for (const auto& [reason, n] : p.intake().rejects().all()) {
+    j += fmt::format("{}\"{}\":{}", first ? "" : ",", reason, n);
+    first = false;
+  }
+  j += "},";
+  j += fmt::format("\"p_r\":{},\"p\":{},", p.processor().config().p_r, p.processor().config().p);
+  j += fmt::format("\"alpha\":{},\"alpha_stderr\":{},\"alpha_spread\":{},\"revolutions\":{},\"converged\":{},",
+                   json_number(est.alpha()), json_number(est.alpha_stderr()), json_number(est.alpha_spread()),
+                   est.revolutions(), est.converged() ? "true" : "false");
+  j += fmt::format("\"eps_rms_raw_rad\":{},\"eps_rms_comp_rad\":{},", json_number(s.eps_raw.stddev()),
+                   json_number(s.eps_comp.stddev()));
+  auto arr = [](const RunningStats (&a)[3]) {
+    return fmt::format("[{},{},{}]", json_number(a[0].value_or_nan()), json_number(a[1].value_or_nan()),
+                       json_number(a[2].value_or_nan()));
+  };
+  j += "\"ripple_orders\":[1,2,6],";
+  j += "\"i_d_ripple_raw\":" + arr(s.id_raw) + ",\"i_d_ripple_comp\":" + arr(s.id_comp) +
+       ",\"i_d_ripple_ref\":" + arr(s.id_ref) + ",";
+  j += "\"i_q_ripple_raw\":" + arr(s.iq_raw) + ",\"i_q_ripple_comp\":" + arr(s.iq_comp) +
+       ",\"i_q_ripple_ref\":" + arr(s.iq_ref);
+  j += "}\n";
+  return j;
+}
+
+}  // namespace resolver

@@ -1,0 +1,97 @@
+// Per-sample signal chain of the daemon, as pure maths over one joined sample:
+//
+//   theta_rd ──► speed, Hwang integral estimator (alpha per revolution)
+//            └─► compensation: theta_c = theta_rd + eps_hat(theta_rd)   (Hwang Fig. 5)
+//   i_a,b,c  ──► Clarke ─► Park with theta_e from raw, compensated, reference angle
+//                          └─► ripple at 1x, 2x, 6x theta_e per electrical revolution
+//
+// Angles follow daemon/core/angles.h: theta = p_r theta_m, theta_e = (p/p_r) theta.
+// The motor electrical angle from the resolver uses the resolver angle unwrapped
+// since the start of the stream, so for p not a multiple of p_r the electrical
+// angle has an unknown constant (which resolver cycle the stream started in);
+// ripple amplitudes do not depend on it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/core/estimation/revolution_ripple.h"
+#include "daemon/core/estimation/speed_estimator.h"
+
+namespace resolver {
+
+struct SampleInput {
+  double t = 0.0;                ///< [s] sample time
+  bool has_rd = false;
+  double theta_rd = 0.0;         ///< [rad] R/D converter angle (resolver electrical)
+  bool has_sincos = false;
+  double sin = 0.0, cos = 0.0;   ///< demodulated envelopes [any unit]
+  bool has_currents = false;
+  double i_a = 0.0, i_b = 0.0, i_c = 0.0;  ///< [A]
+  bool has_ref = false;
+  double theta_m_ref = 0.0;      ///< [rad] mechanical reference angle
+};
+
+struct ProcessorConfig {
+  int p_r = 3;  ///< resolver pole pairs
+  int p = 3;    ///< motor pole pairs
+  HwangIntegralConfig hwang;
+  bool compensate = true;
+};
+
+struct RippleSet {
+  RippleAmplitudes raw, comp, ref;
+  bool raw_valid = false, comp_valid = false, ref_valid = false;
+};
+
+struct SampleOutput {
+  bool has_angle = false;
+  double theta_rd = 0.0;       ///< [rad] wrapped
+  double theta_sincos = 0.0;   ///< [rad] wrapped; NaN without sin/cos
+  double theta_comp = 0.0;     ///< [rad] wrapped
+  double theta_ref = 0.0;      ///< [rad] resolver electrical reference, wrapped; NaN without reference
+  double speed_mech = 0.0;     ///< [rad/s]
+  double eps_hat = 0.0;        ///< [rad] compensation term added to theta_rd
+  double eps_ref = 0.0;        ///< [rad] theta_ref - theta_rd wrapped to [-pi,pi); NaN without reference
+  std::optional<HwangRevolution> revolution;  ///< set when this sample closed a resolver revolution
+
+  bool has_dq = false;
+  double electrical_freq_hz = 0.0;
+  double i_d_raw = 0.0, i_q_raw = 0.0;
+  double i_d_comp = 0.0, i_q_comp = 0.0;
+  double i_d_ref = 0.0, i_q_ref = 0.0;  ///< NaN without reference
+  /// Which ripple trackers closed an electrical revolution on this sample.
+  bool ripple_raw_updated = false, ripple_comp_updated = false, ripple_ref_updated = false;
+  [[nodiscard]] bool ripple_updated() const { return ripple_raw_updated || ripple_comp_updated || ripple_ref_updated; }
+};
+
+class SampleProcessor {
+ public:
+  explicit SampleProcessor(const ProcessorConfig& config);
+
+  /// Processes one sample. Cannot fail; missing signals give NaN outputs.
+  SampleOutput process(const SampleInput& in);
+
+  /// Changes pole pairs (BENCH_INFO); restarts estimation, which depends on them.
+  void set_pole_pairs(int p_r, int p);
+
+  [[nodiscard]] const ProcessorConfig& config() const { return config_; }
+  [[nodiscard]] const HwangIntegralEstimator& estimator() const { return estimator_; }
+  [[nodiscard]] const RippleSet& ripple() const { return ripple_; }
+  /// alpha used by the compensation now (0 until the estimator converged).
+  [[nodiscard]] double active_alpha() const { return active_alpha_; }
+
+ private:
+  ProcessorConfig config_;
+  HwangIntegralEstimator estimator_;
+  SpeedEstimator speed_;
+  AngleUnwrapper rd_unwrap_;
+  AngleUnwrapper ref_unwrap_;
+  RevolutionRipple ripple_raw_, ripple_comp_, ripple_ref_;
+  RippleSet ripple_;
+  double active_alpha_ = 0.0;
+};
+
+}  // namespace resolver

@@ -1,0 +1,134 @@
+#include "daemon/decode/frame_decoder.h"
+
+#include <span>
+#include <stdexcept>
+
+#include "daemon/dbc/dbc_codec.h"
+#include "daemon/decode/crc8_j1850.h"
+
+namespace resolver {
+
+std::string_view to_string(FrameReject reject) {
+  switch (reject) {
+    case FrameReject::kUnknownId: return "unknown_id";
+    case FrameReject::kWrongDlc: return "wrong_dlc";
+    case FrameReject::kCrc: return "crc";
+    case FrameReject::kRemoteFrame: return "remote_frame";
+    case FrameReject::kBenchInfoVersion: return "bench_info_version";
+  }
+  return "unknown";
+}
+
+FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map)
+    : db_(std::move(db)), map_(map) {
+  std::string problems;
+  auto problem = [&problems](const std::string& text) { problems += "\n  - " + text; };
+
+  for (std::size_t r = 0; r < kRoleCount; ++r) {
+    const auto& ref = map_.roles[r];
+    if (!ref) continue;
+    const auto role = static_cast<Role>(r);
+    const dbc::Message* msg = db_->find_message(ref->message);
+    if (msg == nullptr) {
+      problem("role '" + std::string(role_name(role)) + "': no message '" + ref->message + "' in the DBC");
+      continue;
+    }
+    const dbc::Signal* sig = msg->find_signal(ref->signal);
+    if (sig == nullptr) {
+      problem("role '" + std::string(role_name(role)) + "': message '" + ref->message + "' has no signal '" +
+              ref->signal + "'");
+      continue;
+    }
+    auto it = slot_by_id_.find(key(msg->id, msg->extended));
+    int slot_index = 0;
+    if (it == slot_by_id_.end()) {
+      Slot slot;
+      slot.message = msg;
+      slot.counter = msg->find_signal(map_.counter_signal);
+      if (slot.counter == nullptr) {
+        problem("message '" + msg->name + "' carries role '" + std::string(role_name(role)) +
+                "' but has no counter signal '" + map_.counter_signal + "' (set layout.counter_signal)");
+      }
+      if (!map_.crc_signal.empty() && map_.crc != CrcAlgorithm::kNone) {
+        slot.crc = msg->find_signal(map_.crc_signal);
+        if (slot.crc == nullptr) {
+          problem("message '" + msg->name + "' has no CRC signal '" + map_.crc_signal +
+                  "' (set layout.crc_signal, or layout.crc = \"none\")");
+        }
+      }
+      slot_index = static_cast<int>(slots_.size());
+      slots_.push_back(slot);
+      slot_by_id_[key(msg->id, msg->extended)] = slot_index;
+    } else {
+      slot_index = it->second;
+    }
+    slots_[static_cast<std::size_t>(slot_index)].roles.emplace_back(role, sig);
+    mapped_roles_ = static_cast<std::uint16_t>(mapped_roles_ | role_bit(role));
+  }
+  if (!map_.bench_info_message.empty()) {
+    bench_info_ = db_->find_message(map_.bench_info_message);
+    if (bench_info_ == nullptr) {
+      problem("no bench info message '" + map_.bench_info_message + "' in the DBC (set layout.bench_info_message = \"\" to run without one)");
+    }
+  }
+  if ((mapped_roles_ & role_bit(Role::kRdAngle)) == 0 &&
+      (mapped_roles_ & (role_bit(Role::kSin) | role_bit(Role::kCos))) !=
+          (role_bit(Role::kSin) | role_bit(Role::kCos))) {
+    problem("the signal map needs rd_angle, or both sin and cos: nothing to estimate an angle from");
+  }
+  if (!problems.empty()) throw std::invalid_argument("signal map does not fit the DBC:" + problems);
+}
+
+DecodeResult FrameDecoder::decode(const CanFrame& frame, DecodedPart& part, BenchInfo& info) const {
+  DecodeResult result;
+  const std::span<const std::uint8_t> data(frame.data.data(), frame.len);
+  auto reject = [&result](FrameReject why) {
+    result.status = DecodeStatus::kRejected;
+    result.reject = why;
+    return result;
+  };
+  const bool is_bench_info = bench_info_ != nullptr && frame.id == bench_info_->id && frame.extended == bench_info_->extended;
+  const auto it = slot_by_id_.find(key(frame.id, frame.extended));
+  if (it == slot_by_id_.end() && !is_bench_info) return reject(FrameReject::kUnknownId);
+  if (frame.rtr) return reject(FrameReject::kRemoteFrame);
+  const dbc::Message* msg = is_bench_info ? bench_info_ : slots_[static_cast<std::size_t>(it->second)].message;
+  if (frame.len != msg->dlc) return reject(FrameReject::kWrongDlc);
+
+  const dbc::Signal* crc_signal = nullptr;
+  if (map_.crc == CrcAlgorithm::kBenchJ1850 && !map_.crc_signal.empty()) {
+    crc_signal = is_bench_info ? msg->find_signal(map_.crc_signal) : slots_[static_cast<std::size_t>(it->second)].crc;
+  }
+  if (crc_signal != nullptr && frame.len >= 8) {
+    const auto sent = static_cast<std::uint8_t>(dbc::extract_raw(*crc_signal, data));
+    if (sent != bench_frame_crc(frame.data.data(), frame.id)) return reject(FrameReject::kCrc);
+  }
+
+  if (is_bench_info) {
+    auto get = [&](const char* name) -> double {
+      const dbc::Signal* s = msg->find_signal(name);
+      return s != nullptr ? dbc::decode_physical(*s, data) : 0.0;
+    };
+    info.layout_version = static_cast<int>(get("layout_version"));
+    if (info.layout_version != 1) return reject(FrameReject::kBenchInfoVersion);
+    info.p_r = static_cast<int>(get("p_r"));
+    info.p = static_cast<int>(get("p"));
+    info.rd_bits = static_cast<int>(get("rd_bits"));
+    info.sample_rate_hz = get("sample_rate_hz");
+    result.status = DecodeStatus::kBenchInfo;
+    return result;
+  }
+
+  const Slot& slot = slots_[static_cast<std::size_t>(it->second)];
+  part.slot = it->second;
+  part.counter = static_cast<std::uint8_t>(dbc::extract_raw(*slot.counter, data));
+  part.roles = 0;
+  part.timestamp_us = frame.timestamp_us;
+  for (const auto& [role, sig] : slot.roles) {
+    part.values[static_cast<std::size_t>(role)] = dbc::decode_physical(*sig, data);
+    part.roles = static_cast<std::uint16_t>(part.roles | role_bit(role));
+  }
+  result.status = DecodeStatus::kPart;
+  return result;
+}
+
+}  // namespace resolver

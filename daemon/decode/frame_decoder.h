@@ -1,0 +1,87 @@
+// CAN frame -> typed part of a bench sample, through a DBC and a SignalMap.
+//
+// Each DBC message that carries at least one role is a "slot". Decoding a
+// frame checks, in order: error/remote frames, known ID, length against the
+// DBC's DLC, CRC; then extracts the counter and every role the slot carries.
+// A frame that fails a check is rejected with a reason and never touches a
+// sample.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "daemon/dbc/dbc_types.h"
+#include "daemon/decode/signal_map.h"
+#include "drivers/can_frame.h"
+
+namespace resolver {
+
+/// Stable reasons for rejecting a frame; their names are health_t counter names.
+enum class FrameReject : std::uint8_t {
+  kUnknownId,       ///< no DBC message with that ID is mapped
+  kWrongDlc,        ///< length differs from the DBC's DLC
+  kCrc,             ///< CRC mismatch
+  kRemoteFrame,     ///< RTR frame with a mapped ID
+  kBenchInfoVersion ///< BENCH_INFO with an unsupported layout version
+};
+[[nodiscard]] std::string_view to_string(FrameReject reject);
+
+/// One decoded frame that belongs to a sample.
+struct DecodedPart {
+  int slot = 0;                       ///< index into FrameDecoder::slots()
+  std::uint8_t counter = 0;
+  std::uint16_t roles = 0;            ///< role_bit() mask of what `values` holds
+  std::array<double, kRoleCount> values{};
+  std::int64_t timestamp_us = 0;
+};
+
+struct BenchInfo {
+  int layout_version = 0;
+  int p_r = 0;                 ///< resolver pole pairs
+  int p = 0;                   ///< motor pole pairs
+  int rd_bits = 0;             ///< R/D converter resolution [bits]
+  double sample_rate_hz = 0.0; ///< control/sample rate [Hz]
+};
+
+enum class DecodeStatus : std::uint8_t { kPart, kBenchInfo, kRejected };
+
+struct DecodeResult {
+  DecodeStatus status = DecodeStatus::kRejected;
+  FrameReject reject = FrameReject::kUnknownId;
+};
+
+class FrameDecoder {
+ public:
+  struct Slot {
+    const dbc::Message* message = nullptr;
+    const dbc::Signal* counter = nullptr;
+    const dbc::Signal* crc = nullptr;
+    std::vector<std::pair<Role, const dbc::Signal*>> roles;
+  };
+
+  /// Builds the decoder. Throws std::invalid_argument listing every problem
+  /// (unknown message or signal names, missing counter) in one message.
+  FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map);
+
+  /// Decodes one frame. Cannot fail beyond returning kRejected with a reason.
+  DecodeResult decode(const CanFrame& frame, DecodedPart& part, BenchInfo& info) const;
+
+  [[nodiscard]] const std::vector<Slot>& slots() const { return slots_; }
+  [[nodiscard]] std::uint16_t mapped_roles() const { return mapped_roles_; }
+
+ private:
+  static std::uint32_t key(std::uint32_t id, bool extended) { return extended ? (id | 0x80000000U) : id; }
+
+  std::shared_ptr<const dbc::Database> db_;
+  SignalMap map_;
+  std::vector<Slot> slots_;
+  std::unordered_map<std::uint32_t, int> slot_by_id_;  ///< key(id) -> slot
+  const dbc::Message* bench_info_ = nullptr;
+  std::uint16_t mapped_roles_ = 0;
+};
+
+}  // namespace resolver

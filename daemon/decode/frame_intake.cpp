@@ -1,0 +1,125 @@
+#include "daemon/decode/frame_intake.h"
+
+#include <cstdio>
+
+namespace resolver {
+
+std::string describe_frame(const CanFrame& frame) {
+  char buf[96];
+  const auto sec = frame.timestamp_us / 1000000;
+  const auto usec = frame.timestamp_us % 1000000;
+  std::snprintf(buf, sizeof buf, "frame %0*X at (%lld.%06lld)", frame.extended ? 8 : 3, frame.id,
+                static_cast<long long>(sec), static_cast<long long>(usec < 0 ? -usec : usec));
+  return buf;
+}
+
+FrameIntake::FrameIntake(std::shared_ptr<const FrameDecoder> decoder, int max_counter_delta, Callbacks callbacks)
+    : decoder_(std::move(decoder)),
+      max_counter_delta_(max_counter_delta),
+      callbacks_(std::move(callbacks)),
+      counters_(decoder_->slots().size(), CounterCheck(max_counter_delta)),
+      joiner_([this](const BenchSample& s) { on_joined(s); }) {}
+
+void FrameIntake::restart_sequence() {
+  joiner_.flush();
+  joiner_.reset();
+  for (auto& c : counters_) c.reset();
+}
+
+void FrameIntake::count_problem(std::string_view reason, const std::string& message) {
+  rejects_.add(reason);
+  if (callbacks_.on_problem) callbacks_.on_problem(reason, message);
+}
+
+void FrameIntake::reject(std::string_view reason, const CanFrame& frame, std::uint64_t line, const std::string& detail) {
+  rejects_.add(reason);
+  if (!callbacks_.on_problem) return;
+  std::string msg = line > 0 ? "line " + std::to_string(line) + ": " : std::string();
+  msg += describe_frame(frame) + ": " + detail;
+  callbacks_.on_problem(reason, msg);
+}
+
+void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
+  ++stats_.frames_seen;
+  if (frame.error) {
+    ++stats_.bus_errors;
+    return;
+  }
+  const DecodeResult r = decoder_->decode(frame, part_, info_);
+  if (r.status == DecodeStatus::kRejected) {
+    std::string detail;
+    switch (r.reject) {
+      case FrameReject::kUnknownId: detail = "unknown CAN ID (not in the DBC's mapped messages)"; break;
+      case FrameReject::kWrongDlc: detail = "length " + std::to_string(frame.len) + " differs from the DBC's DLC"; break;
+      case FrameReject::kCrc: detail = "CRC-8 J1850 mismatch: frame corrupted, dropped"; break;
+      case FrameReject::kRemoteFrame: detail = "remote (RTR) frame carries no data"; break;
+      case FrameReject::kBenchInfoVersion: detail = "BENCH_INFO layout version is not 1"; break;
+    }
+    reject(to_string(r.reject), frame, line, detail);
+    return;
+  }
+  if (r.status == DecodeStatus::kBenchInfo) {
+    ++stats_.frames_decoded;
+    if (callbacks_.on_bench_info) callbacks_.on_bench_info(info_);
+    return;
+  }
+  CounterCheck& check = counters_[static_cast<std::size_t>(part_.slot)];
+  const std::string& name = decoder_->slots()[static_cast<std::size_t>(part_.slot)].message->name;
+  switch (check.check(part_.counter)) {
+    case CounterStatus::kInitial:
+    case CounterStatus::kOk: break;
+    case CounterStatus::kRepeated:
+      reject("counter_repeated", frame, line,
+             name + " counter " + std::to_string(part_.counter) + " repeated: duplicate frame dropped");
+      return;
+    case CounterStatus::kSomeLost:
+      stats_.frames_lost += check.lost();
+      rejects_.add("counter_gap");
+      rejects_.add("frames_lost", check.lost());
+      if (callbacks_.on_problem) {
+        callbacks_.on_problem("counter_gap", (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) +
+                                                 describe_frame(frame) + ": " + name + " counter jumped to " +
+                                                 std::to_string(part_.counter) + ", " + std::to_string(check.lost()) +
+                                                 " frame(s) lost");
+      }
+      break;
+    case CounterStatus::kWrongSequence:
+      rejects_.add("counter_wrong_sequence");
+      if (callbacks_.on_problem) {
+        callbacks_.on_problem("counter_wrong_sequence",
+                              (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) + describe_frame(frame) +
+                                  ": " + name + " counter jumped to " + std::to_string(part_.counter) +
+                                  " (more than " + std::to_string(max_counter_delta_) + " lost): resynchronised");
+      }
+      break;
+  }
+  if (joiner_.add(part_) == JoinResult::kDuplicate) {
+    reject("duplicate_in_sample", frame, line, name + " appeared twice for counter " + std::to_string(part_.counter));
+    return;
+  }
+  ++stats_.frames_decoded;
+}
+
+void FrameIntake::on_joined(const BenchSample& sample) {
+  if (sample.complete()) {
+    ++stats_.samples_complete;
+  } else {
+    ++stats_.samples_incomplete;
+    std::string missing;
+    for (std::size_t i = 0; i < decoder_->slots().size(); ++i) {
+      const std::uint32_t bit = 1U << i;
+      if ((sample.slots_expected & bit) != 0 && (sample.slots_present & bit) == 0) {
+        missing += (missing.empty() ? "" : ", ") + decoder_->slots()[i].message->name;
+      }
+    }
+    rejects_.add("sample_incomplete");
+    if (callbacks_.on_problem) {
+      callbacks_.on_problem("sample_incomplete", "sample counter " + std::to_string(sample.counter) + " (index " +
+                                                     std::to_string(sample.index) + ") is missing " + missing +
+                                                     "; used with what arrived");
+    }
+  }
+  if (callbacks_.on_sample) callbacks_.on_sample(sample);
+}
+
+}  // namespace resolver

@@ -1,0 +1,77 @@
+// Front half of the pipeline: CAN frames in, joined bench samples out.
+//
+//   frame ─► error frame? ─► bus_errors
+//         └► FrameDecoder (ID, DLC, CRC) ─► reject counters
+//              └► CounterCheck per message (repeated / some lost / wrong sequence)
+//                   └► SampleJoiner ─► on_sample(BenchSample)
+//   BENCH_INFO ─► on_bench_info(BenchInfo)
+//
+// No I/O: problems are reported through the Diagnostics callback with a
+// message that names the frame (and log line when the caller knows it).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "daemon/decode/counter_check.h"
+#include "daemon/decode/frame_decoder.h"
+#include "daemon/decode/reject_counters.h"
+#include "daemon/decode/sample_joiner.h"
+
+namespace resolver {
+
+struct IntakeStats {
+  std::int64_t frames_seen = 0;
+  std::int64_t frames_decoded = 0;   ///< frames that became part of a sample or a BENCH_INFO
+  std::int64_t bus_errors = 0;       ///< CAN error frames
+  std::int64_t samples_complete = 0;
+  std::int64_t samples_incomplete = 0;
+  std::int64_t frames_lost = 0;      ///< frames missing according to counter gaps
+};
+
+class FrameIntake {
+ public:
+  struct Callbacks {
+    std::function<void(const BenchSample&)> on_sample;
+    std::function<void(const BenchInfo&)> on_bench_info;
+    /// reason (a counter name) and a one-line human message.
+    std::function<void(std::string_view reason, const std::string& message)> on_problem;
+  };
+
+  FrameIntake(std::shared_ptr<const FrameDecoder> decoder, int max_counter_delta, Callbacks callbacks);
+
+  /// Processes one frame; `line` is the log line (0 when live). Cannot fail.
+  void feed(const CanFrame& frame, std::uint64_t line = 0);
+  /// Counts a problem found before decoding (e.g. a malformed log line).
+  void count_problem(std::string_view reason, const std::string& message);
+  /// Emits the sample still open (end of input).
+  void flush() { joiner_.flush(); }
+  /// Forgets counters and open samples, keeps statistics (e.g. log loop).
+  void restart_sequence();
+
+  [[nodiscard]] const IntakeStats& stats() const { return stats_; }
+  [[nodiscard]] const RejectCounters& rejects() const { return rejects_; }
+  [[nodiscard]] const FrameDecoder& decoder() const { return *decoder_; }
+
+ private:
+  void reject(std::string_view reason, const CanFrame& frame, std::uint64_t line, const std::string& detail);
+  void on_joined(const BenchSample& sample);
+
+  std::shared_ptr<const FrameDecoder> decoder_;
+  int max_counter_delta_;
+  Callbacks callbacks_;
+  std::vector<CounterCheck> counters_;
+  SampleJoiner joiner_;
+  RejectCounters rejects_;
+  IntakeStats stats_;
+  DecodedPart part_;
+  BenchInfo info_;
+};
+
+/// "frame 0x100 (RESOLVER_SAMPLE) at 1700000000.123456 s" — how messages name a frame.
+std::string describe_frame(const CanFrame& frame);
+
+}  // namespace resolver
