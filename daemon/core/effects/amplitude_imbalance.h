@@ -1,0 +1,31 @@
+// Effect: amplitude imbalance between the resolver's sin and cos channels.
+//
+// Cause: different transformer ratios of the two secondaries, unbalanced
+// excitation, different analog gains (Hwang section 1).
+// Forward model (Hanselman eq. 4, Hwang eq. 6): the cos channel is scaled by
+// (1 + alpha), the sin channel is untouched.
+// Signature (Hanselman eq. 5, Hwang eq. 10), eps = theta - phi:
+//   eps ~= (alpha/2) sin(2 theta)          error at 2x the resolver angle.
+// Exactly, phi = atan2(sin theta, (1 + alpha) cos theta); the omitted terms are
+// O(alpha^2) (a 2theta amplitude change of alpha^2/4 and a 4theta term of
+// alpha^2/8), see tests/unit/effects for the bound.
+#pragma once
+
+#include "daemon/core/effects/sin_cos.h"
+
+namespace resolver {
+
+struct AmplitudeImbalance {
+  /// [1] relative gain error of the cos channel; must be > -1.
+  double alpha = 0.0;
+  [[nodiscard]] bool active() const { return alpha != 0.0; }
+};
+
+/// Forward model: returns `in` with the cos channel scaled by (1 + alpha).
+[[nodiscard]] SinCos apply_amplitude_imbalance(const AmplitudeImbalance& p, const SinCos& in);
+
+/// Small-alpha position error eps = theta - phi [rad] at resolver angle theta [rad]
+/// (Hanselman eq. 5, Hwang eq. 10).
+[[nodiscard]] double amplitude_imbalance_error(const AmplitudeImbalance& p, double theta);
+
+}  // namespace resolver

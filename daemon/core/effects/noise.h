@@ -1,0 +1,31 @@
+// Effect: measurement noise on the sampled sin/cos envelopes and phase currents.
+//
+// White Gaussian noise added by the inverter's ADCs; it sets the floor every
+// estimate and residual is compared against (DESIGN 6). It is applied where the
+// DSP samples (ADC counts, amperes), not inside the R/D converter's analog loop.
+//
+// Randomness only through an engine the caller passes in (no global state), so a
+// seed reproduces a run exactly (with the same standard library build: the
+// normal distribution's algorithm is implementation-defined).
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+namespace resolver {
+
+struct Noise {
+  double sigma_sc = 0.0;  ///< [counts] standard deviation on each sin/cos ADC sample
+  double sigma_i = 0.0;   ///< [A] standard deviation on each phase current sample
+  [[nodiscard]] bool active() const { return sigma_sc != 0.0 || sigma_i != 0.0; }
+};
+
+/// The one random engine type of the effect models.
+using NoiseEngine = std::mt19937_64;
+
+/// One N(0, sigma^2) draw [unit of sigma]. Returns exactly 0 and leaves the engine
+/// untouched when sigma == 0, so switching one noise source off does not change
+/// the draws of the others.
+[[nodiscard]] double gaussian_noise(NoiseEngine& engine, double sigma);
+
+}  // namespace resolver

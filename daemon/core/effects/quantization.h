@@ -1,0 +1,32 @@
+// Effect: R/D converter quantization.
+//
+// The converter reports its angle with rd_bits of resolution. On the bench CAN
+// layout (DESIGN 4) the angle travels in a u16 (65536 counts = 2pi resolver
+// electrical rad) whose low (16 - rd_bits) bits are zero.
+// Forward model: round phi to the nearest multiple of LSB = 2pi / 2^rd_bits.
+// Signature: eps_q = phi - q(phi), uniform in [-LSB/2, +LSB/2] for a moving
+// angle, RMS LSB / sqrt(12).
+#pragma once
+
+#include <cstdint>
+
+namespace resolver {
+
+struct Quantization {
+  static constexpr int kMinBits = 1;
+  static constexpr int kMaxBits = 16;  ///< the u16 field's own resolution: no extra quantization
+  int rd_bits = kMaxBits;              ///< [bits] R/D converter resolution, kMinBits..kMaxBits
+  [[nodiscard]] bool active() const { return rd_bits != kMaxBits; }
+};
+
+/// One LSB of an rd_bits converter [rad]. rd_bits must be in 1..16 (not checked here).
+[[nodiscard]] double quantization_lsb(int rd_bits);
+
+/// Rounds phi [rad, any range] to rd_bits and returns the u16 field value
+/// (0..65535 = 0..2pi, low 16 - rd_bits bits zero). rd_bits must be in 1..16.
+[[nodiscard]] std::uint16_t quantize_rd_angle(double phi, int rd_bits);
+
+/// The angle [rad] in [0, 2pi) a u16 rd_angle field value stands for.
+[[nodiscard]] double rd_counts_to_angle(std::uint16_t counts);
+
+}  // namespace resolver

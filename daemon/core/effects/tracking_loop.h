@@ -1,0 +1,102 @@
+// Effect: the dynamics of a type-II tracking R/D converter.
+//
+// The converter (Hanselman II.A and Fig. 1, Hwang Fig. 2) multiplies the sin
+// envelope by cos(phi) and the cos envelope by sin(phi), takes the difference
+//   e = s cos(phi) - c sin(phi)          (= sin(theta - phi) for ideal envelopes,
+//                                         Hanselman eq. 3, Hwang eq. 4)
+// and drives it to zero with a type-II servo (two integrators plus a zero):
+//   d(phi)/dt   = w + 2 zeta omega_n e
+//   d(w)/dt     = omega_n^2 e
+// Linearised (e ~= theta - phi) the closed loop is
+//   Phi(s)/Theta(s) = H(s) = (2 zeta omega_n s + omega_n^2) / (s^2 + 2 zeta omega_n s + omega_n^2),
+// so a constant speed is tracked with zero error (type II), a constant
+// acceleration a [rad/s^2] lags by a / omega_n^2, and error harmonics of the
+// envelopes at speed-dependent frequencies are filtered by H (DESIGN 6: the
+// ripple's amplitude and phase change with speed).
+//
+// Integration: classical RK4 with the envelopes evaluated at the true angle of
+// each stage time, so the true angle advances continuously inside a control
+// sample period. The loop's poles have |lambda| = omega_n; RK4 is stable for
+// |lambda h| < ~2.8 and its one-step error is ~(lambda h)^5 / 120. We keep
+// omega_n h <= kMaxOmegaNStep = 0.05: the per-step error is ~3e-9 relative, i.e.
+// the integration is far below any quantization or noise level.
+//
+// omega_n == 0 selects the ideal, infinitely fast converter: phi equals the
+// static equilibrium atan2(s, c) at every instant.
+#pragma once
+
+#include <cmath>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/effects/sin_cos.h"
+
+namespace resolver {
+
+struct TrackingLoopConfig {
+  /// Largest omega_n * h of one RK4 substep [1] (see the header comment).
+  static constexpr double kMaxOmegaNStep = 0.05;
+  /// [rad/s] closed-loop natural frequency; 0 = ideal converter; must be >= 0.
+  double omega_n = 0.0;
+  /// [1] damping ratio; must be > 0.
+  double zeta = 0.7;
+  [[nodiscard]] bool active() const { return omega_n > 0.0; }
+};
+
+struct TrackingLoopState {
+  double phi = 0.0;    ///< [rad] converter angle, continuous (not wrapped)
+  double omega = 0.0;  ///< [rad/s] converter velocity (the second integrator)
+};
+
+/// Number of RK4 substeps advance() takes over `duration` [s]. At least 1.
+[[nodiscard]] int tracking_loop_substeps(const TrackingLoopConfig& config, double duration);
+
+class TrackingLoop {
+ public:
+  explicit TrackingLoop(const TrackingLoopConfig& config) : config_(config) {}
+
+  /// Sets the state, e.g. to a converged loop: phi = true angle, omega = true speed.
+  void reset(const TrackingLoopState& state) { state_ = state; }
+
+  /// Advances the loop from time t0 to t0 + duration [s]. `envelope_at(t)` must
+  /// return the envelopes (SinCos) seen by the converter at time t [s]; it is
+  /// evaluated at t0, the substep mid-points and ends.
+  template <typename EnvelopeAt>
+  void advance(EnvelopeAt&& envelope_at, double t0, double duration) {
+    if (!config_.active()) {
+      // Ideal converter: follow the static angle, keep phi continuous.
+      const double target = static_rd_angle(envelope_at(t0 + duration));
+      const double step = wrap_pi(target - state_.phi);
+      state_.omega = duration > 0.0 ? step / duration : 0.0;
+      state_.phi += step;
+      return;
+    }
+    const int n = tracking_loop_substeps(config_, duration);
+    const double h = duration / n;
+    SinCos at_start = envelope_at(t0);
+    for (int i = 0; i < n; ++i) {
+      const double t = t0 + h * i;
+      const SinCos at_mid = envelope_at(t + 0.5 * h);
+      const SinCos at_end = envelope_at(t + h);
+      rk4_step(at_start, at_mid, at_end, h);
+      at_start = at_end;
+    }
+  }
+
+  [[nodiscard]] const TrackingLoopState& state() const { return state_; }
+  [[nodiscard]] const TrackingLoopConfig& config() const { return config_; }
+  /// Converter angle wrapped to [0, 2pi) [rad].
+  [[nodiscard]] double angle() const { return wrap_2pi(state_.phi); }
+
+ private:
+  void rk4_step(const SinCos& at_start, const SinCos& at_mid, const SinCos& at_end, double h);
+
+  TrackingLoopConfig config_;
+  TrackingLoopState state_;
+};
+
+/// The linearised closed-loop gain |H(j omega)| of the loop at angular frequency omega [rad/s].
+[[nodiscard]] double tracking_loop_gain(const TrackingLoopConfig& config, double omega);
+/// The linearised closed-loop phase arg H(j omega) [rad].
+[[nodiscard]] double tracking_loop_phase(const TrackingLoopConfig& config, double omega);
+
+}  // namespace resolver

@@ -1,0 +1,45 @@
+// CandumpWriter: CanFrames -> a candump -l log file that canplayer, log2asc
+// and python-can read.
+//
+// Lines are formatted into one reused buffer and written with write(2) in
+// 64 KiB chunks, so the good path makes no allocation per frame. Every
+// failure throws (the caller decides whether a lost log is fatal).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "drivers/can_frame.h"
+
+namespace resolver {
+
+class CandumpWriter {
+ public:
+  /// Creates or truncates `path` (mode 0644). Throws std::runtime_error
+  /// ("cannot create <path>: <strerror>").
+  explicit CandumpWriter(const std::string& path);
+  /// Closes without throwing; a failure here is lost, so call close() to see it.
+  ~CandumpWriter();
+  CandumpWriter(const CandumpWriter&) = delete;
+  CandumpWriter& operator=(const CandumpWriter&) = delete;
+
+  /// Appends one line. Throws std::invalid_argument if check_loggable()
+  /// rejects the frame (nothing is written), std::runtime_error on an I/O
+  /// error or after close().
+  void write(const CanFrame& frame);
+  /// Flushes and closes; throws std::runtime_error naming the path and strerror.
+  /// A second call does nothing.
+  void close();
+  [[nodiscard]] std::uint64_t frames_written() const { return frames_written_; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  void flush();
+
+  std::string path_;
+  int fd_ = -1;
+  std::string buffer_;
+  std::uint64_t frames_written_ = 0;
+};
+
+}  // namespace resolver

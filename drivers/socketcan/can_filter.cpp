@@ -1,0 +1,23 @@
+#include "drivers/socketcan/can_filter.h"
+
+#include <linux/can.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace resolver {
+
+KernelCanFilter to_kernel_filter(const CanIdFilter& filter) {
+  const std::uint32_t width_mask = filter.extended ? CAN_EFF_MASK : CAN_SFF_MASK;
+  if (filter.id > width_mask) {
+    throw std::invalid_argument(
+        "CAN filter id " + std::to_string(filter.id) + " does not fit in " +
+        (filter.extended ? "29 bits" : "11 bits; set extended = true for 29-bit IDs"));
+  }
+  KernelCanFilter out{};
+  out.can_id = filter.id | (filter.extended ? CAN_EFF_FLAG : 0U);
+  out.can_mask = (filter.mask & width_mask) | CAN_EFF_FLAG;
+  return out;
+}
+
+}  // namespace resolver

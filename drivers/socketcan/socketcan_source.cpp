@@ -1,0 +1,154 @@
+// SocketCanSource: construction, read loop and write. Setup of a real CAN_RAW
+// socket lives in socketcan_open.cpp.
+#include "drivers/socketcan/socketcan_source.h"
+
+#include <poll.h>
+#include <sys/socket.h>
+
+#include <array>
+#include <cerrno>
+#include <climits>
+#include <optional>
+#include <utility>
+
+#include "drivers/socketcan/can_cmsg.h"
+#include "drivers/socketcan/can_wire.h"
+
+namespace resolver {
+namespace {
+
+// [bytes] Room for every cmsg open() enables: SCM_TIMESTAMPING (3 x 16 + 16
+// header), SCM_TIMESTAMPNS (16 + 16) and SO_RXQ_OVFL (4 + 16, padded to 24),
+// about 120 bytes; 256 leaves slack for an adopted fd with other options.
+constexpr std::size_t kControlBytes = 256;
+
+int to_poll_timeout_ms(std::chrono::milliseconds timeout) {
+  if (timeout.count() < 0) return -1;  // poll(): wait forever
+  return timeout.count() > INT_MAX ? INT_MAX : static_cast<int>(timeout.count());
+}
+
+std::int64_t realtime_now_us() {
+  // system_clock is CLOCK_REALTIME on Linux, the clock SO_TIMESTAMP uses.
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+SocketCanSource::SocketCanSource(UniqueFd fd, std::string iface,
+                                 std::chrono::milliseconds read_timeout)
+    : fd_(std::move(fd)), iface_(std::move(iface)), read_timeout_(read_timeout) {}
+
+SocketCanSource SocketCanSource::adopt(int fd, std::string iface_name) {
+  if (fd < 0) throw SocketCanError("adopt(fd " + std::to_string(fd) + ")", iface_name, EBADF);
+  return SocketCanSource(UniqueFd(fd), std::move(iface_name), SocketCanOptions{}.read_timeout);
+}
+
+ReadStatus SocketCanSource::read(CanFrame& frame) {
+  pollfd pfd{};
+  pfd.fd = fd_.get();
+  pfd.events = POLLIN;
+  const int ready = ::poll(&pfd, 1, to_poll_timeout_ms(read_timeout_));
+  if (ready < 0) {
+    if (errno == EINTR) return ReadStatus::kInterrupted;
+    throw SocketCanError("poll", iface_, errno);
+  }
+  if (ready == 0) {
+    ++stats_.timeouts;
+    return ReadStatus::kTimeout;
+  }
+  if ((pfd.revents & POLLNVAL) != 0) throw SocketCanError("poll", iface_, EBADF);
+  // POLLERR is not handled here: recvmsg() returns the pending socket error
+  // (ENETDOWN, ENODEV), which receive() maps to a status.
+  return receive(frame, pfd.revents);
+}
+
+ReadStatus SocketCanSource::receive(CanFrame& frame, short revents) {
+  CanWireImage image{};
+  iovec iov{};
+  iov.iov_base = image.data();
+  iov.iov_len = image.size();
+  alignas(cmsghdr) std::array<unsigned char, kControlBytes> control{};
+  msghdr msg{};
+  msg.msg_iov = &iov;
+  msg.msg_iovlen = 1;
+  msg.msg_control = control.data();
+  msg.msg_controllen = control.size();
+
+  // MSG_DONTWAIT: poll() said readable, but a pending error may already have
+  // been consumed; never block past read_timeout.
+  const ssize_t received = ::recvmsg(fd_.get(), &msg, MSG_DONTWAIT);
+  if (received < 0) {
+    const int err = errno;
+    switch (err) {
+      case EAGAIN:
+        ++stats_.timeouts;
+        return ReadStatus::kTimeout;
+      case EINTR:
+        return ReadStatus::kInterrupted;
+      case ENETDOWN:
+        ++stats_.network_down;
+        return ReadStatus::kNetworkDown;
+      case ENODEV:
+      case ENXIO:
+        return ReadStatus::kDeviceGone;
+      default:
+        throw SocketCanError("recvmsg", iface_, err);
+    }
+  }
+  // CAN_RAW never returns an empty read; a 0-byte read with POLLHUP is a
+  // stream/seqpacket peer that closed (adopted fds).
+  if (received == 0 && (revents & POLLHUP) != 0) return ReadStatus::kDeviceGone;
+
+  // Drops are counted even when this read turns out to be malformed.
+  const ReceiveMetadata meta = parse_receive_cmsgs(msg);
+  if (meta.drop_counter) {
+    stats_.kernel_drops += drops_since(last_drop_counter_, *meta.drop_counter);
+    last_drop_counter_ = *meta.drop_counter;
+  }
+
+  const auto size = static_cast<std::size_t>(received);
+  if ((msg.msg_flags & MSG_TRUNC) != 0 ||
+      decode_wire_frame(std::span<const std::uint8_t>(image.data(), size), frame) !=
+          WireDecodeStatus::kOk) {
+    ++stats_.truncated;
+    return ReadStatus::kTruncated;
+  }
+  frame.timestamp_us = meta.timestamp_us ? *meta.timestamp_us : realtime_now_us();
+  frame.set_iface(iface_);
+  ++stats_.frames;
+  if (frame.fd) ++stats_.fd_frames;
+  if (frame.error) ++stats_.error_frames;
+  return ReadStatus::kFrame;
+}
+
+void SocketCanSource::write(const CanFrame& frame) {
+  CanWireImage image{};
+  const std::size_t size = encode_wire_frame(frame, image);
+  using Clock = std::chrono::steady_clock;
+  const std::optional<Clock::time_point> deadline =
+      read_timeout_.count() < 0 ? std::nullopt : std::optional(Clock::now() + read_timeout_);
+  for (;;) {
+    // MSG_NOSIGNAL: a closed peer (adopted socketpair) gives EPIPE, not SIGPIPE.
+    const ssize_t sent = ::send(fd_.get(), image.data(), size, MSG_NOSIGNAL);
+    if (sent == static_cast<ssize_t>(size)) return;
+    if (sent >= 0) {
+      throw SocketCanError("write (" + std::to_string(sent) + " of " + std::to_string(size) +
+                               " bytes sent)",
+                           iface_, EIO, "the socket is not a CAN_RAW datagram socket");
+    }
+    const int err = errno;
+    if (err == EINTR) continue;
+    const bool queue_full = err == ENOBUFS || err == EAGAIN;
+    if (queue_full && (!deadline || Clock::now() < *deadline)) {
+      // CAN_RAW does not signal POLLOUT when the device queue drains, so
+      // retry after 1 ms (about 4 classic frames at 500 kbit/s).
+      ::poll(nullptr, 0, 1);
+      continue;
+    }
+    throw SocketCanError("write", iface_, err);
+  }
+}
+
+}  // namespace resolver

@@ -1,0 +1,170 @@
+// Each envelope effect's exact forward model (through an ideal converter,
+// phi = atan2(s, c)) against the paper's small-parameter signature, within an
+// approximation bound derived for that effect.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/effects/sensor_chain.h"
+
+namespace resolver {
+namespace {
+
+constexpr int kGrid = 3600;  // theta grid over one electrical turn
+
+/// Exact position error eps = theta - phi [rad] of the chain through an ideal converter.
+double exact_error(const SensorChainConfig& chain, double theta) {
+  return wrap_pi(theta - static_rd_angle(sensor_envelopes(chain, theta)));
+}
+
+/// Largest |exact - signature| over the grid, and the largest |signature|.
+struct Residual {
+  double max_residual = 0.0;
+  double max_signature = 0.0;
+};
+template <typename Signature>
+Residual residual(const SensorChainConfig& chain, Signature&& signature) {
+  Residual r;
+  for (int i = 0; i < kGrid; ++i) {
+    const double theta = kTwoPi * (i + 0.37) / kGrid;  // off the symmetric points on purpose
+    const double sig = signature(theta);
+    r.max_residual = std::max(r.max_residual, std::abs(exact_error(chain, theta) - sig));
+    r.max_signature = std::max(r.max_signature, std::abs(sig));
+  }
+  return r;
+}
+
+/// Bound on the second-order remainder of atan2 for a perturbation of length d
+/// from the unit circle: the Hessian of atan2 has norm 1/r^2 and r >= 1 - d on the
+/// segment, so |remainder| <= d^2 / (2 (1 - d)^2).
+double atan2_second_order_bound(double d) { return 0.5 * d * d / ((1.0 - d) * (1.0 - d)); }
+
+TEST(EffectsSignatures, IdealChainHasNoError) {
+  const SensorChainConfig ideal;
+  const Residual r = residual(ideal, [](double) { return 0.0; });
+  EXPECT_LT(r.max_residual, 1e-15 * kTwoPi * 4);  // rounding of atan2 only
+}
+
+TEST(EffectsSignatures, AmplitudeImbalanceMatchesHanselmanEq5) {
+  for (const double alpha : {-0.05, -0.01, 0.003, 0.01, 0.05}) {
+    SensorChainConfig chain;
+    chain.amplitude_imbalance.alpha = alpha;
+    const Residual r =
+        residual(chain, [&](double theta) { return amplitude_imbalance_error(chain.amplitude_imbalance, theta); });
+    // Exact: tan(phi) = tan(theta)/(1+alpha) gives
+    //   eps = -sum_k q^k/k sin(2k theta), q = -alpha/(2+alpha),
+    // so eps - (alpha/2) sin 2theta is bounded by the change of the first term,
+    // |alpha/2 - alpha/(2+alpha)| ~ alpha^2/4, plus the tail sum_{k>=2} |q|^k/k = -ln(1-|q|) - |q|.
+    const double q = std::abs(alpha / (2.0 + alpha));
+    const double bound = std::abs(0.5 * alpha - alpha / (2.0 + alpha)) + (-std::log1p(-q) - q);
+    EXPECT_LE(r.max_residual, bound * (1.0 + 1e-6) + 1e-15) << "alpha=" << alpha;
+    // The bound is second order: far below the signature itself, so a wrong
+    // sign or factor could not pass.
+    EXPECT_LT(bound, 0.05 * r.max_signature) << "alpha=" << alpha;
+    EXPECT_NEAR(r.max_signature, std::abs(alpha) / 2.0, 1e-6 * std::abs(alpha));
+  }
+}
+
+TEST(EffectsSignatures, QuadratureSignMatchesExactModel) {
+  // At theta = pi/2 the exact model is closed-form: phi = atan2(1, cos(pi/2 + beta))
+  // = atan2(1, -sin beta) = pi/2 + atan(sin beta), so eps = theta - phi = -atan(sin beta)
+  // ~= -beta. Hanselman eq. 7 as printed, +(beta/2)(1 - cos 2theta), would give +beta:
+  // with eps = theta - phi the sign is negative.
+  const double beta = 0.004;
+  SensorChainConfig chain;
+  chain.quadrature.beta = beta;
+  const double theta = 0.5 * std::numbers::pi;
+  EXPECT_NEAR(exact_error(chain, theta), -std::atan(std::sin(beta)), 1e-15);
+  EXPECT_NEAR(quadrature_error(chain.quadrature, theta), -beta, 1e-15);
+  // atan(sin beta) = beta - beta^3/2 + ...: the signature is right to third order here.
+  EXPECT_NEAR(exact_error(chain, theta), quadrature_error(chain.quadrature, theta), beta * beta * beta);
+}
+
+TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
+  for (const double beta : {-0.03, -0.004, 0.004, 0.01, 0.03}) {
+    SensorChainConfig chain;
+    chain.quadrature.beta = beta;
+    const Residual r = residual(chain, [&](double theta) { return quadrature_error(chain.quadrature, theta); });
+    // phi(beta) = atan2(sin theta, cos(theta + beta)); d phi/d beta = N/D with
+    // N = sin theta sin(theta+beta), D = sin^2 theta + cos^2(theta+beta) = 1 - sin(2theta+beta) sin beta.
+    // |N|, |N'|, |D'| <= 1, 1-|beta| <= D <= 1+|beta|, so |phi''| <= (2+|beta|)/(1-|beta|)^2 and the
+    // Taylor remainder after the first-order term is <= beta^2/2 * (2+|beta|)/(1-|beta|)^2.
+    const double b = std::abs(beta);
+    const double bound = 0.5 * b * b * (2.0 + b) / ((1.0 - b) * (1.0 - b));
+    EXPECT_LE(r.max_residual, bound) << "beta=" << beta;
+    EXPECT_LT(bound, 0.05 * r.max_signature) << "beta=" << beta;
+    EXPECT_NEAR(r.max_signature, b, 1e-6 * b);  // peak of (beta/2)(1 - cos 2theta) is beta
+  }
+}
+
+TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
+  for (const auto& [o_s, o_c] : {std::pair{0.001, -0.002}, std::pair{-0.01, 0.0}, std::pair{0.0, 0.02}}) {
+    SensorChainConfig chain;
+    chain.offsets = {o_s, o_c};
+    const Residual r = residual(chain, [&](double theta) { return offsets_error(chain.offsets, theta); });
+    const double bound = atan2_second_order_bound(std::hypot(o_s, o_c));
+    EXPECT_LE(r.max_residual, bound) << o_s << "," << o_c;
+    EXPECT_LT(bound, 0.05 * r.max_signature);
+    EXPECT_NEAR(r.max_signature, std::hypot(o_s, o_c), 1e-5 * std::hypot(o_s, o_c));  // 1x sinusoid
+  }
+}
+
+TEST(EffectsSignatures, HarmonicsMatchHanselmanEq9) {
+  SensorChainConfig chain;
+  chain.harmonics.k0 = 0.002;
+  chain.harmonics.k[2] = -0.001;
+  chain.harmonics.k[3] = 0.0015;
+  chain.harmonics.k[7] = 0.0005;
+  const Residual r = residual(chain, [&](double theta) { return harmonics_error(chain.harmonics, theta); });
+  // The harmonic part is an additive perturbation of length <= sqrt2 (|K_0| + sum |K_n|);
+  // Hanselman eq. 9 is exactly its first-order atan2 term.
+  const double d = std::numbers::sqrt2 * (0.002 + 0.001 + 0.0015 + 0.0005);
+  const double bound = atan2_second_order_bound(d);
+  EXPECT_LE(r.max_residual, bound);
+  EXPECT_LT(bound, 0.05 * r.max_signature);
+}
+
+TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
+  // DESIGN 6: K_3 and alpha both give a 2theta error; K_3 = -alpha/2 mimics alpha to first order.
+  SensorChainConfig with_alpha;
+  with_alpha.amplitude_imbalance.alpha = 0.004;
+  SensorChainConfig with_k3;
+  with_k3.harmonics.k[3] = -0.002;
+  for (int i = 0; i < 64; ++i) {
+    const double theta = kTwoPi * i / 64.0;
+    EXPECT_NEAR(small_signal_error(with_alpha, theta), small_signal_error(with_k3, theta), 1e-15);
+  }
+  // ...but the envelopes differ at first order: the effects are told apart there.
+  const SinCos a = sensor_envelopes(with_alpha, 0.3);
+  const SinCos k = sensor_envelopes(with_k3, 0.3);
+  EXPECT_GT(std::abs(a.c - k.c) + std::abs(a.s - k.s), 1e-3);
+}
+
+TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {
+  SensorChainConfig chain;
+  chain.amplitude_imbalance.alpha = 0.003;
+  chain.quadrature.beta = 0.002;
+  chain.offsets = {0.001, -0.0015};
+  chain.harmonics.k0 = 0.0005;
+  chain.harmonics.k[3] = 0.0008;
+  const Residual r = residual(chain, [&](double theta) { return small_signal_error(chain, theta); });
+  // Perturbation of the envelopes from the unit circle: d = d_lin + d_2 with
+  // |d_2| <= beta^2/2 (cos(theta+beta) vs its linearisation) + |alpha| (|beta| + |H|)
+  // (alpha times the perturbed cos channel). The signature sum is the first-order
+  // atan2 term of d_lin (gradient norm 1), so
+  //   |residual| <= |d_2| + d^2 / (2 (1-d)^2).
+  const double alpha = 0.003;
+  const double beta = 0.002;
+  const double harm = std::numbers::sqrt2 * (0.0005 + 0.0008);
+  const double off = std::hypot(0.001, 0.0015);
+  const double d2 = 0.5 * beta * beta + alpha * (beta + harm);
+  const double d = beta + alpha * (1.0 + beta + harm) + harm + off;
+  const double bound = d2 + atan2_second_order_bound(d);
+  EXPECT_LE(r.max_residual, bound);
+  EXPECT_LT(bound, 0.05 * r.max_signature);
+}
+
+}  // namespace
+}  // namespace resolver

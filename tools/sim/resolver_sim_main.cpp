@@ -1,0 +1,245 @@
+// resolver-sim: writes a candump -l log of the bench with chosen catalog effects.
+// Wiring only: options -> SimConfig -> BenchSimulator -> CandumpWriter.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "daemon/core/effects/effect_catalog.h"
+#include "drivers/candump/candump_writer.h"
+#include "tools/sim/bench_simulator.h"
+#include "tools/sim/sim_truth.h"
+
+namespace {
+
+using resolver::SimConfig;
+
+constexpr double kBusFramesPerSecond = 8000.0;  // ~1 Mbit/s classic CAN, 8-byte standard frames
+
+constexpr const char* kExamples = R"(
+Examples:
+  # Hwang's setup: 200 r/min, 0.3 % amplitude imbalance, 5 s
+  resolver-sim --out imbalance.log --effect amplitude_imbalance:alpha=0.003
+  # Constant 1000 r/min for 10 s, 12-bit converter, truth file for the report
+  resolver-sim --out fast.log --rpm 1000 --duration 10 --rd-bits 12 --truth fast.json
+  # Hold 200 r/min, ramp to 1000 r/min in 3 s, hold 2 s; several effects
+  resolver-sim --out sweep.log --profile "200:5,200-1000:3,1000:2" \
+      --effect quadrature:beta=0.004 --effect offsets:o_s=0.001,o_c=-0.002
+  # An ideal chain: no noise, infinitely fast converter
+  resolver-sim --out ideal.log --effect noise:sigma_sc=0,sigma_i=0 --effect tracking_loop:omega_n=0
+  # Replay on a virtual bus:  canplayer -I imbalance.log vcan0=can0
+Options can also come from --config FILE.toml (keys = long option names with '_'
+for '-', effects = ["spec", ...]); options on the command line win.
+)";
+
+struct Options {
+  std::string out;
+  std::string truth;
+  std::string config_file;
+  std::string profile_text;
+  double rpm = 200.0;
+  double duration = 5.0;
+  int p_r = 3;
+  int p = 3;
+  int rd_bits = 16;
+  double sample_rate = 2000.0;
+  double amplitude = 26000.0;
+  double iq = 10.0;
+  double id = 0.0;
+  std::vector<std::string> effects;
+  bool no_reference = false;
+  std::uint64_t seed = 1;
+  std::string iface = "can0";
+  bool list_effects = false;
+};
+
+[[noreturn]] void fail(const std::string& message) {
+  fmt::print(stderr, "resolver-sim: {}\n", message);
+  std::exit(2);
+}
+
+/// Fills options the command line did not set from a TOML file.
+void apply_toml(const std::string& path, const CLI::App& app, Options& o, std::vector<std::string>& toml_effects) {
+  toml::table table;
+  try {
+    table = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    fail(fmt::format("--config {}: {} (line {}); fix the TOML syntax", path, e.description(),
+                     e.source().begin.line));
+  }
+  const auto unset = [&](const char* option) { return app.get_option(option)->count() == 0; };
+  const auto number = [&](const std::string& key, const toml::node& node) {
+    if (auto v = node.value<double>()) return *v;
+    fail(fmt::format("--config {}: key '{}' must be a number", path, key));
+  };
+  const auto text = [&](const std::string& key, const toml::node& node) {
+    if (auto v = node.value<std::string>()) return *v;
+    fail(fmt::format("--config {}: key '{}' must be a string", path, key));
+  };
+  const auto integer = [&](const std::string& key, const toml::node& node) {
+    if (auto v = node.value<std::int64_t>()) return *v;
+    fail(fmt::format("--config {}: key '{}' must be an integer", path, key));
+  };
+  for (const auto& [key_node, node] : table) {
+    const std::string key(key_node.str());
+    if (key == "out") { if (unset("--out")) o.out = text(key, node); }
+    else if (key == "truth") { if (unset("--truth")) o.truth = text(key, node); }
+    else if (key == "profile") { if (unset("--profile") && unset("--rpm")) o.profile_text = text(key, node); }
+    else if (key == "rpm") { if (unset("--rpm") && unset("--profile")) { o.rpm = number(key, node); o.profile_text.clear(); } }
+    else if (key == "duration") { if (unset("--duration")) o.duration = number(key, node); }
+    else if (key == "p_r") { if (unset("--p-r")) o.p_r = static_cast<int>(integer(key, node)); }
+    else if (key == "p") { if (unset("--p")) o.p = static_cast<int>(integer(key, node)); }
+    else if (key == "rd_bits") { if (unset("--rd-bits")) o.rd_bits = static_cast<int>(integer(key, node)); }
+    else if (key == "sample_rate") { if (unset("--sample-rate")) o.sample_rate = number(key, node); }
+    else if (key == "amplitude") { if (unset("--amplitude")) o.amplitude = number(key, node); }
+    else if (key == "iq") { if (unset("--iq")) o.iq = number(key, node); }
+    else if (key == "id") { if (unset("--id")) o.id = number(key, node); }
+    else if (key == "seed") { if (unset("--seed")) o.seed = static_cast<std::uint64_t>(integer(key, node)); }
+    else if (key == "iface") { if (unset("--iface")) o.iface = text(key, node); }
+    else if (key == "reference") {
+      const auto v = node.value<bool>();
+      if (!v) fail(fmt::format("--config {}: key 'reference' must be true or false", path));
+      if (unset("--no-reference")) o.no_reference = !*v;
+    } else if (key == "effects") {
+      const toml::array* arr = node.as_array();
+      if (arr == nullptr) fail(fmt::format("--config {}: key 'effects' must be an array of spec strings", path));
+      for (const toml::node& e : *arr) toml_effects.push_back(text("effects[]", e));
+    } else {
+      fail(fmt::format(
+          "--config {}: unknown key '{}'; valid keys: out, truth, rpm, duration, profile, p_r, p, rd_bits, "
+          "sample_rate, amplitude, iq, id, effects, reference, seed, iface",
+          path, key));
+    }
+  }
+}
+
+SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<std::string>& toml_effects) {
+  SimConfig c;
+  const bool rpm_given = app.get_option("--rpm")->count() > 0 || o.profile_text.empty();
+  if (!o.profile_text.empty() && app.get_option("--duration")->count() > 0) {
+    fail("--duration applies to --rpm; with --profile each segment carries its own seconds (rpm:seconds)");
+  }
+  if (!o.profile_text.empty()) {
+    if (auto err = resolver::parse_speed_profile(o.profile_text, c.profile)) fail(*err);
+  } else if (rpm_given) {
+    c.profile = {{o.duration, o.rpm, o.rpm}};
+  }
+  c.p_r = o.p_r;
+  c.p = o.p;
+  c.rd_bits = o.rd_bits;
+  c.sample_rate_hz = o.sample_rate;
+  c.amplitude_counts = o.amplitude;
+  c.i_q_cmd = o.iq;
+  c.i_d_cmd = o.id;
+  c.reference = !o.no_reference;
+  c.seed = o.seed;
+  c.iface = o.iface;
+  // TOML effects first, then the command line's: a later spec of the same parameter wins.
+  for (const auto* list : {&toml_effects, &o.effects}) {
+    for (const std::string& spec : *list) {
+      if (auto err = resolver::apply_effect_spec(c.chain, spec)) fail(fmt::format("--effect: {}", *err));
+    }
+  }
+  // --effect quantization:rd_bits=N and --rd-bits N are one setting.
+  if (app.get_option("--rd-bits")->count() == 0 && c.chain.quantization.rd_bits != 16) {
+    c.rd_bits = c.chain.quantization.rd_bits;
+  }
+  return c;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
+      "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects."};
+  app.footer(std::string(kExamples) + "\n" + resolver::format_effect_catalog());
+  Options o;
+  app.add_option("--out,-o", o.out, "candump -l log file to write (required)");
+  app.add_option("--rpm", o.rpm, "constant mechanical speed [r/min] (default 200)");
+  app.add_option("--duration", o.duration, "run length with --rpm [s] (default 5)")->check(CLI::PositiveNumber);
+  app.add_option("--profile", o.profile_text, "speed profile: rpm[-rpm_end]:seconds,... e.g. \"200:5,200-1000:3\"")
+      ->excludes("--rpm");
+  app.add_option("--p-r", o.p_r, "resolver pole pairs (default 3)")->check(CLI::Range(1, 255));
+  app.add_option("--p", o.p, "motor pole pairs (default 3)")->check(CLI::Range(1, 255));
+  app.add_option("--rd-bits", o.rd_bits, "R/D converter resolution [bits] (default 16)")->check(CLI::Range(1, 16));
+  app.add_option("--sample-rate", o.sample_rate, "control samples per second [Hz] (default 2000)")
+      ->check(CLI::Range(1.0, 65535.0));
+  app.add_option("--amplitude", o.amplitude, "sin/cos envelope amplitude [ADC counts] (default 26000)");
+  app.add_option("--iq", o.iq, "commanded q current [A] (default 10)");
+  app.add_option("--id", o.id, "commanded d current [A] (default 0)");
+  app.add_option("--effect,-e", o.effects, "effect spec effect:param=value,... (repeatable; see the catalog below)");
+  app.add_flag("--no-reference", o.no_reference, "do not send REFERENCE_ANGLE frames");
+  app.add_option("--seed", o.seed, "noise seed (default 1; same seed, same log)");
+  app.add_option("--iface", o.iface, "interface name written into the log (default can0)");
+  app.add_option("--truth", o.truth, "also write the true configuration and effect parameters as JSON");
+  app.add_option("--config", o.config_file, "TOML file with the same options; the command line wins")
+      ->check(CLI::ExistingFile);
+  app.add_flag("--list-effects", o.list_effects, "print the effect catalog and exit");
+  CLI11_PARSE(app, argc, argv);
+
+  if (o.list_effects) {
+    fmt::print("{}", resolver::format_effect_catalog());
+    return 0;
+  }
+  std::vector<std::string> toml_effects;
+  if (!o.config_file.empty()) apply_toml(o.config_file, app, o, toml_effects);
+  if (o.out.empty()) fail("--out FILE is required (the candump log to write); see --help");
+
+  const SimConfig config = build_config(app, o, toml_effects);
+  std::optional<resolver::BenchSimulator> sim;
+  try {
+    sim.emplace(config);
+  } catch (const std::invalid_argument& e) {
+    fail(e.what());
+  }
+  const double fps = resolver::frames_per_second(config);
+  if (fps > kBusFramesPerSecond) {
+    fmt::print(stderr,
+               "resolver-sim: warning: {:.0f} frames/s exceed what a 1 Mbit/s classic CAN bus carries (~{:.0f}); "
+               "the log is fine, but replaying it in real time will not fit a real bus (lower --sample-rate or use "
+               "--no-reference)\n",
+               fps, kBusFramesPerSecond);
+  }
+
+  try {
+    resolver::CandumpWriter writer(o.out);
+    resolver::SimSample s{};
+    std::vector<resolver::CanFrame> frames;
+    const auto t0 = std::chrono::steady_clock::now();
+    auto last_report = t0;
+    const std::uint64_t total = sim->total_samples();
+    while (sim->next(s)) {
+      frames.clear();
+      sim->append_frames(s, frames);
+      for (const resolver::CanFrame& f : frames) writer.write(f);
+      const auto now = std::chrono::steady_clock::now();
+      if (now - last_report > std::chrono::seconds(2)) {
+        last_report = now;
+        fmt::print(stderr, "resolver-sim: {:5.1f} % ({} of {} samples)\n", 100.0 * static_cast<double>(s.index + 1) /
+                   static_cast<double>(total), s.index + 1, total);
+      }
+    }
+    writer.close();
+    if (!o.truth.empty()) {
+      std::ofstream truth(o.truth);
+      truth << resolver::sim_truth_json(sim->config(), total, o.out);
+      truth.close();
+      if (!truth) fail(fmt::format("--truth {}: cannot write the file; check the directory exists and is writable", o.truth));
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    fmt::print(stderr, "resolver-sim: wrote {} frames ({} samples, {:.3g} s of bench time) to {} in {:.2f} s\n",
+               writer.frames_written(), total, sim->profile().duration(), o.out, wall);
+  } catch (const std::exception& e) {
+    fail(e.what());
+  }
+  return 0;
+}

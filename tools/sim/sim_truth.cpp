@@ -1,0 +1,74 @@
+#include "tools/sim/sim_truth.h"
+
+#include <fmt/format.h>
+
+#include "daemon/core/effects/effect_catalog.h"
+
+namespace resolver {
+
+namespace {
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    switch (ch) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(ch) < 0x20) {
+          out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(ch)));
+        } else {
+          out += ch;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+// fmt's "{}" is the shortest round-trip form of a double, which is valid JSON for finite values.
+std::string parameters_json(const std::vector<std::pair<std::string_view, double>>& params) {
+  std::string out = "{";
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    out += fmt::format("{}{}: {}", i == 0 ? "" : ", ", json_string(params[i].first), params[i].second);
+  }
+  return out + "}";
+}
+}  // namespace
+
+std::string sim_truth_json(const SimConfig& c, std::uint64_t total_samples, const std::string& log_path) {
+  std::string out = "{\n";
+  out += fmt::format("  \"generator\": \"resolver-sim\",\n  \"log\": {},\n", json_string(log_path));
+  out += fmt::format("  \"samples\": {},\n  \"start_time_us\": {},\n  \"sample_rate_hz\": {},\n", total_samples,
+                     c.start_time_us, c.sample_rate_hz);
+  out += fmt::format("  \"p_r\": {},\n  \"p\": {},\n  \"rd_bits\": {},\n  \"amplitude_counts\": {},\n", c.p_r, c.p,
+                     c.rd_bits, c.amplitude_counts);
+  out += fmt::format("  \"i_d_cmd\": {},\n  \"i_q_cmd\": {},\n  \"reference\": {},\n  \"seed\": {},\n", c.i_d_cmd,
+                     c.i_q_cmd, c.reference ? "true" : "false", c.seed);
+  out += fmt::format("  \"theta_m0\": {},\n  \"iface\": {},\n  \"profile\": [", c.theta_m0, json_string(c.iface));
+  for (std::size_t i = 0; i < c.profile.size(); ++i) {
+    const SpeedSegment& s = c.profile[i];
+    out += fmt::format("{}{{\"duration_s\": {}, \"rpm_start\": {}, \"rpm_end\": {}}}", i == 0 ? "" : ", ",
+                       s.duration_s, s.rpm_start, s.rpm_end);
+  }
+  out += "],\n  \"effects\": {";
+  const std::vector<EffectValues> active = active_effect_values(c.chain);
+  for (std::size_t i = 0; i < active.size(); ++i) {
+    out += fmt::format("{}\n    {}: {}", i == 0 ? "" : ",", json_string(active[i].effect),
+                       parameters_json(active[i].parameters));
+  }
+  out += active.empty() ? "},\n" : "\n  },\n";
+  out += "  \"chain\": {";
+  bool first = true;
+  for (const EffectInfo& e : effect_catalog()) {
+    if (!e.implemented) continue;
+    std::vector<std::pair<std::string_view, double>> params;
+    for (const EffectParameter& p : e.parameters) params.emplace_back(p.name, p.get(c.chain));
+    out += fmt::format("{}\n    {}: {}", first ? "" : ",", json_string(e.name), parameters_json(params));
+    first = false;
+  }
+  out += "\n  }\n}\n";
+  return out;
+}
+
+}  // namespace resolver
