@@ -96,7 +96,9 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     read(*t, "health", c.channels.health, s, "channels");
   }
   if (const auto* t = section("output")) {
-    check_keys(*t, "output", {"angle_decimation", "dq_decimation"}, s);
+    check_keys(*t, "output", {"angle_decimation", "dq_decimation", "ripple_revolutions"}, s);
+    read(*t, "ripple_revolutions", c.ripple_revolutions, s, "output");
+    require_positive(c.ripple_revolutions, "[output] ripple_revolutions", s);
     read(*t, "angle_decimation", c.angle_decimation, s, "output");
     read(*t, "dq_decimation", c.dq_decimation, s, "output");
     require_positive(c.angle_decimation, "[output] angle_decimation", s);

@@ -11,6 +11,7 @@
 //   [output]
 //   angle_decimation = 1       # publish angle_t every Nth sample
 //   dq_decimation = 10
+//   ripple_revolutions = 8     # electrical revolutions averaged (coherently) for dq ripple
 //   [bench]                    # used until a BENCH_INFO frame says otherwise
 //   p_r = 3
 //   p = 3
@@ -63,6 +64,7 @@ struct DaemonConfig {
   LcmChannels channels;
   int angle_decimation = 1;
   int dq_decimation = 1;
+  int ripple_revolutions = 8;
   BenchDefaults bench;
   std::string dbc_path;  ///< "" = the bundled proto/resolver_bench.dbc
   SignalMap signal_map = SignalMap::bench_default();

@@ -32,6 +32,7 @@ ProcessorConfig processor_config(const DaemonConfig& c) {
   p.p = c.bench.p;
   p.hwang = c.hwang;
   p.compensate = c.compensation_enabled;
+  p.ripple_revolutions = c.ripple_revolutions;
   return p;
 }
 

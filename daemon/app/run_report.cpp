@@ -17,7 +17,22 @@ double ratio_db(double before, double after) {
 
 std::string json_number(double v) {
   if (!std::isfinite(v)) return "null";
-  return fmt::format("{:.9g}", v);
+  return fmt::format("{:.17g}", v);  // round-trips a double
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (char ch : text) {
+    if (ch == '"' || ch == '\\') {
+      out += '\\';
+      out += ch;
+    } else if (static_cast<unsigned char>(ch) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(ch)));
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
 }
 
 }  // namespace
@@ -53,15 +68,18 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   } else {
     out << "  position   no reference angle (or no converged estimate): error vs reference not measured\n";
   }
-  for (std::size_t k = 0; k < 3; ++k) {
-    if (s.id_raw[k].n == 0) continue;
-    out << fmt::format("  dq ripple  {}x theta_e: i_d raw {:.2f} mA -> comp {:.2f} mA ({:+.1f} dB); i_q raw {:.2f} -> comp {:.2f} mA",
-                       kRippleOrders[k], 1e3 * s.id_raw[k].mean, 1e3 * s.id_comp[k].mean,
-                       ratio_db(s.id_raw[k].mean, s.id_comp[k].mean), 1e3 * s.iq_raw[k].mean, 1e3 * s.iq_comp[k].mean);
-    if (s.id_ref[k].n > 0) out << fmt::format("; with reference angle i_d {:.2f} mA", 1e3 * s.id_ref[k].mean);
-    out << "\n";
+  if (s.have_ripple) {
+    const RippleSet& r = s.ripple;
+    for (std::size_t k = 0; k < 3; ++k) {
+      out << fmt::format("  dq ripple  {}x theta_e: i_d raw {:.2f} mA -> comp {:.2f} mA ({:+.1f} dB); i_q raw {:.2f} -> comp {:.2f} mA",
+                         kRippleOrders[k], 1e3 * r.raw.d[k], 1e3 * r.comp.d[k], ratio_db(r.raw.d[k], r.comp.d[k]),
+                         1e3 * r.raw.q[k], 1e3 * r.comp.q[k]);
+      if (r.ref_valid) out << fmt::format("; with reference angle i_d {:.2f} mA", 1e3 * r.ref.d[k]);
+      out << "\n";
+    }
+  } else {
+    out << "  dq ripple  not measured (no phase currents, or no converged estimate)\n";
   }
-  if (s.id_raw[0].n == 0) out << "  dq ripple  not measured (no phase currents, or no converged estimate)\n";
   const LatencyHistogram& lat = p.latency_total();
   out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us\n",
                      lat.percentile(0.5), lat.percentile(0.99), lat.max());
@@ -72,7 +90,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   const HwangIntegralEstimator& est = p.processor().estimator();
   const RunSummary& s = p.summary();
   std::string j = "{";
-  j += fmt::format("\"source\":\"{}\",\"wall_seconds\":{},", info.source, json_number(info.wall_seconds));
+  j += fmt::format("\"source\":{},\"wall_seconds\":{},", json_string(info.source), json_number(info.wall_seconds));
   j += fmt::format("\"frames_seen\":{},\"frames_decoded\":{},\"bus_errors\":{},\"samples_complete\":{},\"samples_incomplete\":{},",
                    st.frames_seen, st.frames_decoded, st.bus_errors, st.samples_complete, st.samples_incomplete);
   j += "\"rejects\":{";
@@ -88,15 +106,16 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
                    est.revolutions(), est.converged() ? "true" : "false");
   j += fmt::format("\"eps_rms_raw_rad\":{},\"eps_rms_comp_rad\":{},", json_number(s.eps_raw.stddev()),
                    json_number(s.eps_comp.stddev()));
-  auto arr = [](const RunningStats (&a)[3]) {
-    return fmt::format("[{},{},{}]", json_number(a[0].value_or_nan()), json_number(a[1].value_or_nan()),
-                       json_number(a[2].value_or_nan()));
+  const RippleSet& r = s.ripple;
+  auto arr = [&s](const std::array<double, 3>& a, bool valid) {
+    if (!s.have_ripple || !valid) return std::string("null");
+    return fmt::format("[{},{},{}]", json_number(a[0]), json_number(a[1]), json_number(a[2]));
   };
   j += "\"ripple_orders\":[1,2,6],";
-  j += "\"i_d_ripple_raw\":" + arr(s.id_raw) + ",\"i_d_ripple_comp\":" + arr(s.id_comp) +
-       ",\"i_d_ripple_ref\":" + arr(s.id_ref) + ",";
-  j += "\"i_q_ripple_raw\":" + arr(s.iq_raw) + ",\"i_q_ripple_comp\":" + arr(s.iq_comp) +
-       ",\"i_q_ripple_ref\":" + arr(s.iq_ref);
+  j += "\"i_d_ripple_raw\":" + arr(r.raw.d, r.raw_valid) + ",\"i_d_ripple_comp\":" + arr(r.comp.d, r.comp_valid) +
+       ",\"i_d_ripple_ref\":" + arr(r.ref.d, r.ref_valid) + ",";
+  j += "\"i_q_ripple_raw\":" + arr(r.raw.q, r.raw_valid) + ",\"i_q_ripple_comp\":" + arr(r.comp.q, r.comp_valid) +
+       ",\"i_q_ripple_ref\":" + arr(r.ref.q, r.ref_valid);
   j += "}\n";
   return j;
 }

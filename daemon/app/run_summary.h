@@ -35,10 +35,11 @@ struct RunSummary {
   // zero (mounting) is not an error the amplitude-imbalance model addresses.
   RunningStats eps_raw;
   RunningStats eps_comp;
-  // Ripple amplitudes [A] averaged over electrical revolutions after convergence,
-  // per order index (kRippleOrders) for i_d and i_q.
-  RunningStats id_raw[3], id_comp[3], id_ref[3];
-  RunningStats iq_raw[3], iq_comp[3], iq_ref[3];
+  // Ripple amplitudes [A] at the end of the run (coherent average over the
+  // processor's last ripple_revolutions electrical revolutions), taken only
+  // once the estimator has converged, so "compensated" is compensated.
+  RippleSet ripple;
+  bool have_ripple = false;
 
   /// Accumulates one processed sample (only after the estimator converged,
   /// so "compensated" means compensated with a converged estimate).

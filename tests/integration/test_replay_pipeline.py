@@ -10,13 +10,19 @@ Where the tolerances come from (see also docs in README):
   * alpha: the estimator's per-revolution spread from 16-bit quantization is
     pi*LSB/sqrt(12 N) ~ 6e-6 (N = 200 samples per revolution), 0.2 % of alpha;
     the small-angle approximation (Hwang eq. 10) biases it by alpha/2 = 0.15 %;
-    sin/cos noise filtered by the tracking loop adds less. 5 % (the issue's
+    sin/cos noise filtered by the tracking loop adds less. With the sample grid
+    locked to the revolution (exactly 200 samples per revolution) the 16-bit
+    quantization error repeats every revolution and does not average out: it
+    biases alpha by up to ~0.8 % depending on the start phase. 5 % (the issue's
     requirement) is therefore met with a wide margin; a broken estimator
     (wrong sign, factor 2, missing normalisation) misses it by far.
   * ripple: raw 2x ripple is I_m alpha/2 = 15 mA at I_q = 10 A. After
-    compensation what remains is I_m |alpha - alpha_hat| / 2 plus the noise
-    floor of a one-revolution DFT, ~2 sigma_i / sqrt(N) ~ 0.2 mA for 1 mA
-    current quantization and the simulator's current noise: >= 10x holds.
+    compensation what remains is I_m |alpha - alpha_hat| / 2 (~0.1 mA) plus
+    the noise floor of the ripple measurement, 2 sigma_i / sqrt(N K) for the
+    simulator's sigma_i = 20 mA, N = 200 samples per electrical revolution and
+    K coherently averaged revolutions: 2.5 mA for K = 1, 0.6 mA for K = 16.
+    The test asks for K = 16 so that the floor is 25x below the raw ripple
+    and the required 10x is decided by the compensation, not by the noise.
 """
 import argparse
 import json
@@ -48,10 +54,13 @@ class ReplayPipeline(unittest.TestCase):
             if os.path.exists(f):
                 os.remove(f)
         b = ARGS.bin
-        run([f"{b}/resolver-sim", "--out", cls.log, "--rpm", "200", "--duration", "6", "--p-r", "3", "--p", "3",
+        run([f"{b}/resolver-sim", "--out", cls.log, "--rpm", "200", "--duration", "8", "--p-r", "3", "--p", "3",
              "--rd-bits", "16", "--iq", "10", "--effect", "amplitude_imbalance:alpha=0.003", "--seed", "7",
              "--truth", cls.truth])
-        cls.daemon = run([f"{b}/resolverd", "--replay", cls.log, "--once", "--fast", "--quiet",
+        cls.config = os.path.join(work, "ripple16.toml")
+        with open(cls.config, "w") as f:
+            f.write("[output]\nripple_revolutions = 16\n")
+        cls.daemon = run([f"{b}/resolverd", "--replay", cls.log, "--once", "--fast", "--quiet", "--config", cls.config,
                           "--lcm", f"file://{cls.lcmlog}?mode=w", "--report", cls.report])
         echo = run([f"{b}/resolver-echo", "--log", cls.lcmlog])
         cls.msgs = [json.loads(line) for line in echo.stdout.splitlines() if line.strip()]

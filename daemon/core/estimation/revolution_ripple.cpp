@@ -17,9 +17,28 @@ bool RevolutionRipple::update(double theta_e, double i_d, double i_q) {
       const double scale = 2.0 / n;
       const double mean_d = sum_x_d_ / n;
       const double mean_q = sum_x_q_ / n;
+      std::array<std::complex<double>, 3> cd{}, cq{};
       for (std::size_t k = 0; k < kRippleOrders.size(); ++k) {
-        last_.d[k] = scale * std::abs(sum_d_[k] - mean_d * sum_w_[k]);
-        last_.q[k] = scale * std::abs(sum_q_[k] - mean_q * sum_w_[k]);
+        cd[k] = scale * (sum_d_[k] - mean_d * sum_w_[k]);
+        cq[k] = scale * (sum_q_[k] - mean_q * sum_w_[k]);
+      }
+      if (ring_d_.size() < static_cast<std::size_t>(window_)) {
+        ring_d_.push_back(cd);
+        ring_q_.push_back(cq);
+      } else {
+        ring_d_[ring_next_] = cd;
+        ring_q_[ring_next_] = cq;
+        ring_next_ = (ring_next_ + 1) % ring_d_.size();
+      }
+      const double inv = 1.0 / static_cast<double>(ring_d_.size());
+      for (std::size_t k = 0; k < kRippleOrders.size(); ++k) {
+        std::complex<double> ad{}, aq{};
+        for (std::size_t r = 0; r < ring_d_.size(); ++r) {
+          ad += ring_d_[r][k];
+          aq += ring_q_[r][k];
+        }
+        last_.d[k] = std::abs(ad) * inv;
+        last_.q[k] = std::abs(aq) * inv;
       }
       ++revolutions_;
       completed = true;

@@ -10,13 +10,19 @@
 // the current at all. Computed in one pass as
 // sum x w - mean(x) sum w, w = exp(-j k theta). Orders are those DESIGN 5 names: 1x (current-sensor offsets), 2x
 // (amplitude imbalance, Hwang eqs. 15-16; gain mismatch), 6x (dead time).
-// Noise sets a floor of about 2 sigma / sqrt(N) per order.
+// Noise sets a floor of about 2 sigma / sqrt(N) per order and revolution. The
+// published amplitude is |mean of the complex coefficients of the last K
+// revolutions| (coherent: every revolution's phase is referenced to the same
+// theta_e), which keeps a steady ripple and lowers the noise floor to
+// ~2 sigma / sqrt(N K). At the simulator's default sigma_i = 20 mA and N = 200
+// that is 2.5 mA per revolution, 0.9 mA with K = 8.
 #pragma once
 
 #include <array>
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <vector>
 
 namespace resolver {
 
@@ -29,6 +35,10 @@ struct RippleAmplitudes {
 
 class RevolutionRipple {
  public:
+  /// revolutions_averaged: K, the coherent averaging window (>= 1).
+  explicit RevolutionRipple(int revolutions_averaged = 8)
+      : window_(revolutions_averaged < 1 ? 1 : revolutions_averaged) {}
+
   /// Feeds one sample: theta_e continuous (unwrapped) [rad], i_d, i_q [A].
   /// Returns true when this sample completed a revolution; `last()` then holds
   /// the ripple of that revolution.
@@ -37,7 +47,7 @@ class RevolutionRipple {
   [[nodiscard]] const RippleAmplitudes& last() const { return last_; }
   [[nodiscard]] bool valid() const { return revolutions_ > 0; }
   [[nodiscard]] std::int64_t revolutions() const { return revolutions_; }
-  void reset() { *this = RevolutionRipple{}; }
+  void reset() { *this = RevolutionRipple(window_); }
 
  private:
   bool started_ = false;
@@ -49,6 +59,10 @@ class RevolutionRipple {
   std::array<std::complex<double>, 3> sum_w_{};
   double sum_x_d_ = 0.0;
   double sum_x_q_ = 0.0;
+  // Ring of the last K revolutions' normalised complex coefficients.
+  int window_;
+  std::vector<std::array<std::complex<double>, 3>> ring_d_, ring_q_;
+  std::size_t ring_next_ = 0;
   RippleAmplitudes last_;
   std::int64_t revolutions_ = 0;
 };

@@ -11,7 +11,12 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
-SampleProcessor::SampleProcessor(const ProcessorConfig& config) : config_(config), estimator_(config.hwang) {}
+SampleProcessor::SampleProcessor(const ProcessorConfig& config)
+    : config_(config),
+      estimator_(config.hwang),
+      ripple_raw_(config.ripple_revolutions),
+      ripple_comp_(config.ripple_revolutions),
+      ripple_ref_(config.ripple_revolutions) {}
 
 void SampleProcessor::set_pole_pairs(int p_r, int p) {
   if (p_r == config_.p_r && p == config_.p) return;

@@ -39,6 +39,8 @@ struct ProcessorConfig {
   int p = 3;    ///< motor pole pairs
   HwangIntegralConfig hwang;
   bool compensate = true;
+  /// Electrical revolutions coherently averaged for the ripple amplitudes.
+  int ripple_revolutions = 8;
 };
 
 struct RippleSet {

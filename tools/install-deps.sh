@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages the build, the tools and the tests need.
+# Idempotent: runs apt-get only when something is missing. Needs root or sudo.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake g++ pkg-config git
+  libgtest-dev libgmock-dev libbenchmark-dev
+  liblcm-dev liblcm-bin
+  libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
+  can-utils python3 python3-can
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "install-deps: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  SUDO="sudo"
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
