@@ -21,7 +21,7 @@ echo "== simulating the demo bench log"
 echo "   $(wc -l < "$DEMO/demo.log") frames in $DEMO/demo.log (truth in $DEMO/demo.truth.json)"
 
 echo "== listening on LCM: resolver-echo prints the first estimates seen on the bus"
-"$BIN/resolver-echo" --lcm "" --channel RESOLVER_ESTIMATE --count 3 --timeout 20 > "$DEMO/live_estimates.jsonl" &
+"$BIN/resolver-echo" --lcm 'udpm://239.255.76.67:7667?ttl=0' --channel RESOLVER_ESTIMATE --count 3 --timeout 20 > "$DEMO/live_estimates.jsonl" &
 ECHO_PID=$!
 sleep 0.5
 

@@ -28,7 +28,7 @@ Examples:
   # live from SocketCAN
   resolverd --can can0 --config /etc/resolverd/resolverd.toml
 
-Watch the output with: resolver-echo --lcm '' --count 10   (or lcm-spy, lcm-logger)
+Watch the output with: resolver-echo --lcm 'udpm://239.255.76.67:7667?ttl=0' --count 10   (or lcm-spy, lcm-logger)
 Channels (configurable in [channels]): RESOLVER_ANGLE, RESOLVER_DQ, RESOLVER_ESTIMATE,
 RESOLVER_MODEL_FIT, RESOLVER_HEALTH. Signals: SIGTERM/SIGINT exit cleanly (with --replay,
 after printing the report), SIGHUP reloads the config (a bad config keeps the old one).

@@ -1,0 +1,91 @@
+// resolverd's TOML config: defaults, overrides, and errors that name the
+// file, line and key.
+#include <gtest/gtest.h>
+
+#include "daemon/app/daemon_config.h"
+
+namespace resolver {
+namespace {
+
+std::string error_of(std::string_view text) {
+  try {
+    parse_daemon_config(text, "test.toml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(DaemonConfig, EmptyFileKeepsDefaults) {
+  const DaemonConfig c = parse_daemon_config("", "empty.toml");
+  EXPECT_EQ(c.channels.angle, "RESOLVER_ANGLE");
+  EXPECT_EQ(c.bench.p_r, 3);
+  EXPECT_TRUE(c.signal_map.roles[static_cast<std::size_t>(Role::kRdAngle)].has_value());
+}
+
+TEST(DaemonConfig, OverridesAndUserSignalMap) {
+  const DaemonConfig c = parse_daemon_config(R"(
+[lcm]
+url = "memq://"
+[channels]
+angle = "BENCH2_ANGLE"
+[output]
+angle_decimation = 10
+[bench]
+p_r = 1
+p = 4
+[layout]
+dbc = "/tmp/x.dbc"
+crc = "none"
+[layout.signals]
+rd_angle = "FB.Angle"
+i_a = "CUR.Ia"
+)", "user.toml");
+  EXPECT_EQ(c.lcm_url, "memq://");
+  EXPECT_EQ(c.channels.angle, "BENCH2_ANGLE");
+  EXPECT_EQ(c.channels.dq, "RESOLVER_DQ");
+  EXPECT_EQ(c.angle_decimation, 10);
+  EXPECT_EQ(c.bench.p, 4);
+  EXPECT_EQ(c.signal_map.crc, CrcAlgorithm::kNone);
+  const auto& rd = c.signal_map.roles[static_cast<std::size_t>(Role::kRdAngle)];
+  ASSERT_TRUE(rd.has_value());
+  EXPECT_EQ(rd->message, "FB");
+  EXPECT_EQ(rd->signal, "Angle");
+  EXPECT_FALSE(c.signal_map.roles[static_cast<std::size_t>(Role::kSin)].has_value())
+      << "a user map replaces the default one";
+}
+
+TEST(DaemonConfig, SyntaxErrorNamesFileAndLine) {
+  const std::string e = error_of("[bench]\np_r = 3\np = = 4\n");
+  EXPECT_NE(e.find("test.toml:3:"), std::string::npos) << e;
+  EXPECT_NE(e.find("TOML syntax error"), std::string::npos) << e;
+}
+
+TEST(DaemonConfig, UnknownKeyIsAnErrorListingValidKeys) {
+  const std::string e = error_of("[bench]\npr = 3\n");
+  EXPECT_NE(e.find("test.toml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key 'pr'"), std::string::npos) << e;
+  EXPECT_NE(e.find("p_r"), std::string::npos) << e;
+}
+
+TEST(DaemonConfig, BadValuesAreRejectedWithTheRule) {
+  EXPECT_NE(error_of("[bench]\np_r = \"three\"\n").find("must be an integer"), std::string::npos);
+  EXPECT_NE(error_of("[bench]\nrd_bits = 20\n").find("rd_bits must be 1..16"), std::string::npos);
+  EXPECT_NE(error_of("[output]\nangle_decimation = 0\n").find(">= 1"), std::string::npos);
+  EXPECT_NE(error_of("[layout]\ncrc = \"crc32\"\n").find("j1850_bench"), std::string::npos);
+  EXPECT_NE(error_of("[layout.signals]\nsine = \"A.b\"\n").find("unknown role 'sine'"), std::string::npos);
+  EXPECT_NE(error_of("[layout.signals]\nsin = \"nodot\"\n").find("MESSAGE.signal"), std::string::npos);
+  EXPECT_NE(error_of("[estimator]\nmethod = \"magic\"\n").find("available: hwang_integral"), std::string::npos);
+}
+
+TEST(DaemonConfig, MissingFileSaysSo) {
+  try {
+    load_daemon_config("/nonexistent/resolverd.toml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/resolverd.toml"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace resolver
