@@ -30,9 +30,16 @@ void check_keys(const toml::table& table, const std::string& section, std::initi
     for (auto a : allowed) ok = ok || a == key.str();
     if (!ok) {
       std::string list;
-      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      throw ConfigError(where(source, node) + ": unknown key '" + std::string(key.str()) + "' in [" + section +
-                        "]; valid keys: " + list);
+      for (auto a : allowed) {
+        if (!list.empty()) list += ", ";
+        list += a;
+      }
+      std::string msg = where(source, node);
+      msg += ": unknown key '";
+      msg += key.str();
+      msg += "' in [" + section + "]; valid keys: ";
+      msg += list;
+      throw ConfigError(msg);
     }
   }
 }

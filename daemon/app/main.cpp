@@ -36,7 +36,7 @@ after printing the report), SIGHUP reloads the config (a bad config keeps the ol
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
   using namespace resolver;
   CLI::App app{kDescription, "resolverd"};
   std::string config_path, replay_path, can_iface, report_path;
@@ -128,4 +128,16 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    // Last resort: every expected failure is reported where it happens.
+    std::cerr << "resolverd: unexpected error: " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "resolverd: unexpected non-standard exception\n";
+  }
+  return 1;
 }
