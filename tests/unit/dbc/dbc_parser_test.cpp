@@ -1,0 +1,276 @@
+// Parser behaviour on small hand-written DBC texts: what is read, and that each
+// malformed input is rejected with the right line and a message naming what
+// was expected.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include "daemon/dbc/dbc_codec.h"
+#include "daemon/dbc/dbc_parser.h"
+
+namespace resolver::dbc {
+namespace {
+
+Database parse_ok(const std::string& text) {
+  auto r = parse_dbc(text, "test.dbc");
+  if (const auto* e = std::get_if<DbcError>(&r)) {
+    ADD_FAILURE() << "unexpected error: " << e->what();
+    return {};
+  }
+  return std::get<Database>(std::move(r));
+}
+
+DbcError parse_bad(const std::string& text) {
+  auto r = parse_dbc(text, "bad.dbc");
+  if (std::holds_alternative<Database>(r)) {
+    ADD_FAILURE() << "expected an error for:\n" << text;
+    return {};
+  }
+  return std::get<DbcError>(std::move(r));
+}
+
+// Line 1 comment; the message starts on line 3, its first signal on line 4.
+const std::string kHeader = "VERSION \"1.2\"\n\nBO_ 291 TEST: 8 ECU\n";
+
+TEST(DbcParser, ReadsHeaderMessageAndSignalFields) {
+  const Database db = parse_ok(
+      "VERSION \"1.2\"\n"
+      "NS_ :\n\tCM_\n\tBA_DEF_\n\tVAL_\n\n"
+      "BS_:\n"
+      "BU_: ECU Logger Dash\n"
+      "BO_ 291 TEST: 8 ECU\n"
+      " SG_ speed : 7|16@0- (0.125,-40) [-4136|4055.875] \"km/h\" Logger,Dash\n"
+      " SG_ flag : 16|1@1+ (1,0) [0|1] \"\" Vector__XXX\n");
+  EXPECT_EQ(db.version, "1.2");
+  EXPECT_EQ(db.nodes, (std::vector<std::string>{"ECU", "Logger", "Dash"}));
+  ASSERT_EQ(db.messages.size(), 1U);
+  const Message& m = db.messages[0];
+  EXPECT_EQ(m.id, 291U);
+  EXPECT_FALSE(m.extended);
+  EXPECT_EQ(m.name, "TEST");
+  EXPECT_EQ(m.dlc, 8U);
+  EXPECT_EQ(m.sender, "ECU");
+  ASSERT_EQ(m.signals.size(), 2U);
+  const Signal& s = m.signals[0];
+  EXPECT_EQ(s.name, "speed");
+  EXPECT_EQ(s.start_bit, 7U);
+  EXPECT_EQ(s.length, 16U);
+  EXPECT_EQ(s.order, ByteOrder::kBigEndian);
+  EXPECT_TRUE(s.is_signed);
+  EXPECT_EQ(s.factor, 0.125);
+  EXPECT_EQ(s.offset, -40.0);
+  EXPECT_EQ(s.minimum, -4136.0);
+  EXPECT_EQ(s.maximum, 4055.875);
+  EXPECT_EQ(s.unit, "km/h");
+  EXPECT_EQ(s.receivers, (std::vector<std::string>{"Logger", "Dash"}));
+  EXPECT_EQ(m.signals[1].order, ByteOrder::kLittleEndian);
+  EXPECT_FALSE(m.signals[1].is_signed);
+  EXPECT_TRUE(m.signals[1].receivers.empty()) << "Vector__XXX means no receiver";
+  EXPECT_EQ(db.find_message("TEST"), &m);
+  EXPECT_EQ(db.find_message(291, false), &m);
+  EXPECT_EQ(db.find_message(291, true), nullptr);
+  EXPECT_EQ(m.find_signal("flag"), &m.signals[1]);
+  EXPECT_EQ(m.find_signal("nope"), nullptr);
+}
+
+TEST(DbcParser, ExtendedIdIsBit31) {
+  const std::uint32_t id29 = 0x18FEF100U;  // a J1939 PGN-style 29-bit ID
+  const Database db = parse_ok("BO_ " + std::to_string(0x80000000U | id29) + " EEC1: 8 Engine\n");
+  ASSERT_EQ(db.messages.size(), 1U);
+  EXPECT_EQ(db.messages[0].id, id29);
+  EXPECT_TRUE(db.messages[0].extended);
+  EXPECT_NE(db.find_message(id29, true), nullptr);
+  EXPECT_EQ(db.find_message(id29, false), nullptr);
+}
+
+TEST(DbcParser, CommentsIncludingMultiLineAndEscapedQuotes) {
+  const Database db = parse_ok(kHeader +
+                               " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+                               "CM_ \"file comment\";\n"
+                               "CM_ BU_ ECU \"the ECU\";\n"
+                               "CM_ BO_ 291 \"first line\nsecond \\\"quoted\\\" line\";\n"
+                               "CM_ SG_ 291 a \"signal a\";\n"
+                               "CM_ SG_ 999 a \"dangling\";\n");
+  const Message& m = db.messages.at(0);
+  EXPECT_EQ(m.comment, "first line\nsecond \"quoted\" line");
+  EXPECT_EQ(m.signals.at(0).comment, "signal a");
+  ASSERT_EQ(db.warnings.size(), 1U);
+  // Lines: 1-3 header, 4 SG_, 5-6 CM_, 7-8 the two-line CM_ BO_, 9 CM_ SG_, 10 the dangling one.
+  EXPECT_NE(db.warnings[0].find("test.dbc:10:"), std::string::npos) << db.warnings[0];
+}
+
+TEST(DbcParser, ValueTablesAndAttributes) {
+  const Database db = parse_ok(kHeader +
+                               " SG_ gear : 0|4@1+ (1,0) [0|15] \"\" ECU\n"
+                               "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 10000;\n"
+                               "BA_DEF_DEF_ \"GenMsgCycleTime\" 100;\n"
+                               "BA_ \"GenMsgCycleTime\" BO_ 291 20;\n"
+                               "VAL_TABLE_ Gears 0 \"P\" 1 \"R\" 2 \"N\" 3 \"D\" ;\n"
+                               "VAL_ 291 gear 0 \"Park\" 1 \"Reverse\" -1 \"invalid\" ;\n");
+  const Signal& s = db.messages.at(0).signals.at(0);
+  ASSERT_EQ(s.value_table.size(), 3U);
+  EXPECT_EQ(s.value_table.at(0), "Park");
+  EXPECT_EQ(s.value_table.at(1), "Reverse");
+  EXPECT_EQ(s.value_table.at(-1), "invalid");
+  ASSERT_EQ(db.value_tables.count("Gears"), 1U);
+  EXPECT_EQ(db.value_tables.at("Gears").at(3), "D");
+  EXPECT_TRUE(db.warnings.empty());
+}
+
+TEST(DbcParser, UnknownKeywordIsSkippedLineWiseWithAWarning) {
+  // Line 5 holds an unknown keyword with junk and a string that runs on to line 6;
+  // parsing resumes on line 7.
+  const Database db = parse_ok(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+                                         "FOO_BAR_ 1 2 ### \"multi\nline\"\n"
+                                         "BO_ 292 B: 8 ECU\n");
+  ASSERT_EQ(db.messages.size(), 2U);
+  EXPECT_EQ(db.messages[1].name, "B");
+  ASSERT_EQ(db.warnings.size(), 1U);
+  EXPECT_NE(db.warnings[0].find("test.dbc:5:"), std::string::npos) << db.warnings[0];
+  EXPECT_NE(db.warnings[0].find("FOO_BAR_"), std::string::npos) << db.warnings[0];
+}
+
+TEST(DbcParser, SignalAfterAnotherStatementIsNotAttachedToTheEarlierMessage) {
+  const DbcError e = parse_bad(kHeader + "CM_ BO_ 291 \"x\";\n SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n");
+  EXPECT_EQ(e.line, 5U) << e.what();
+  EXPECT_NE(e.message.find("not inside a message"), std::string::npos) << e.what();
+}
+
+TEST(DbcParser, MultiplexedSignalsDecodeOnlyForTheirMuxValue) {
+  const Database db = parse_ok(kHeader +
+                               " SG_ mode M : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+                               " SG_ temp m1 : 8|16@1- (0.1,0) [0|0] \"degC\" ECU\n"
+                               " SG_ volts m2 : 8|16@1+ (0.01,0) [0|0] \"V\" ECU\n"
+                               " SG_ always : 24|8@1+ (1,0) [0|0] \"\" ECU\n");
+  const Message& m = db.messages.at(0);
+  ASSERT_EQ(m.multiplexor(), m.find_signal("mode"));
+  const Signal& temp = *m.find_signal("temp");
+  const Signal& volts = *m.find_signal("volts");
+  const Signal& always = *m.find_signal("always");
+  EXPECT_EQ(temp.multiplexed_by, 1U);
+  EXPECT_EQ(volts.multiplexed_by, 2U);
+  for (std::uint64_t mode = 0; mode < 4; ++mode) {
+    std::array<std::uint8_t, 8> d{};
+    insert_raw(*m.multiplexor(), mode, d);
+    EXPECT_EQ(signal_present(m, temp, d), mode == 1) << "mode " << mode;
+    EXPECT_EQ(signal_present(m, volts, d), mode == 2) << "mode " << mode;
+    EXPECT_TRUE(signal_present(m, always, d));
+    EXPECT_TRUE(signal_present(m, *m.multiplexor(), d));
+  }
+}
+
+TEST(DbcParser, MultiplexedSignalWithoutMultiplexorIsAnError) {
+  const DbcError e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ b m3 : 8|8@1+ (1,0) [0|0] \"\" ECU\n");
+  EXPECT_EQ(e.line, 5U) << e.what();
+  EXPECT_NE(e.message.find("no multiplexor"), std::string::npos) << e.what();
+}
+
+TEST(DbcParser, FloatSignalsFromSigValtype) {
+  const Database db = parse_ok(kHeader + " SG_ f : 0|32@1- (1,0) [0|0] \"\" ECU\nSIG_VALTYPE_ 291 f : 1;\n");
+  EXPECT_EQ(db.messages.at(0).signals.at(0).value_type, ValueType::kFloat32);
+  const DbcError e = parse_bad(kHeader + " SG_ f : 0|16@1- (1,0) [0|0] \"\" ECU\nSIG_VALTYPE_ 291 f : 2;\n");
+  EXPECT_EQ(e.line, 5U) << e.what();
+  EXPECT_NE(e.message.find("needs 64"), std::string::npos) << e.what();
+}
+
+struct BadCase {
+  const char* name;
+  std::string text;
+  std::size_t line;
+  const char* expected_words;  // must appear in the message
+};
+
+TEST(DbcParser, SyntaxErrorsNameTheLineAndWhatWasExpected) {
+  const BadCase cases[] = {
+      {"missing colon after message name", kHeader + "BO_ 292 OTHER 8 ECU\n", 4, "expected ':' after the message name"},
+      {"non-numeric id", "\n\nBO_ abc X: 8 ECU\n", 3, "expected the message ID"},
+      {"fractional start bit", kHeader + " SG_ a : 1.5|8@1+ (1,0) [0|0] \"\" ECU\n", 4, "start bit"},
+      {"missing pipe", kHeader + " SG_ a : 0 8@1+ (1,0) [0|0] \"\" ECU\n", 4, "expected '|' between start bit and length"},
+      {"bad byte order", kHeader + " SG_ a : 0|8@2+ (1,0) [0|0] \"\" ECU\n", 4, "byte order 1 (Intel) or 0 (Motorola)"},
+      {"missing sign", kHeader + " SG_ a : 0|8@1 (1,0) [0|0] \"\" ECU\n", 4, "'+' (unsigned) or '-' (signed)"},
+      {"missing comma in scale", kHeader + " SG_ a : 0|8@1+ (1 0) [0|0] \"\" ECU\n", 4, "expected ',' between factor and offset"},
+      {"missing bracket", kHeader + " SG_ a : 0|8@1+ (1,0) 0|0] \"\" ECU\n", 4, "expected '[' before the minimum"},
+      {"unit not a string", kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] V ECU\n", 4, "expected the unit string"},
+      {"bad mux indicator", kHeader + " SG_ a x7 : 0|8@1+ (1,0) [0|0] \"\" ECU\n", 4, "multiplexer indicator"},
+      {"signal outside a message", "VERSION \"\"\n SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n", 2, "not inside a message"},
+      {"signal past the DLC", kHeader + " SG_ a : 60|8@1+ (1,0) [0|0] \"\" ECU\n", 4, "has DLC 8"},
+      {"motorola signal past the DLC", kHeader + " SG_ a : 63|16@0+ (1,0) [0|0] \"\" ECU\n", 4, "needs bytes 7..8"},
+      {"zero length", kHeader + " SG_ a : 0|0@1+ (1,0) [0|0] \"\" ECU\n", 4, "1..64 bits"},
+      {"too long", kHeader + " SG_ a : 0|65@1+ (1,0) [0|0] \"\" ECU\n", 4, "1..64 bits"},
+      {"standard id too large", "\nBO_ 2048 X: 8 ECU\n", 2, "11-bit"},
+      {"dlc too large", "\nBO_ 1 X: 65 ECU\n", 2, "at most 64 bytes"},
+      {"CM_ missing semicolon", kHeader + "CM_ BO_ 291 \"text\"\nBO_ 5 Y: 8 ECU\n", 5, "expected ';' to end the CM_"},
+      {"unterminated string", kHeader + "CM_ BO_ 291 \"text;\n\n", 4, "unterminated string"},
+      {"VAL_ value not a number", kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\nVAL_ 291 a x \"y\" ;\n", 5, "expected a value or ';'"},
+      {"BA_ without semicolon", kHeader + "BA_ \"x\" BO_ 291 20\n", 4, "no terminating ';'"},
+      {"garbage at statement start", kHeader + "\n$\n", 5, "expected a keyword"},
+      {"duplicate signal", kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ a : 8|8@1+ (1,0) [0|0] \"\" ECU\n", 5, "defined twice"},
+  };
+  for (const BadCase& c : cases) {
+    const DbcError e = parse_bad(c.text);
+    EXPECT_EQ(e.line, c.line) << c.name << ": " << e.what();
+    EXPECT_NE(e.message.find(c.expected_words), std::string::npos) << c.name << ": " << e.what();
+    EXPECT_EQ(e.what().rfind("bad.dbc:" + std::to_string(c.line) + ": ", 0), 0U) << c.name << ": " << e.what();
+  }
+}
+
+TEST(DbcParser, MissingFileIsAnErrorNotACrash) {
+  const auto r = load_dbc_file("/nonexistent/dir/none.dbc");
+  ASSERT_TRUE(std::holds_alternative<DbcError>(r));
+  const DbcError& e = std::get<DbcError>(r);
+  EXPECT_EQ(e.line, 0U);
+  EXPECT_NE(e.what().find("/nonexistent/dir/none.dbc: cannot open"), std::string::npos) << e.what();
+}
+
+TEST(DbcParser, EmptyAndWhitespaceInputsGiveEmptyDatabases) {
+  EXPECT_TRUE(parse_ok("").messages.empty());
+  EXPECT_TRUE(parse_ok("\xEF\xBB\xBF\r\n  \t\r\n").messages.empty());
+}
+
+TEST(DbcParser, IndependentSignalPseudoMessageIsDropped) {
+  const Database db = parse_ok("BO_ 3221225472 VECTOR__INDEPENDENT_SIG_MSG: 0 Vector__XXX\n"
+                               " SG_ orphan : 0|8@1+ (1,0) [0|0] \"\" Vector__XXX\n"
+                               "BO_ 1 REAL: 8 ECU\n");
+  ASSERT_EQ(db.messages.size(), 1U);
+  EXPECT_EQ(db.messages[0].name, "REAL");
+}
+
+}  // namespace
+}  // namespace resolver::dbc
+
+namespace resolver::dbc {
+namespace {
+
+// Robustness: every truncation of a real file, and random byte damage to it,
+// parses to a Database or to an error whose line exists in the input.
+TEST(DbcParserRobustness, TruncatedAndDamagedFilesNeverCrash) {
+  std::ifstream in(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc");
+  ASSERT_TRUE(in) << "cannot open proto/resolver_bench.dbc";
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string full = ss.str();
+  const auto check = [](const std::string& text, const std::string& what) {
+    const auto r = parse_dbc(text, "damaged.dbc");
+    if (const auto* e = std::get_if<DbcError>(&r)) {
+      const auto lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1U;
+      EXPECT_GE(e->line, 1U) << what << ": " << e->what();
+      EXPECT_LE(e->line, lines) << what << ": " << e->what();
+      EXPECT_FALSE(e->message.empty()) << what;
+    }
+  };
+  for (std::size_t n = 0; n <= full.size(); n += 7) check(full.substr(0, n), "prefix " + std::to_string(n));
+  std::mt19937 rng(3);
+  for (int i = 0; i < 2000; ++i) {
+    std::string text = full;
+    for (int k = 0; k < 3; ++k) text[rng() % text.size()] = static_cast<char>(rng());
+    check(text, "damage " + std::to_string(i));
+  }
+}
+
+}  // namespace
+}  // namespace resolver::dbc
