@@ -5,6 +5,7 @@
 #include <optional>
 #include <thread>
 
+#include "daemon/service/sd_notify.h"
 #include "drivers/socketcan/socketcan_source.h"
 
 namespace resolver {
@@ -28,21 +29,63 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
   bool reported_down = false;
   std::uint64_t drops_reported = 0;
   CanFrame frame;
+  SdNotifier* notify = options.notifier;
+  NotifyPacer pacer(notify != nullptr ? notify->watchdog_interval() : std::chrono::microseconds(0),
+                    std::chrono::seconds(1));
+  bool announced_ready = false;
+  std::int64_t frames_at_status = 0;
+  auto status_time = Clock::now();
+  std::string waiting_for;  // non-empty while the interface cannot be opened
+
+  // systemd: watchdog pings and a one-line STATUS= every second.
+  auto service_tick = [&](Pipeline& p) {
+    if (notify == nullptr) return;
+    const auto now = Clock::now();
+    const NotifyPacer::Due due = pacer.poll(now);
+    if (due.watchdog) notify->watchdog();
+    if (!due.status) return;
+    const std::int64_t seen = p.intake().stats().frames_seen;
+    const double dt = std::chrono::duration<double>(now - status_time).count();
+    const double rate = dt > 0.0 ? static_cast<double>(seen - frames_at_status) / dt : 0.0;
+    frames_at_status = seen;
+    status_time = now;
+    std::string detail;
+    for (const auto& [reason, n] : p.intake().rejects().all()) {
+      detail += (detail.empty() ? "" : " ") + reason + "=" + std::to_string(n);
+    }
+    const auto& est = p.processor().estimator();
+    const std::string extra = !waiting_for.empty() ? waiting_for
+                              : est.converged()    ? "alpha " + std::to_string(est.alpha())
+                                                   : "estimating";
+    notify->status(format_service_status(options.iface, rate, p.intake().rejects().total(), detail, extra));
+  };
 
   while (!flags.stop.load()) {
     if (flags.reload.exchange(false)) on_reload();
     Pipeline& pipeline = current();
+    service_tick(pipeline);
     if (!source) {
       try {
         source.emplace(SocketCanSource::open(so));
         err << "resolverd: reading " << options.iface << "\n";
         backoff = std::chrono::milliseconds(250);
         reported_down = false;
+        waiting_for.clear();
+        if (notify != nullptr && !announced_ready) {
+          notify->ready();  // the socket is bound and LCM is up
+          announced_ready = true;
+        }
       } catch (const SocketCanError& e) {
+        waiting_for = "waiting for " + options.iface;
         pipeline.count_problem("interface_unavailable", std::string(e.what()) + "; retrying in " +
                                                            std::to_string(backoff.count()) + " ms");
         pipeline.tick(wall_us());
-        std::this_thread::sleep_for(backoff);
+        // Sleep in slices so watchdog pings and SIGTERM are not held up by the backoff.
+        const auto until = Clock::now() + backoff;
+        while (Clock::now() < until && !flags.stop.load()) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+          service_tick(pipeline);
+        }
         backoff = std::min(backoff * 2, kMaxBackoff);
         continue;
       }
@@ -84,6 +127,7 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
     }
     pipeline.tick(wall_us());
   }
+  if (notify != nullptr) notify->stopping();
   current().finish();
 }
 

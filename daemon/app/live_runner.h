@@ -13,8 +13,12 @@
 
 namespace resolver {
 
+class SdNotifier;
+
 struct LiveOptions {
   std::string iface;
+  /// systemd notifications (READY, WATCHDOG, STATUS, STOPPING); null = none.
+  SdNotifier* notifier = nullptr;
 };
 
 /// `current` returns the pipeline to feed (it may be rebuilt on SIGHUP by

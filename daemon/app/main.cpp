@@ -13,6 +13,8 @@
 #include "daemon/app/replay_runner.h"
 #include "daemon/app/run_report.h"
 #include "daemon/app/stop_flag.h"
+#include "daemon/service/calibration_store.h"
+#include "daemon/service/sd_notify.h"
 
 namespace {
 
@@ -54,6 +56,10 @@ static int run(int argc, char** argv) {
                  "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
   app.add_option("--report", report_path, "also write the end-of-run report as JSON to this file");
   app.add_flag("--quiet", quiet, "no progress lines on stderr");
+  std::string state_dir;
+  app.add_option("--state-dir", state_dir,
+                 "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
+                 "saved at exit when the estimate has converged");
   CLI11_PARSE(app, argc, argv);
   if (replay_path.empty() && can_iface.empty()) {
     std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
@@ -79,6 +85,23 @@ static int run(int argc, char** argv) {
     return 2;
   }
 
+  if (!state_dir.empty()) {
+    const LoadResult loaded = load_calibration(state_dir);
+    if (loaded.status == LoadResult::Status::kLoaded) {
+      for (const auto& param : loaded.calibration->params) {
+        if (param.name == "amplitude_imbalance.alpha") {
+          pipeline->seed_alpha(param.value);
+          std::cerr << "resolverd: compensating with the saved alpha = " << param.value << " from "
+                    << calibration_path(state_dir) << " until this run's estimate converges\n";
+        }
+      }
+    } else if (loaded.status == LoadResult::Status::kRejected) {
+      std::cerr << "resolverd: " << loaded.problem << "\n";
+    }
+  }
+  SdNotifier notifier = SdNotifier::from_environment();
+  if (!notifier.last_error().empty()) std::cerr << "resolverd: " << notifier.last_error() << "\n";
+
   StopFlags flags;
   install_signal_handlers(flags);
   RunInfo info;
@@ -95,6 +118,7 @@ static int run(int argc, char** argv) {
     } else {
       auto reload = [&]() {
         // SIGHUP: a new config replaces the pipeline only if it is valid.
+        notifier.reloading();
         try {
           DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
           if (lcm_url) fresh.lcm_url = *lcm_url;
@@ -106,8 +130,9 @@ static int run(int argc, char** argv) {
         } catch (const std::exception& e) {
           std::cerr << "resolverd: reload failed, keeping the running config: " << e.what() << "\n";
         }
+        notifier.ready();
       };
-      run_live(LiveOptions{can_iface}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
+      run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
       info.source = can_iface;
     }
   } catch (const std::exception& e) {
@@ -116,6 +141,20 @@ static int run(int argc, char** argv) {
   }
 
   print_run_report(std::cout, *pipeline, info);
+  const HwangIntegralEstimator& est = pipeline->processor().estimator();
+  if (!state_dir.empty() && est.converged()) {
+    Calibration cal;
+    cal.p_r = pipeline->processor().config().p_r;
+    cal.p = pipeline->processor().config().p;
+    cal.method = "hwang_integral";
+    cal.samples = est.samples_used();
+    cal.params = {{"amplitude_imbalance.alpha", est.alpha(), est.alpha_stderr()}};
+    if (auto problem = save_calibration(state_dir, cal)) {
+      std::cerr << "resolverd: " << *problem << "\n";
+    } else {
+      std::cerr << "resolverd: calibration saved to " << calibration_path(state_dir) << "\n";
+    }
+  }
   if (output->publish_failures() > 0) {
     std::cerr << "resolverd: " << output->publish_failures() << " LCM publish calls failed\n";
   }

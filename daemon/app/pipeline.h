@@ -53,6 +53,8 @@ class Pipeline {
   /// Live idle time: publishes health_t when a second has passed since the
   /// last one even if no frame arrived. now_us [us] on the frames' clock.
   void tick(std::int64_t now_us);
+  /// Compensate with a persisted alpha until the estimator converges.
+  void seed_alpha(double alpha) { processor_.seed_alpha(alpha); }
   /// Cumulative frames dropped by the kernel (SO_RXQ_OVFL), for health_t.
   void set_kernel_drops(std::int64_t drops) { kernel_drops_ = drops; }
 

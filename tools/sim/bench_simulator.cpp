@@ -59,11 +59,35 @@ SimConfig validated(SimConfig c) {
   require(c.amplitude_counts > 0.0 && c.amplitude_counts <= bench::kSinCosFullScale,
           fmt::format("SimConfig amplitude_counts (--amplitude) = {}: must be in (0, 32767] ADC counts", c.amplitude_counts));
   require(std::isfinite(c.i_d_cmd) && std::isfinite(c.i_q_cmd), "SimConfig i_d_cmd / i_q_cmd (--id / --iq) must be finite [A]");
-  // Peak phase current of the amplitude-invariant transform is hypot(i_d, i_q).
-  const double i_peak = std::hypot(c.i_d_cmd, c.i_q_cmd) + 5.0 * c.chain.noise.sigma_i;
+  const SensorChainConfig& ch = c.chain;
+  require(std::isfinite(ch.sampling_skew.tau),
+          "SimConfig chain.sampling_skew.tau (--effect sampling_skew:tau=) must be finite [s]");
+  require(std::abs(ch.eccentricity.e) < 1.0 && std::isfinite(ch.eccentricity.phase),
+          fmt::format("SimConfig chain.eccentricity.e (--effect eccentricity:e=) = {}: must be in (-1, 1) mechanical rad so "
+                      "the resolver angle keeps turning one way; phase must be finite",
+                      ch.eccentricity.e));
+  require(std::isfinite(ch.mounting_offset.theta_0),
+          "SimConfig chain.mounting_offset.theta_0 (--effect mounting_offset:theta_0=) must be finite [rad]");
+  require(std::isfinite(ch.current_offsets.off_a) && std::isfinite(ch.current_offsets.off_b),
+          "SimConfig chain.current_offsets off_a/off_b (--effect current_offsets:...) must be finite [A]");
+  require(ch.current_gain_mismatch.gain_a > -1.0 && ch.current_gain_mismatch.gain_b > -1.0,
+          fmt::format("SimConfig chain.current_gain_mismatch gain_a = {}, gain_b = {} (--effect current_gain_mismatch:...): "
+                      "relative gain errors must be > -1",
+                      ch.current_gain_mismatch.gain_a, ch.current_gain_mismatch.gain_b));
+  require(ch.dead_time.t_d >= 0.0 && std::isfinite(ch.dead_time.t_d),
+          fmt::format("SimConfig chain.dead_time.t_d (--effect dead_time:t_d=) = {}: must be >= 0 s", ch.dead_time.t_d));
+  // Peak measured phase current over a fine theta_e grid: hypot(i_d, i_q) for an
+  // ideal chain (amplitude-invariant transform), more with dead time, gains, offsets.
+  double i_peak = 0.0;
+  for (int i = 0; i < 3600; ++i) {
+    const PhaseCurrents m =
+        phase_currents_measured(ch, phase_currents_true(ch, c.i_d_cmd, c.i_q_cmd, kTwoPi * i / 3600.0));
+    i_peak = std::max({i_peak, std::abs(m.a), std::abs(m.b), std::abs(m.c)});
+  }
+  i_peak += 5.0 * ch.noise.sigma_i;
   require(i_peak <= kCurrentFullScale,
-          fmt::format("SimConfig i_d_cmd/i_q_cmd (--id/--iq): peak phase current {:.3f} A (incl. 5 sigma noise) exceeds the "
-                      "PHASE_CURRENTS range +-32.767 A (1 mA/bit, DESIGN 4); lower --iq/--id",
+          fmt::format("SimConfig i_d_cmd/i_q_cmd (--id/--iq): peak phase current {:.3f} A (incl. current-sensor effects, dead "
+                      "time and 5 sigma noise) exceeds the PHASE_CURRENTS range +-32.767 A (1 mA/bit, DESIGN 4); lower --iq/--id",
                       i_peak));
   require(c.chain.tracking_loop.omega_n >= 0.0 && std::isfinite(c.chain.tracking_loop.omega_n),
           "SimConfig chain.tracking_loop.omega_n (--effect tracking_loop:omega_n=) must be >= 0 rad/s (0 = ideal converter)");
@@ -103,7 +127,7 @@ BenchSimulator::BenchSimulator(SimConfig config)
   const double n = std::ceil(profile_.duration() * config_.sample_rate_hz - 1e-9);
   total_ = static_cast<std::uint64_t>(std::max(n, 1.0));
   // Start the converter converged: at the static angle of the envelopes, at speed.
-  const double theta0 = config_.p_r * theta_m_at(0.0);
+  const double theta0 = resolver_angle_at(0.0);
   const double phi0 = theta0 - wrap_pi(theta0 - static_rd_angle(sensor_envelopes(config_.chain, theta0)));
   loop_.reset({phi0, config_.p_r * profile_.omega_m(0.0)});
 }
@@ -118,13 +142,17 @@ std::int64_t BenchSimulator::sample_time_us(std::uint64_t index) const {
 
 double BenchSimulator::theta_m_at(double t) const { return config_.theta_m0 + profile_.angle_m(t); }
 
+double BenchSimulator::resolver_angle_at(double t) const {
+  return resolver_angle(config_.chain, theta_m_at(t), config_.p_r, config_.p);
+}
+
 bool BenchSimulator::next(SimSample& out) {
   if (index_ >= total_) return false;
   const double t = sample_time_s(index_);
   const double p_r = config_.p_r;
   if (index_ > 0) {
     const double t_prev = sample_time_s(index_ - 1);
-    loop_.advance([&](double tt) { return sensor_envelopes(config_.chain, p_r * theta_m_at(tt)); }, t_prev,
+    loop_.advance([&](double tt) { return sensor_envelopes(config_.chain, resolver_angle_at(tt)); }, t_prev,
                   t - t_prev);
   }
   const double theta_m = theta_m_at(t);
@@ -140,12 +168,16 @@ bool BenchSimulator::next(SimSample& out) {
   s.theta_e = wrap_2pi(theta_e);
   s.omega_m = profile_.omega_m(t);
   // Fixed draw order (sin, cos, i_a, i_b, i_c) keeps a seed's output stable.
-  const SinCos sc = sensor_envelopes(config_.chain, theta);
+  const double theta_seen = resolver_angle_at(t);
+  const double theta_seen_cos =
+      config_.chain.sampling_skew.active() ? resolver_angle_at(t + config_.chain.sampling_skew.tau) : theta_seen;
+  const SinCos sc = sampled_envelopes(config_.chain, theta_seen, theta_seen_cos);
   s.sin_counts = to_i16(config_.amplitude_counts * sc.s + gaussian_noise(engine_, noise.sigma_sc));
   s.cos_counts = to_i16(config_.amplitude_counts * sc.c + gaussian_noise(engine_, noise.sigma_sc));
   s.rd_counts = quantize_rd_angle(loop_.state().phi, config_.rd_bits);
   s.rd_angle = rd_counts_to_angle(s.rd_counts);
-  const PhaseCurrents i = ideal_phase_currents(config_.i_d_cmd, config_.i_q_cmd, theta_e);
+  const PhaseCurrents i =
+      phase_currents_measured(config_.chain, phase_currents_true(config_.chain, config_.i_d_cmd, config_.i_q_cmd, theta_e));
   const double ma_per_amp = 1.0 / bench::kCurrentAmpsPerBit;
   s.i_a_ma = to_i16((i.a + gaussian_noise(engine_, noise.sigma_i)) * ma_per_amp);
   s.i_b_ma = to_i16((i.b + gaussian_noise(engine_, noise.sigma_i)) * ma_per_amp);

@@ -4,12 +4,19 @@
 //
 // Per control sample k (t_k = k / sample_rate_hz):
 //   theta_m(t)  from the speed profile (exact integral), theta = p_r theta_m, theta_e = p theta_m
-//   sin/cos     = amplitude_counts * sensor_envelopes(chain, theta(t_k)) + noise   -> i16 counts
+//   theta_s(t)  = resolver_angle(chain, theta_m(t)): the angle the resolver sees
+//                 (eccentricity, mounting offset; sensor_chain.h)
+//   sin/cos     = amplitude_counts * sampled_envelopes(chain, theta_s(t_k), theta_s(t_k + tau))
+//                 + noise (sin at t_k, cos tau later: sampling skew)   -> i16 counts
 //   rd_angle    = the tracking loop, integrated continuously from t_{k-1} to t_k on
-//                 the noise-free envelopes (the converter has its own analog front
-//                 end; the ADC noise is the DSP's), rounded to rd_bits      -> u16
-//   currents    = ideal current control at the TRUE theta_e (Hwang eqs. 11-12) + noise -> mA
-//   reference   = theta_m wrapped, 2^32 counts per mechanical turn         -> u32
+//                 the noise-free, unskewed envelopes of theta_s (the converter has its
+//                 own analog front end; ADC noise and sampling skew are the DSP's),
+//                 rounded to rd_bits                                   -> u16
+//   currents    = phase_currents_true: ideal current control in the drive frame
+//                 theta_e + theta_0 (Hwang eqs. 11-12; theta_0 = 0 is the TRUE theta_e)
+//                 with the dead-time distortion; then phase_currents_measured (sensor
+//                 gains and offsets) + noise                           -> mA
+//   reference   = theta_m wrapped, 2^32 counts per mechanical turn     -> u32
 // The same effect models (daemon/core/effects) are what the fit uses.
 //
 // Randomness: one std::mt19937_64 seeded with `seed`; the same SimConfig gives the
@@ -104,6 +111,8 @@ class BenchSimulator {
  private:
   [[nodiscard]] double sample_time_s(std::uint64_t index) const;
   [[nodiscard]] double theta_m_at(double t) const;
+  /// [rad] the resolver electrical angle the resolver sees at time t [s] (continuous).
+  [[nodiscard]] double resolver_angle_at(double t) const;
 
   SimConfig config_;
   SpeedProfile profile_;

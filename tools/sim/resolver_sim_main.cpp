@@ -33,6 +33,13 @@ Examples:
   # Hold 200 r/min, ramp to 1000 r/min in 3 s, hold 2 s; several effects
   resolver-sim --out sweep.log --profile "200:5,200-1000:3,1000:2" \
       --effect quadrature:beta=0.004 --effect offsets:o_s=0.001,o_c=-0.002
+  # Effects beyond the resolver windings: sampling skew (grows with speed),
+  # eccentricity (1x mechanical), mounting offset (steady i_d against the reference),
+  # current sensors (1x / 2x dq ripple) and dead time (6x dq ripple)
+  resolver-sim --out bench.log --rpm 3000 --effect sampling_skew:tau=2e-6 \
+      --effect eccentricity:e=5e-4,phase=1 --effect mounting_offset:theta_0=0.05 \
+      --effect current_offsets:off_a=0.05,off_b=-0.03 --effect current_gain_mismatch:gain_a=0.01 \
+      --effect dead_time:t_d=2e-6
   # An ideal chain: no noise, infinitely fast converter
   resolver-sim --out ideal.log --effect noise:sigma_sc=0,sigma_i=0 --effect tracking_loop:omega_n=0
   # Replay on a virtual bus:  canplayer -I imbalance.log vcan0=can0

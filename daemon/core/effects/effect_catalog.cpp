@@ -5,6 +5,8 @@
 #include <cmath>
 #include <system_error>
 
+#include "daemon/core/angles.h"
+
 #include <fmt/format.h>
 
 namespace resolver {
@@ -59,8 +61,9 @@ constexpr std::array kHarmonics{
 };
 static_assert(kHarmonics.size() == Harmonics::kMaxOrder, "one row for k0 and each of k2..kMaxOrder");
 constexpr std::array kSamplingSkew{
-    EffectParameter{"tau", "[s]", "delay of the cos sample after the sin sample", -1e-3, 1e-3, false, true, nullptr,
-                    nullptr},
+    EffectParameter{"tau", "[s]", "delay of the cos sample after the sin sample", -1e-3, 1e-3, false, true,
+                    [](SensorChainConfig& c, double v) { c.sampling_skew.tau = v; },
+                    [](const SensorChainConfig& c) { return c.sampling_skew.tau; }},
 };
 constexpr std::array kTrackingLoop{
     EffectParameter{"omega_n", "[rad/s]", "closed-loop natural frequency (0 = ideal converter)", 0.0, 1e6, false,
@@ -77,29 +80,39 @@ constexpr std::array kQuantization{
                     [](const SensorChainConfig& c) { return static_cast<double>(c.quantization.rd_bits); }},
 };
 constexpr std::array kEccentricity{
-    EffectParameter{"e", "[rad]", "amplitude of the 1x mechanical angle error", -kSmall, kSmall, false, true, nullptr,
-                    nullptr},
-    EffectParameter{"phase", "[rad]", "mechanical angle of the eccentricity", -10.0, 10.0, false, true, nullptr,
-                    nullptr},
+    EffectParameter{"e", "[rad]", "amplitude of the 1x angle error (mechanical rad)", -kSmall, kSmall, false, true,
+                    [](SensorChainConfig& c, double v) { c.eccentricity.e = v; },
+                    [](const SensorChainConfig& c) { return c.eccentricity.e; }},
+    EffectParameter{"phase", "[rad]", "phase of the 1x angle error (mechanical rad)", -10.0, 10.0, false, true,
+                    [](SensorChainConfig& c, double v) { c.eccentricity.phase = v; },
+                    [](const SensorChainConfig& c) { return c.eccentricity.phase; }},
 };
 constexpr std::array kMountingOffset{
-    EffectParameter{"theta_0", "[rad]", "resolver zero minus motor electrical zero", -10.0, 10.0, false, true,
-                    nullptr, nullptr},
+    EffectParameter{"theta_0", "[rad]", "drive (resolver) zero ahead of the rotor d axis (motor electrical rad)",
+                    -kPi, kPi, false, true, [](SensorChainConfig& c, double v) { c.mounting_offset.theta_0 = v; },
+                    [](const SensorChainConfig& c) { return c.mounting_offset.theta_0; }},
 };
 constexpr std::array kCurrentOffsets{
-    EffectParameter{"off_a", "[A]", "offset of the phase a current sensor", -1000.0, 1000.0, false, true, nullptr,
-                    nullptr},
-    EffectParameter{"off_b", "[A]", "offset of the phase b current sensor", -1000.0, 1000.0, false, true, nullptr,
-                    nullptr},
+    EffectParameter{"off_a", "[A]", "offset of the phase a current sensor", -1000.0, 1000.0, false, true,
+                    [](SensorChainConfig& c, double v) { c.current_offsets.off_a = v; },
+                    [](const SensorChainConfig& c) { return c.current_offsets.off_a; }},
+    EffectParameter{"off_b", "[A]", "offset of the phase b current sensor", -1000.0, 1000.0, false, true,
+                    [](SensorChainConfig& c, double v) { c.current_offsets.off_b = v; },
+                    [](const SensorChainConfig& c) { return c.current_offsets.off_b; }},
 };
 constexpr std::array kCurrentGain{
     EffectParameter{"gain_a", "[1]", "relative gain error of the phase a current sensor", -kSmall, kSmall, false,
-                    true, nullptr, nullptr},
+                    true, [](SensorChainConfig& c, double v) { c.current_gain_mismatch.gain_a = v; },
+                    [](const SensorChainConfig& c) { return c.current_gain_mismatch.gain_a; }},
     EffectParameter{"gain_b", "[1]", "relative gain error of the phase b current sensor", -kSmall, kSmall, false,
-                    true, nullptr, nullptr},
+                    true, [](SensorChainConfig& c, double v) { c.current_gain_mismatch.gain_b = v; },
+                    [](const SensorChainConfig& c) { return c.current_gain_mismatch.gain_b; }},
 };
 constexpr std::array kDeadTime{
-    EffectParameter{"t_d", "[s]", "inverter dead time", 0.0, 1e-4, false, true, nullptr, nullptr},
+    // 20 us is already an extreme dead time; it gives k_dt = 0.2 (dead_time.h).
+    EffectParameter{"t_d", "[s]", "inverter dead time (5th/7th current harmonics k_dt = t_d / 100 us)", 0.0, 2e-5,
+                    false, true, [](SensorChainConfig& c, double v) { c.dead_time.t_d = v; },
+                    [](const SensorChainConfig& c) { return c.dead_time.t_d; }},
 };
 constexpr std::array kNoise{
     EffectParameter{"sigma_sc", "[counts]", "white noise on each sin/cos ADC sample", 0.0, 32767.0, false, true,
@@ -124,22 +137,36 @@ const std::array kCatalog{
                "eps ~ -sqrt2 K_0 cos(theta+pi/4) - sum K_n sin((n-1)theta)",
                "Hanselman eq. 8-9", kHarmonics, true,
                [](const SensorChainConfig& c) { return c.harmonics.active(); }},
-    EffectInfo{"sampling_skew", "sin/cos sampled tau apart: like quadrature with beta = omega tau",
-               "DESIGN 6", kSamplingSkew, false, nullptr},
+    EffectInfo{"sampling_skew",
+               "cos sampled tau after sin: like quadrature with beta = omega tau on the sampled sin/cos "
+               "(not the R/D angle); grows with speed",
+               "DESIGN 6, Hanselman eq. 6-7 via beta = omega tau", kSamplingSkew, true,
+               [](const SensorChainConfig& c) { return c.sampling_skew.active(); }},
     EffectInfo{"tracking_loop", "type-II R/D loop: error ripple filtered by H(s), lag under acceleration",
                "Hanselman II.A, Hwang Fig. 2", kTrackingLoop, true,
                [](const SensorChainConfig& c) { return c.tracking_loop.active(); }},
     EffectInfo{"quantization", "R/D angle rounded to 2pi/2^rd_bits; uniform +-1/2 LSB", "Hanselman Table I",
                kQuantization, true, [](const SensorChainConfig& c) { return c.quantization.active(); }},
-    EffectInfo{"eccentricity", "1x mechanical harmonic of the angle error", "DESIGN 6", kEccentricity, false,
-               nullptr},
-    EffectInfo{"mounting_offset", "constant angle: steady i_d with a pure i_q command", "DESIGN 6",
-               kMountingOffset, false, nullptr},
-    EffectInfo{"current_offsets", "current sensor offsets: dq ripple at 1x theta_e", "DESIGN 6", kCurrentOffsets,
-               false, nullptr},
-    EffectInfo{"current_gain_mismatch", "current sensor gains: dq ripple at 2x theta_e", "DESIGN 6", kCurrentGain,
-               false, nullptr},
-    EffectInfo{"dead_time", "inverter dead time: dq ripple at 6x theta_e", "DESIGN 6", kDeadTime, false, nullptr},
+    EffectInfo{"eccentricity",
+               "resolver sees theta_m + e sin(theta_m + phase): eps = -p_r e sin(theta_m + phase), 1x mechanical",
+               "DESIGN 6", kEccentricity, true, [](const SensorChainConfig& c) { return c.eccentricity.active(); }},
+    EffectInfo{"mounting_offset",
+               "drive angle = theta_e + theta_0: eps = -(p_r/p) theta_0; steady i_d = -i_q sin theta_0 in the "
+               "reference frame",
+               "DESIGN 6", kMountingOffset, true,
+               [](const SensorChainConfig& c) { return c.mounting_offset.active(); }},
+    EffectInfo{"current_offsets",
+               "i_a + off_a, i_b + off_b: dq ripple at 1x theta_e of amplitude hypot(off_a, off_b/sqrt3)", "DESIGN 6",
+               kCurrentOffsets, true, [](const SensorChainConfig& c) { return c.current_offsets.active(); }},
+    EffectInfo{"current_gain_mismatch",
+               "i_a (1+gain_a), i_b (1+gain_b): dq ripple at 2x theta_e of amplitude "
+               "|I|/2 sqrt((gain_a - gain_b/2)^2 + gain_b^2/12)",
+               "DESIGN 6", kCurrentGain, true,
+               [](const SensorChainConfig& c) { return c.current_gain_mismatch.active(); }},
+    EffectInfo{"dead_time",
+               "signature model: 5th/7th current harmonics k_dt |I|, dq ripple at 6x theta_e (2 k_dt i_q on i_d)",
+               "DESIGN 6; dead_time.h", kDeadTime, true,
+               [](const SensorChainConfig& c) { return c.dead_time.active(); }},
     EffectInfo{"noise", "white noise on sin/cos samples and phase currents; sets the floor", "DESIGN 6", kNoise,
                true, [](const SensorChainConfig& c) { return c.noise.active(); }},
 };

@@ -9,7 +9,10 @@
 //
 // Spec grammar:  effect:param=value[,param=value...]
 //   e.g. "amplitude_imbalance:alpha=0.003", "offsets:o_s=0.001,o_c=-0.002",
-//        "tracking_loop:omega_n=3000,zeta=0.7", "harmonics:k0=0.001,k3=0.0005"
+//        "tracking_loop:omega_n=3000,zeta=0.7", "harmonics:k0=0.001,k3=0.0005",
+//        "sampling_skew:tau=2e-6", "eccentricity:e=5e-4,phase=1", "mounting_offset:theta_0=0.05",
+//        "current_offsets:off_a=0.05,off_b=-0.03", "current_gain_mismatch:gain_a=0.01",
+//        "dead_time:t_d=2e-6"
 #pragma once
 
 #include <optional>

@@ -21,6 +21,12 @@ struct PhaseCurrents {
   double c = 0.0;
 };
 
+/// A current vector in a rotating (d, q) frame [A].
+struct DqCurrents {
+  double d = 0.0;
+  double q = 0.0;
+};
+
 /// Phase currents [A] that carry exactly (i_d, i_q) [A] in the frame at the true
 /// motor electrical angle theta_e [rad]. Cannot fail.
 [[nodiscard]] PhaseCurrents ideal_phase_currents(double i_d, double i_q, double theta_e);

@@ -82,7 +82,12 @@ class SampleProcessor {
   [[nodiscard]] const ProcessorConfig& config() const { return config_; }
   [[nodiscard]] const HwangIntegralEstimator& estimator() const { return estimator_; }
   [[nodiscard]] const RippleSet& ripple() const { return ripple_; }
-  /// alpha used by the compensation now (0 until the estimator converged).
+  /// Starts compensating with a previously learned alpha (persisted
+  /// calibration) until this run's estimator has converged.
+  void seed_alpha(double alpha) {
+    if (config_.compensate) active_alpha_ = alpha;
+  }
+  /// alpha used by the compensation now (0 until the estimator converged or a seed).
   [[nodiscard]] double active_alpha() const { return active_alpha_; }
 
  private:

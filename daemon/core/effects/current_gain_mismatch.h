@@ -1,0 +1,47 @@
+// Effect: gain mismatch of the phase current sensors.
+//
+// As for offsets (current_offsets.h) the a and b sensors carry the error and c
+// is the reference; it acts on the MEASUREMENT only.
+// Forward model: i_a_meas = (1 + gain_a) i_a, i_b_meas = (1 + gain_b) i_b,
+// i_c_meas = i_c.
+// Signature (DESIGN 6), for ideal currents i_alpha + j i_beta = I e^{j theta_e},
+// I = i_d + j i_q (phase_currents.h): i_a = Re(I e^{j theta_e}),
+// i_b = Re(I e^{j(theta_e - 2pi/3)}), and the Clarke error
+// delta = gain_a i_a + j gain_b i_b / sqrt3, rotated by e^{-j theta_e}, is
+//   delta_dq = I   (gain_a + gain_b/2 - j gain_b/(2 sqrt3)) / 2                    (DC)
+//            + I* (gain_a - gain_b/2 - j gain_b/(2 sqrt3)) / 2 e^{-j 2 theta_e}    (2x)
+// so i_d and i_q each carry a 2x theta_e ripple of amplitude
+//   A_2 = |I| / 2 sqrt((gain_a - gain_b/2)^2 + gain_b^2 / 12)
+// plus a DC shift. Exact (linear in the gains), proportional to the current,
+// independent of speed except for its frequency 2 omega_e. When p_r = p it lands
+// on the same frequency as the resolver's amplitude imbalance (Hwang eq. 15-16):
+// only the resolver signals tell them apart (DESIGN 6).
+// Compensation: divide the measured a, b currents by (1 + gain).
+#pragma once
+
+#include "daemon/core/effects/phase_currents.h"
+
+namespace resolver {
+
+struct CurrentGainMismatch {
+  double gain_a = 0.0;  ///< [1] relative gain error of the phase a sensor; > -1
+  double gain_b = 0.0;  ///< [1] relative gain error of the phase b sensor; > -1
+  [[nodiscard]] bool active() const { return gain_a != 0.0 || gain_b != 0.0; }
+};
+
+/// Forward model: the measured phase currents [A].
+[[nodiscard]] PhaseCurrents apply_current_gain_mismatch(const CurrentGainMismatch& p, const PhaseCurrents& in);
+
+/// Signature: the dq error [A] in the frame at theta_e [rad] when the machine carries
+/// (i_d, i_q) [A] in that frame (ideal currents). Exact.
+[[nodiscard]] DqCurrents current_gain_mismatch_dq_error(const CurrentGainMismatch& p, double i_d, double i_q,
+                                                        double theta_e);
+
+/// [A] amplitude A_2 of the 2x theta_e ripple on i_d (and on i_q) at current (i_d, i_q) [A].
+[[nodiscard]] double current_gain_mismatch_ripple_2x(const CurrentGainMismatch& p, double i_d, double i_q);
+
+/// Compensation: undoes the gains on measured currents [A]. Gains must be > -1.
+[[nodiscard]] PhaseCurrents compensate_current_gain_mismatch(const CurrentGainMismatch& p,
+                                                             const PhaseCurrents& measured);
+
+}  // namespace resolver

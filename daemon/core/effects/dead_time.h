@@ -1,0 +1,62 @@
+// Effect: inverter dead time, as a SIGNATURE model.
+//
+// This is not an inverter model. A real dead time t_d adds to each phase
+// voltage a square wave -V_dt sign(i_x), V_dt = t_d f_pwm V_dc, and the machine's
+// impedance turns its 5th (negative sequence) and 7th (positive sequence)
+// harmonics into current harmonics that appear in the rotating frame at 6x
+// theta_e (DESIGN 6). Here we keep only that signature, with one constant:
+//
+//   each phase current gains  delta i_x = k_dt |I| (sin 7 psi_x - sin 5 psi_x)
+//   where i_x = |I| cos psi_x is the phase's fundamental and
+//   k_dt = t_d / kReferenceTime                                            [1]
+//
+// Where the shape comes from: for an inductive machine (omega_e L >> R) the
+// square wave's harmonics (4 V_dt / pi)(cos 5psi / 5 - cos 7psi / 7) divided by
+// j(-5 omega_e) L and j(7 omega_e) L give current harmonics
+// -j (4 V_dt / (pi omega_e L)) (e^{-j5psi} / 25 + e^{j7psi} / 49) in the
+// stationary frame; the model keeps their phase and sequence and gives both the
+// same relative amplitude k_dt, which is the simplification.
+// kReferenceTime = 100 us is a convention, not a physical constant: it makes
+// a typical 1-2 us dead time of a 10 kHz, few-hundred-volt IGBT inverter give the
+// 1-2 % 5th/7th current distortion such drives show at moderate load.
+// Also simplified: the amplitude scales with |I| (the real one is set by V_dt
+// and the impedance, so it falls ~1/omega_e with speed and does not vanish
+// with load) and zero-crossing clamping is ignored.
+//
+// Signature in dq. In the frame at theta_e with the current vector
+// I = i_d + j i_q = |I| e^{j delta}, psi = theta_e + delta, the stationary
+// distortion -j k |I| (e^{-j5psi} + e^{j7psi}) becomes
+//   delta i_d =  2 k_dt i_q cos(6 (theta_e + delta))
+//   delta i_q = -2 k_dt i_d cos(6 (theta_e + delta))
+// a 6x theta_e ripple perpendicular to the current vector: a pure-i_q command
+// shows it on i_d with amplitude 2 k_dt |i_q|. Speed: none in the model (frequency 6 omega_e).
+// It acts on the MACHINE current, so the sensors measure it.
+// Compensation: subtract the modelled dq ripple (dead_time_dq_error); a real drive
+// would feed the square-wave voltage forward instead.
+#pragma once
+
+#include "daemon/core/effects/phase_currents.h"
+
+namespace resolver {
+
+struct DeadTime {
+  /// [s] the dead time that gives k_dt = 1 (see the header comment).
+  static constexpr double kReferenceTime = 100e-6;
+  double t_d = 0.0;  ///< [s] inverter dead time; >= 0
+  [[nodiscard]] bool active() const { return t_d != 0.0; }
+  /// [1] relative amplitude of each of the 5th and 7th current harmonics.
+  [[nodiscard]] double k_dt() const { return t_d / kReferenceTime; }
+};
+
+/// Forward model: the phase currents [A] with the 5th/7th distortion added to the
+/// balanced fundamental `fundamental` (zero sum). The result still sums to zero.
+[[nodiscard]] PhaseCurrents apply_dead_time(const DeadTime& p, const PhaseCurrents& fundamental);
+
+/// Signature: the dq distortion [A] in the frame at theta_e [rad] when the fundamental is
+/// (i_d, i_q) [A] in that frame.
+[[nodiscard]] DqCurrents dead_time_dq_error(const DeadTime& p, double i_d, double i_q, double theta_e);
+
+/// [A] amplitudes of the 6x theta_e ripple on i_d (2 k_dt |i_q|) and on i_q (2 k_dt |i_d|).
+[[nodiscard]] DqCurrents dead_time_ripple_6x(const DeadTime& p, double i_d, double i_q);
+
+}  // namespace resolver

@@ -1,0 +1,42 @@
+// Effect: mechanical eccentricity of the resolver (rotor not concentric with
+// the stator, or a bent / runout shaft).
+//
+// Forward model: the resolver sees the mechanical angle
+//   theta_seen_m = theta_m + e sin(theta_m + phase)                      [rad, mechanical]
+// and reports theta = p_r theta_seen_m (plus the mounting offset, mounting_offset.h).
+// e [rad, mechanical] is the amplitude of the angle error, phase [rad,
+// mechanical] the rotor angle where the error crosses zero rising. |e| < 1
+// keeps theta_seen_m monotone (catalog limit 0.5; realistic e is ~1e-4..1e-3).
+// Signature (DESIGN 6): a 1x MECHANICAL harmonic of the position error,
+//   eps_m = theta_m - theta_seen_m = -e sin(theta_m + phase)          [rad, mechanical]
+//   eps   = p_r eps_m                                                 [rad, resolver electrical]
+// exact as a function of the true angle. In the resolver electrical angle it is
+// the subharmonic order 1/p_r, so a fit over theta alone (Hwang, Hanselman
+// eq. 9) cannot see it; a fit against the reference angle per mechanical turn
+// can. Speed: none in amplitude (geometry); its frequency omega_m is far inside
+// any R/D loop's bandwidth. It reaches sin/cos, the R/D angle and everything the
+// drive derives from them; the reference encoder and the motor do not see it.
+// Compensation: invert theta_seen_m -> theta_m (Kepler-type equation, solved by
+// fixed-point iteration, which contracts with factor |e|). To first order
+// theta_m ~= theta_seen_m - e sin(theta_seen_m + phase), error <= e^2.
+#pragma once
+
+namespace resolver {
+
+struct Eccentricity {
+  double e = 0.0;      ///< [rad, mechanical] amplitude of the 1x angle error; |e| < 1
+  double phase = 0.0;  ///< [rad, mechanical] phase of the 1x angle error
+  [[nodiscard]] bool active() const { return e != 0.0; }
+};
+
+/// Forward model: the mechanical angle the resolver sees [rad] at true theta_m [rad] (continuous in, continuous out).
+[[nodiscard]] double eccentric_angle(const Eccentricity& p, double theta_m);
+
+/// Position error eps_m = theta_m - theta_seen_m [rad, mechanical] at true theta_m (exact).
+[[nodiscard]] double eccentricity_error(const Eccentricity& p, double theta_m);
+
+/// Compensation: the true mechanical angle [rad] whose eccentric image is theta_seen_m
+/// [rad], to |error| <= 1e-15 rad (plus rounding) for |e| <= 0.5. Requires |e| < 1.
+[[nodiscard]] double compensate_eccentricity(const Eccentricity& p, double theta_seen_m);
+
+}  // namespace resolver

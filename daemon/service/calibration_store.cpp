@@ -1,0 +1,373 @@
+#include "daemon/service/calibration_store.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <set>
+#include <string_view>
+
+namespace resolver {
+
+namespace {
+
+constexpr std::string_view kMagic = "resolverd-calibration";
+constexpr std::string_view kChecksumKey = "crc32 ";
+/// A version-1 file is a few hundred bytes; anything above this is not ours.
+constexpr std::size_t kMaxFileBytes = 1 << 20;  // [bytes]
+constexpr int kMaxPolePairs = 255;               // BENCH_INFO carries p_r and p as u8
+
+const std::array<std::uint32_t, 256>& crc_table() {
+  static const std::array<std::uint32_t, 256> table = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1U) != 0 ? (c >> 1) ^ 0xEDB88320U : c >> 1;
+      t[i] = c;
+    }
+    return t;
+  }();
+  return table;
+}
+
+bool valid_name(std::string_view name) {
+  if (name.empty() || name.size() > 128) return false;
+  for (const char ch : name) {
+    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
+                    ch == '.' || ch == ':' || ch == '-';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+std::string shortest(double v) {
+  std::array<char, 64> buf{};
+  const auto res = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  return std::string(buf.data(), res.ptr);
+}
+
+/// A line of a possibly foreign file, made safe to print in one message.
+std::string printable(std::string_view line) {
+  std::string out;
+  for (const char ch : line.substr(0, 40)) out += (ch >= 0x20 && ch < 0x7f) ? ch : '?';
+  if (line.size() > 40) out += "...";
+  return out;
+}
+
+template <typename T>
+bool parse_number(std::string_view text, T& out) {
+  if (text.empty()) return false;
+  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
+  return ec == std::errc{} && ptr == text.data() + text.size();
+}
+
+/// Splits "key rest" at the first space.
+std::pair<std::string_view, std::string_view> split_key(std::string_view line) {
+  const auto space = line.find(' ');
+  if (space == std::string_view::npos) return {line, {}};
+  return {line.substr(0, space), line.substr(space + 1)};
+}
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+/// Writes all of `data` to `fd`, retrying short writes and EINTR. errno on failure.
+bool write_all(int fd, std::string_view data) {
+  while (!data.empty()) {
+    const ssize_t n = ::write(fd, data.data(), data.size());
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    data.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+}  // namespace
+
+std::uint32_t crc32_ieee(const std::string& bytes) {
+  const auto& table = crc_table();
+  std::uint32_t crc = 0xFFFFFFFFU;
+  for (const char ch : bytes) crc = table[(crc ^ static_cast<std::uint8_t>(ch)) & 0xFFU] ^ (crc >> 8);
+  return crc ^ 0xFFFFFFFFU;
+}
+
+std::string calibration_path(const std::string& dir) {
+  if (!dir.empty() && dir.back() == '/') return dir + kCalibrationFileName;
+  return dir + "/" + kCalibrationFileName;
+}
+
+std::optional<std::string> format_calibration(const Calibration& c, std::string& text) {
+  if (c.p_r < 1 || c.p_r > kMaxPolePairs || c.p < 1 || c.p > kMaxPolePairs) {
+    return "cannot save the calibration: pole pairs p_r=" + std::to_string(c.p_r) + ", p=" + std::to_string(c.p) +
+           " are outside 1..255; the bench identity must come from BENCH_INFO or the config";
+  }
+  if (c.method.find_first_of("\r\n") != std::string::npos) {
+    return "cannot save the calibration: the method name contains a line break; use a one-line name";
+  }
+  if (c.samples < 0) {
+    return "cannot save the calibration: samples=" + std::to_string(c.samples) + " is negative";
+  }
+  std::set<std::string> seen;
+  for (const auto& param : c.params) {
+    if (!valid_name(param.name)) {
+      return "cannot save the calibration: parameter name '" + printable(param.name) +
+             "' is empty or has characters outside [A-Za-z0-9_.:-]; rename the parameter";
+    }
+    if (!seen.insert(param.name).second) {
+      return "cannot save the calibration: parameter '" + param.name + "' appears twice";
+    }
+    if (!std::isfinite(param.value) || !std::isfinite(param.std_error) || param.std_error < 0.0) {
+      return "cannot save the calibration: parameter '" + param.name + "' has value " + shortest(param.value) +
+             " and std_error " + shortest(param.std_error) +
+             "; only finite values and a finite std_error >= 0 are saved (the estimate has not converged?)";
+    }
+  }
+  std::string body;
+  body += kMagic;
+  body += "\n# learned by resolverd; edits break the checksum and the file is then ignored\n";
+  body += "format " + std::to_string(kCalibrationFormatVersion) + "\n";
+  body += "p_r " + std::to_string(c.p_r) + "\n";
+  body += "p " + std::to_string(c.p) + "\n";
+  body += "method " + c.method + "\n";
+  body += "samples " + std::to_string(c.samples) + "\n";
+  for (const auto& param : c.params) {
+    body += "param " + param.name + " " + shortest(param.value) + " " + shortest(param.std_error) + "\n";
+  }
+  char crc[16];
+  std::snprintf(crc, sizeof crc, "%08x", static_cast<unsigned>(crc32_ieee(body)));
+  text = body + std::string(kChecksumKey) + crc + "\n";
+  return std::nullopt;
+}
+
+std::optional<Calibration> parse_calibration(const std::string& text, const std::string& where, std::string& problem) {
+  auto fail = [&](const std::string& why) -> std::optional<Calibration> {
+    problem = where + ": " + why;
+    return std::nullopt;
+  };
+  if (text.empty()) return fail("empty file (an interrupted write by an old version?); it is ignored");
+
+  // Identity and version first, so a foreign or future file is named as such
+  // rather than as "corrupt".
+  const std::string_view all(text);
+  const std::string_view first = all.substr(0, all.find('\n'));
+  if (first.size() == all.size() && kMagic.substr(0, first.size()) == first) {
+    return fail("truncated inside the identity line; the file is ignored");
+  }
+  if (first != kMagic) {
+    return fail("not a resolverd calibration file: the first line is '" + printable(first) + "', expected '" +
+                std::string(kMagic) + "'; check --state-dir, the file is ignored");
+  }
+  std::size_t pos = first.size() + 1;
+  std::string_view version_line;
+  while (pos < all.size()) {
+    const std::size_t end = all.find('\n', pos);
+    const std::string_view line = all.substr(pos, end == std::string_view::npos ? std::string_view::npos : end - pos);
+    pos = end == std::string_view::npos ? all.size() : end + 1;
+    if (!line.empty() && line.front() == '#') continue;
+    version_line = line;
+    break;
+  }
+  {
+    const auto [key, rest] = split_key(version_line);
+    int version = 0;
+    if (key != "format" || !parse_number(rest, version)) {
+      return fail("no 'format N' line after the identity line (found '" + printable(version_line) +
+                  "'); the file is truncated or damaged and is ignored");
+    }
+    if (version != kCalibrationFormatVersion) {
+      return fail("calibration format version " + std::to_string(version) + ", but this resolverd reads only version " +
+                  std::to_string(kCalibrationFormatVersion) +
+                  "; it was written by another resolverd release and is ignored (it is replaced at the next save)");
+    }
+  }
+
+  // Checksum: the last line, covering every byte before it.
+  if (text.back() != '\n') {
+    return fail("truncated: the file does not end with a complete line; it is ignored");
+  }
+  const std::size_t last_start = all.rfind('\n', all.size() - 2);
+  const std::size_t crc_line_start = last_start == std::string_view::npos ? 0 : last_start + 1;
+  const std::string_view crc_line = all.substr(crc_line_start, all.size() - 1 - crc_line_start);
+  if (crc_line.substr(0, kChecksumKey.size()) != kChecksumKey) {
+    return fail("truncated: the last line is '" + printable(crc_line) + "', not the 'crc32 XXXXXXXX' checksum; ignored");
+  }
+  std::uint32_t stated = 0;
+  const std::string_view hex = crc_line.substr(kChecksumKey.size());
+  const auto [ptr, ec] = std::from_chars(hex.data(), hex.data() + hex.size(), stated, 16);
+  if (hex.size() != 8 || ec != std::errc{} || ptr != hex.data() + hex.size()) {
+    return fail("malformed checksum line '" + printable(crc_line) + "'; ignored");
+  }
+  const std::uint32_t actual = crc32_ieee(text.substr(0, crc_line_start));
+  if (actual != stated) {
+    char msg[160];
+    std::snprintf(msg, sizeof msg, "checksum mismatch (file says %08x, contents give %08x): the file is corrupt; ignored",
+                  static_cast<unsigned>(stated), static_cast<unsigned>(actual));
+    return fail(msg);
+  }
+
+  // Fields. The checksum matched, so anything odd here was written that way.
+  Calibration c;
+  bool have_p_r = false, have_p = false, have_method = false, have_samples = false;
+  std::set<std::string> names;
+  std::size_t line_no = 1;
+  pos = first.size() + 1;
+  while (pos < crc_line_start) {
+    ++line_no;
+    const std::size_t end = all.find('\n', pos);
+    const std::string_view line = all.substr(pos, end - pos);
+    pos = end + 1;
+    if (line.empty() || line.front() == '#') continue;
+    const auto [key, rest] = split_key(line);
+    const std::string at = "line " + std::to_string(line_no) + ": ";
+    if (key == "format") continue;  // checked above
+    if (key == "p_r" || key == "p") {
+      int v = 0;
+      if (!parse_number(rest, v) || v < 1 || v > kMaxPolePairs) {
+        return fail(at + std::string(key) + " '" + printable(rest) + "' is not a pole-pair count in 1..255; ignored");
+      }
+      bool& have = key == "p_r" ? have_p_r : have_p;
+      if (have) return fail(at + std::string(key) + " appears twice; ignored");
+      have = true;
+      (key == "p_r" ? c.p_r : c.p) = v;
+    } else if (key == "method") {
+      if (have_method) return fail(at + "method appears twice; ignored");
+      have_method = true;
+      c.method = std::string(rest);
+    } else if (key == "samples") {
+      if (have_samples) return fail(at + "samples appears twice; ignored");
+      if (!parse_number(rest, c.samples) || c.samples < 0) {
+        return fail(at + "samples '" + printable(rest) + "' is not a count >= 0; ignored");
+      }
+      have_samples = true;
+    } else if (key == "param") {
+      const auto [name, values] = split_key(rest);
+      const auto [value_text, error_text] = split_key(values);
+      CalibrationParam param;
+      param.name = std::string(name);
+      if (!valid_name(name) || !parse_number(value_text, param.value) || !parse_number(error_text, param.std_error) ||
+          !std::isfinite(param.value) || !std::isfinite(param.std_error) || param.std_error < 0.0) {
+        return fail(at + "'" + printable(line) + "' is not 'param NAME VALUE STD_ERROR' with finite numbers; ignored");
+      }
+      if (!names.insert(param.name).second) return fail(at + "parameter '" + param.name + "' appears twice; ignored");
+      c.params.push_back(std::move(param));
+    } else {
+      return fail(at + "unknown key '" + printable(key) + "' in a version-1 file; ignored");
+    }
+  }
+  if (!have_p_r || !have_p || !have_method || !have_samples) {
+    return fail(std::string("the bench identity is incomplete (missing ") +
+                (!have_p_r ? "p_r" : !have_p ? "p" : !have_method ? "method" : "samples") + "); ignored");
+  }
+  problem.clear();
+  return c;
+}
+
+std::optional<std::string> save_calibration(const std::string& dir, const Calibration& calibration) {
+  std::string text;
+  if (auto bad = format_calibration(calibration, text)) return bad;
+  const std::string final_path = calibration_path(dir);
+  const std::string temp_path = final_path + ".tmp";
+  const std::string advice =
+      "; check that the state directory exists and is writable by resolverd "
+      "(--state-dir, StateDirectory=resolverd in the unit); the previous calibration, if any, is unchanged";
+  auto step_failed = [&](const std::string& step, const std::string& path, int err) {
+    return "cannot save the calibration: " + step + " '" + path + "' failed: " + errno_text(err) + advice;
+  };
+
+  const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return step_failed("creating", temp_path, errno);
+  if (!write_all(fd, text)) {
+    const int err = errno;
+    ::close(fd);
+    ::unlink(temp_path.c_str());
+    return step_failed("writing", temp_path, err);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    ::unlink(temp_path.c_str());
+    return step_failed("fsync of", temp_path, err);
+  }
+  if (::close(fd) != 0) {
+    const int err = errno;
+    ::unlink(temp_path.c_str());
+    return step_failed("closing", temp_path, err);
+  }
+  if (::rename(temp_path.c_str(), final_path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(temp_path.c_str());
+    return step_failed("renaming the temp file over", final_path, err);
+  }
+  // Make the rename itself durable.
+  const int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd < 0) return step_failed("opening the directory", dir, errno);
+  const int sync_rc = ::fsync(dfd);
+  const int sync_err = errno;
+  ::close(dfd);
+  if (sync_rc != 0) return step_failed("fsync of the directory", dir, sync_err);
+  return std::nullopt;
+}
+
+LoadResult load_calibration(const std::string& dir) {
+  LoadResult result;
+  const std::string path = calibration_path(dir);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    const int err = errno;
+    if (err == ENOENT) {
+      result.status = LoadResult::Status::kMissing;
+      result.problem = "no saved calibration at " + path + " (first start); learning from scratch";
+    } else {
+      result.status = LoadResult::Status::kRejected;
+      result.problem = "cannot read the saved calibration " + path + ": " + errno_text(err) +
+                       "; check the state directory's permissions; learning from scratch";
+    }
+    return result;
+  }
+  struct stat st {};
+  std::string text;
+  std::string problem;
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    problem = path + ": not a regular file; remove it; learning from scratch";
+  } else if (static_cast<std::uint64_t>(st.st_size) > kMaxFileBytes) {
+    problem = path + ": " + std::to_string(st.st_size) + " bytes is far larger than a calibration file (at most " +
+              std::to_string(kMaxFileBytes) + "); not ours, ignored";
+  } else {
+    std::array<char, 4096> buf{};
+    while (true) {
+      const ssize_t n = ::read(fd, buf.data(), buf.size());
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        problem = "cannot read the saved calibration " + path + ": " + errno_text(errno) + "; learning from scratch";
+        break;
+      }
+      if (n == 0) break;
+      text.append(buf.data(), static_cast<std::size_t>(n));
+      if (text.size() > kMaxFileBytes) {
+        problem = path + ": grew past " + std::to_string(kMaxFileBytes) + " bytes while reading; ignored";
+        break;
+      }
+    }
+  }
+  ::close(fd);
+  if (problem.empty()) {
+    result.calibration = parse_calibration(text, path, problem);
+  }
+  if (result.calibration) {
+    result.status = LoadResult::Status::kLoaded;
+    result.problem.clear();
+  } else {
+    result.status = LoadResult::Status::kRejected;
+    result.problem = problem;
+  }
+  return result;
+}
+
+}  // namespace resolver

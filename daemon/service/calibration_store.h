@@ -1,0 +1,97 @@
+// Persisting the learned resolver calibration across daemon restarts.
+//
+// resolverd keeps what it has learned (the active model's parameters with
+// their standard errors, for the bench identity p_r/p) in one small text file,
+// `<state dir>/calibration.txt` — under systemd the state dir is
+// /var/lib/resolverd (StateDirectory=resolverd, passed as --state-dir
+// ${STATE_DIRECTORY}). The file, format version 1:
+//
+//   resolverd-calibration                      magic/identity line (first line)
+//   format 1                                   format version
+//   p_r 1                                      resolver pole pairs
+//   p 4                                        motor pole pairs
+//   method hwang_integral                      estimator that produced it (may be empty)
+//   samples 123456                             samples the estimate used
+//   param amplitude_imbalance.alpha 0.0123 4.5e-05    name value std_error
+//   ...
+//   crc32 1a2b3c4d                             CRC-32 (IEEE 802.3) of every byte above
+//
+// Numbers are written in the shortest form that reads back bit-exactly. A
+// line starting with '#' is a comment (covered by the checksum too).
+//
+// Writing is atomic: a temp file in the same directory is written, fsync'ed,
+// renamed over the old file, and the directory is fsync'ed, so a crash or power
+// cut leaves either the old or the new file, never a mix. A leftover temp file
+// from an interrupted save is never read.
+//
+// Loading never throws: a missing file is normal on first start; a corrupt,
+// truncated, foreign (other magic), wrong-version or inconsistent file is
+// reported with the reason and ignored — the daemon then learns from scratch.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace resolver {
+
+/// One learned parameter, named as in estimate_t (e.g. "amplitude_imbalance.alpha").
+struct CalibrationParam {
+  std::string name;        ///< [A-Za-z0-9_.:-]+, unique within a calibration
+  double value = 0.0;      ///< in the parameter's own unit (see the effect catalog)
+  double std_error = 0.0;  ///< one standard error, same unit; >= 0
+  bool operator==(const CalibrationParam&) const = default;
+};
+
+struct Calibration {
+  int p_r = 1;  ///< resolver pole pairs (theta = p_r * theta_m), 1..255 as in BENCH_INFO
+  int p = 1;    ///< motor pole pairs (theta_e = p * theta_m), 1..255
+  std::string method;        ///< estimator name, printable, no newline; may be empty
+  std::int64_t samples = 0;  ///< samples the estimate is based on, >= 0
+  std::vector<CalibrationParam> params;
+  bool operator==(const Calibration&) const = default;
+};
+
+/// File name inside the state directory.
+inline constexpr const char* kCalibrationFileName = "calibration.txt";
+/// Format version this code writes and the only one it reads.
+inline constexpr int kCalibrationFormatVersion = 1;
+
+/// Full path of the calibration file in `dir`.
+std::string calibration_path(const std::string& dir);
+
+/// Serialises `calibration` in format version 1 (with its checksum line).
+/// Returns an error text instead if a field cannot be written (bad name,
+/// non-finite value, p_r/p out of range, newline in method).
+std::optional<std::string> format_calibration(const Calibration& calibration, std::string& text);
+
+/// Parses file contents; `where` names the source in messages. On failure
+/// returns nullopt and sets `problem` to the reason.
+std::optional<Calibration> parse_calibration(const std::string& text, const std::string& where, std::string& problem);
+
+/// Writes `calibration` atomically to calibration_path(dir). `dir` must exist
+/// (systemd's StateDirectory= creates it). Returns nullopt on success or an
+/// error text naming the path, the failing step, errno text and what to do.
+/// On failure the previous file, if any, is untouched.
+std::optional<std::string> save_calibration(const std::string& dir, const Calibration& calibration);
+
+struct LoadResult {
+  enum class Status {
+    kLoaded,    ///< `calibration` holds the file's contents
+    kMissing,   ///< no file yet (first start); `problem` says where it looked
+    kRejected,  ///< the file exists but is unusable; `problem` says why
+  };
+  Status status = Status::kMissing;
+  std::optional<Calibration> calibration;
+  std::string problem;  ///< empty when loaded
+};
+
+/// Reads calibration_path(dir). Never throws; see LoadResult.
+LoadResult load_calibration(const std::string& dir);
+
+/// CRC-32 (IEEE 802.3, reflected poly 0xEDB88320, init and final xor
+/// 0xFFFFFFFF); crc32("123456789") == 0xCBF43926.
+std::uint32_t crc32_ieee(const std::string& bytes);
+
+}  // namespace resolver
