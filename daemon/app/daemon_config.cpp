@@ -7,13 +7,9 @@
 #include <fstream>
 #include <sstream>
 
-#ifndef RESOLVER_DEFAULT_DBC
-#define RESOLVER_DEFAULT_DBC "proto/resolver_bench.dbc"
-#endif
-
 namespace resolver {
 
-std::string default_dbc_path() { return RESOLVER_DEFAULT_DBC; }
+std::string default_dbc_path() { return "proto/resolver_bench.dbc (built into resolverd)"; }
 
 namespace {
 
@@ -81,7 +77,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   DaemonConfig c;
   c.source = source_name;
   const std::string& s = source_name;
-  check_keys(root, "top level", {"lcm", "channels", "output", "bench", "layout", "estimator", "compensation"}, s);
+  check_keys(root, "top level", {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation"}, s);
 
   auto section = [&root, &s](const char* name) -> const toml::table* {
     const toml::node* n = root.get(name);
@@ -93,6 +89,11 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   if (const auto* t = section("lcm")) {
     check_keys(*t, "lcm", {"url"}, s);
     read(*t, "url", c.lcm_url, s, "lcm");
+  }
+  if (const auto* t = section("can")) {
+    check_keys(*t, "can", {"receive_buffer_bytes"}, s);
+    read(*t, "receive_buffer_bytes", c.can.receive_buffer_bytes, s, "can");
+    if (c.can.receive_buffer_bytes < 0) throw ConfigError(s + ": [can] receive_buffer_bytes must be >= 0");
   }
   if (const auto* t = section("channels")) {
     check_keys(*t, "channels", {"angle", "dq", "estimate", "model_fit", "health"}, s);
@@ -112,7 +113,15 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     require_positive(c.dq_decimation, "[output] dq_decimation", s);
   }
   if (const auto* t = section("bench")) {
-    check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info"}, s);
+    check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source"}, s);
+    read(*t, "sample_rate_hz", c.bench.sample_rate_hz, s, "bench");
+    if (c.bench.sample_rate_hz < 0.0) throw ConfigError(s + ": [bench] sample_rate_hz must be >= 0");
+    std::string time_source = "counter";
+    read(*t, "time_source", time_source, s, "bench");
+    if (time_source != "counter" && time_source != "frame") {
+      throw ConfigError(s + ": [bench] time_source must be \"counter\" or \"frame\", got \"" + time_source + "\"");
+    }
+    c.bench.time_from_counter = time_source == "counter";
     read(*t, "p_r", c.bench.p_r, s, "bench");
     read(*t, "p", c.bench.p, s, "bench");
     read(*t, "rd_bits", c.bench.rd_bits, s, "bench");

@@ -23,6 +23,7 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
               const std::function<void()>& on_reload, StopFlags& flags, std::ostream& err) {
   SocketCanOptions so;
   so.iface = options.iface;
+  so.receive_buffer_bytes = options.receive_buffer_bytes;
   std::optional<SocketCanSource> source;
   auto backoff = std::chrono::milliseconds(250);
   constexpr auto kMaxBackoff = std::chrono::milliseconds(5000);

@@ -19,6 +19,7 @@ struct LiveOptions {
   std::string iface;
   /// systemd notifications (READY, WATCHDOG, STATUS, STOPPING); null = none.
   SdNotifier* notifier = nullptr;
+  int receive_buffer_bytes = 0;  ///< SO_RCVBUF; 0 = kernel default
 };
 
 /// `current` returns the pipeline to feed (it may be rebuilt on SIGHUP by

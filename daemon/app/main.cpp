@@ -2,6 +2,7 @@
 // config, build the pipeline with an LCM output, run a source, print a report.
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -132,8 +133,10 @@ static int run(int argc, char** argv) {
         }
         notifier.ready();
       };
-      run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
+      const auto live_start = std::chrono::steady_clock::now();
+      run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
       info.source = can_iface;
+      info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }
   } catch (const std::exception& e) {
     std::cerr << "resolverd: " << e.what() << "\n";

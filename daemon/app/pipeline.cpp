@@ -4,6 +4,7 @@
 #include <limits>
 #include <variant>
 
+#include "daemon/app/embedded_dbc.h"
 #include "daemon/dbc/dbc_parser.h"
 
 namespace resolver {
@@ -15,7 +16,7 @@ constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // DESIGN 5: health_t at 1 
 
 std::shared_ptr<const FrameDecoder> make_decoder(const DaemonConfig& config) {
   const std::string path = config.dbc_path.empty() ? default_dbc_path() : config.dbc_path;
-  auto loaded = dbc::load_dbc_file(path);
+  auto loaded = config.dbc_path.empty() ? dbc::parse_dbc(embedded_bench_dbc(), path) : dbc::load_dbc_file(path);
   if (auto* err = std::get_if<dbc::DbcError>(&loaded)) throw ConfigError(err->what());
   auto db = std::make_shared<const dbc::Database>(std::move(std::get<dbc::Database>(loaded)));
   try {
@@ -36,9 +37,9 @@ ProcessorConfig processor_config(const DaemonConfig& c) {
   return p;
 }
 
-SampleInput to_input(const BenchSample& s) {
+SampleInput to_input(const BenchSample& s, double t) {
   SampleInput in;
-  in.t = static_cast<double>(s.timestamp_us) * 1e-6;
+  in.t = t;
   in.has_rd = s.has(Role::kRdAngle);
   in.theta_rd = s.get(Role::kRdAngle);
   in.has_sincos = s.has(Role::kSin) && s.has(Role::kCos);
@@ -68,7 +69,29 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
                   [this](const BenchSample& s) { on_sample(s); },
                   [this](const BenchInfo& i) { on_bench_info(i); },
                   [this](std::string_view reason, const std::string& msg) { problems_.report(reason, msg); }}),
-      processor_(processor_config(config)) {}
+      processor_(processor_config(config)),
+      sample_rate_hz_(config.bench.sample_rate_hz) {}
+
+double Pipeline::sample_time(const BenchSample& sample) {
+  const double frame_t = static_cast<double>(sample.timestamp_us) * 1e-6;
+  if (!config_.bench.time_from_counter || !(sample_rate_hz_ > 0.0)) return frame_t;
+  // Re-anchor when the two clocks disagree by more than 64 samples: a u8
+  // counter is only unambiguous within 256 samples, so a stall or a long gap
+  // cannot be bridged by counting.
+  constexpr double kMaxDriftSamples = 64.0;
+  if (anchored_) {
+    const double t = anchor_t_ + static_cast<double>(sample.index - anchor_index_) / sample_rate_hz_;
+    if (std::abs(t - frame_t) * sample_rate_hz_ <= kMaxDriftSamples) return t;
+    problems_.report("sample_clock_reanchored", "sample counter time and frame time differ by " +
+                                                    std::to_string(t - frame_t) + " s at index " +
+                                                    std::to_string(sample.index) + ": time base re-anchored");
+    intake_.count_problem_silently("sample_clock_reanchored");
+  }
+  anchored_ = true;
+  anchor_index_ = sample.index;
+  anchor_t_ = frame_t;
+  return frame_t;
+}
 
 void Pipeline::count_problem(std::string_view reason, const std::string& message) {
   intake_.count_problem(reason, message);
@@ -105,6 +128,10 @@ void Pipeline::on_bench_info(const BenchInfo& info) {
                                                ", p=" + std::to_string(info.p) + " ignored (pole pairs must be >= 1)");
     return;
   }
+  if (info.sample_rate_hz > 0.0 && info.sample_rate_hz != sample_rate_hz_) {
+    sample_rate_hz_ = info.sample_rate_hz;
+    anchored_ = false;
+  }
   if (info.p_r != pc.p_r || info.p != pc.p) {
     if (bench_info_seen_ || samples_ > 0) {
       problems_.report("bench_info_changed", "BENCH_INFO changed pole pairs to p_r=" + std::to_string(info.p_r) +
@@ -119,7 +146,7 @@ void Pipeline::on_sample(const BenchSample& sample) {
   ++samples_;
   last_sample_index_ = sample.index;
   last_counter_ = sample.counter;
-  const SampleOutput out = processor_.process(to_input(sample));
+  const SampleOutput out = processor_.process(to_input(sample, sample_time(sample)));
   summary_.add(out, processor_);
   if (!out.has_angle) return;
 

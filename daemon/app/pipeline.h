@@ -49,7 +49,10 @@ class Pipeline {
   /// End of input: emit the open sample, publish a final health_t.
   void finish();
   /// Log loop: counters and joins restart, estimates and statistics stay.
-  void restart_sequence() { intake_.restart_sequence(); }
+  void restart_sequence() {
+    intake_.restart_sequence();
+    anchored_ = false;
+  }
   /// Live idle time: publishes health_t when a second has passed since the
   /// last one even if no frame arrived. now_us [us] on the frames' clock.
   void tick(std::int64_t now_us);
@@ -85,6 +88,12 @@ class Pipeline {
   std::int64_t last_sample_index_ = 0;
   std::uint8_t last_counter_ = 0;
   bool bench_info_seen_ = false;
+  // Sample clock: time = anchor_t + (index - anchor_index) / sample_rate.
+  double sample_rate_hz_ = 0.0;
+  bool anchored_ = false;
+  std::int64_t anchor_index_ = 0;
+  double anchor_t_ = 0.0;
+  double sample_time(const BenchSample& sample);
   std::int64_t kernel_drops_ = 0;
 };
 

@@ -47,6 +47,8 @@ class FrameIntake {
   void feed(const CanFrame& frame, std::uint64_t line = 0);
   /// Counts a problem found before decoding (e.g. a malformed log line).
   void count_problem(std::string_view reason, const std::string& message);
+  /// Counts a problem the caller has already reported.
+  void count_problem_silently(std::string_view reason) { rejects_.add(reason); }
   /// Emits the sample still open (end of input).
   void flush() { joiner_.flush(); }
   /// Forgets counters and open samples, keeps statistics (e.g. log loop).
