@@ -9,6 +9,7 @@ PACKAGES=(
   liblcm-dev liblcm-bin
   libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
   can-utils python3 python3-can
+  qemu-system-x86 iproute2
 )
 
 missing=()

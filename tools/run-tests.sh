@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Every test: installs packages, builds with warnings as errors, runs ctest
-# (labels: unit, integration). With RESOLVER_SANITIZE=1 it also builds
+# (labels: unit, integration, vcan: the SocketCAN suite in a QEMU guest, ~1 min). With RESOLVER_SANITIZE=1 it also builds
 # everything with ASan+UBSan into build-asan and runs the unit tests there.
 set -euo pipefail
 cd "$(dirname "$0")/.."

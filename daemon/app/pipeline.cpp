@@ -75,21 +75,32 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
 double Pipeline::sample_time(const BenchSample& sample) {
   const double frame_t = static_cast<double>(sample.timestamp_us) * 1e-6;
   if (!config_.bench.time_from_counter || !(sample_rate_hz_ > 0.0)) return frame_t;
-  // Re-anchor when the two clocks disagree by more than 64 samples: a u8
-  // counter is only unambiguous within 256 samples, so a stall or a long gap
-  // cannot be bridged by counting.
-  constexpr double kMaxDriftSamples = 64.0;
+  // The counter is u8, so consecutive samples can only be told apart while
+  // fewer than 256 periods pass between them. When more frame time passed
+  // than the index step explains by over 128 periods (a stall or an outage:
+  // the counter may have wrapped unseen), counting cannot bridge the gap and
+  // the time base re-anchors. Slow or bursty delivery (a replay under
+  // emulation, canplayer's bursts) only shifts frame time against sample
+  // time and is not a reason to re-anchor.
+  constexpr double kMaxUnexplainedPeriods = 128.0;
   if (anchored_) {
-    const double t = anchor_t_ + static_cast<double>(sample.index - anchor_index_) / sample_rate_hz_;
-    if (std::abs(t - frame_t) * sample_rate_hz_ <= kMaxDriftSamples) return t;
-    problems_.report("sample_clock_reanchored", "sample counter time and frame time differ by " +
-                                                    std::to_string(t - frame_t) + " s at index " +
-                                                    std::to_string(sample.index) + ": time base re-anchored");
+    const double explained = static_cast<double>(sample.index - last_index_);
+    const double elapsed = (frame_t - last_frame_t_) * sample_rate_hz_;
+    last_index_ = sample.index;
+    last_frame_t_ = frame_t;
+    if (elapsed - explained <= kMaxUnexplainedPeriods) {
+      return anchor_t_ + static_cast<double>(sample.index - anchor_index_) / sample_rate_hz_;
+    }
+    problems_.report("sample_clock_reanchored",
+                     "sample index " + std::to_string(sample.index) + " arrived " + std::to_string(elapsed) +
+                         " sample periods after the previous one, more than its counter step explains: time base re-anchored");
     intake_.count_problem_silently("sample_clock_reanchored");
   }
   anchored_ = true;
   anchor_index_ = sample.index;
   anchor_t_ = frame_t;
+  last_index_ = sample.index;
+  last_frame_t_ = frame_t;
   return frame_t;
 }
 

@@ -93,6 +93,8 @@ class Pipeline {
   bool anchored_ = false;
   std::int64_t anchor_index_ = 0;
   double anchor_t_ = 0.0;
+  std::int64_t last_index_ = 0;   ///< index of the previous sample
+  double last_frame_t_ = 0.0;     ///< [s] frame time of the previous sample
   double sample_time(const BenchSample& sample);
   std::int64_t kernel_drops_ = 0;
 };
