@@ -172,21 +172,60 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     }
   }
   if (const auto* t = section("estimator")) {
-    check_keys(*t, "estimator", {"method", "min_revolutions", "max_speed_change", "min_samples_per_revolution"}, s);
+    check_keys(*t, "estimator",
+               {"method", "min_revolutions", "max_speed_change", "min_samples_per_revolution", "forgetting",
+                "harmonics", "max_order"},
+               s);
     read(*t, "method", c.estimator_method, s, "estimator");
+    double forgetting = 1.0;
+    read(*t, "forgetting", forgetting, s, "estimator");
+    if (!(forgetting > 0.0 && forgetting <= 1.0)) {
+      throw ConfigError(s + ": [estimator] forgetting must be in (0, 1], got " + std::to_string(forgetting));
+    }
+    c.sincos.forgetting = forgetting;
+    c.fourier.forgetting = forgetting;
+    read(*t, "max_order", c.fourier.max_order, s, "estimator");
+    require_positive(c.fourier.max_order, "[estimator] max_order", s);
+    if (const toml::node* h = t->get("harmonics")) {
+      const toml::array* arr = h->as_array();
+      if (arr == nullptr) throw ConfigError(where(s, *h) + ": [estimator] harmonics must be an array of orders, e.g. [3]");
+      c.sincos.harmonics.clear();
+      for (const auto& el : *arr) {
+        const auto n = el.value<std::int64_t>();
+        if (!n || *n < 2 || *n > 16) {
+          throw ConfigError(where(s, *h) + ": [estimator] harmonics: orders must be integers 2..16");
+        }
+        c.sincos.harmonics.push_back(static_cast<int>(*n));
+      }
+    }
     read(*t, "min_revolutions", c.hwang.min_revolutions, s, "estimator");
     read(*t, "max_speed_change", c.hwang.max_speed_change, s, "estimator");
     read(*t, "min_samples_per_revolution", c.hwang.min_samples_per_revolution, s, "estimator");
-    if (c.estimator_method != "hwang_integral") {
+    const auto method = estimator_from_name(c.estimator_method);
+    if (!method) {
       throw ConfigError(s + ": [estimator] method \"" + c.estimator_method +
-                        "\" is not available; available: hwang_integral");
+                        "\" is not available; available: hwang_integral, sincos_least_squares, fourier_reference");
     }
+    c.method = *method;
     require_positive(c.hwang.min_revolutions, "[estimator] min_revolutions", s);
     if (!(c.hwang.max_speed_change > 0.0)) throw ConfigError(s + ": [estimator] max_speed_change must be > 0");
   }
   if (const auto* t = section("compensation")) {
-    check_keys(*t, "compensation", {"enabled"}, s);
+    check_keys(*t, "compensation", {"enabled", "domain"}, s);
     read(*t, "enabled", c.compensation_enabled, s, "compensation");
+    std::string domain = "angle";
+    read(*t, "domain", domain, s, "compensation");
+    if (domain == "angle") {
+      c.compensation_domain = CompensationDomain::kAngle;
+    } else if (domain == "signal") {
+      c.compensation_domain = CompensationDomain::kSignal;
+    } else {
+      throw ConfigError(s + ": [compensation] domain must be \"angle\" or \"signal\", got \"" + domain + "\"");
+    }
+  }
+  if (c.compensation_domain == CompensationDomain::kSignal && c.method != EstimatorMethod::kSinCosLeastSquares) {
+    throw ConfigError(s + ": [compensation] domain = \"signal\" needs [estimator] method = \"sincos_least_squares\" "
+                          "(only it estimates the sin/cos signal parameters)");
   }
   return c;
 }

@@ -29,11 +29,15 @@
 //   [layout.signals]           # role = "MESSAGE.signal"
 //   sin = "RESOLVER_SAMPLE.sin"
 //   [estimator]
-//   method = "hwang_integral"
-//   min_revolutions = 3
-//   max_speed_change = 0.02
+//   method = "hwang_integral"  # or "sincos_least_squares", "fourier_reference"
+//   min_revolutions = 3        # hwang_integral
+//   max_speed_change = 0.02    # hwang_integral
+//   forgetting = 1.0           # sincos_least_squares / fourier_reference: 1 = all data
+//   harmonics = [3]            # sincos_least_squares with a reference angle: K_n fitted
+//   max_order = 4              # fourier_reference: highest harmonic
 //   [compensation]
 //   enabled = true
+//   domain = "angle"           # or "signal" (sincos_least_squares: correct sin/cos, then atan2)
 #pragma once
 
 #include <optional>
@@ -41,6 +45,7 @@
 #include <string>
 
 #include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/signal_map.h"
 
 namespace resolver {
@@ -87,8 +92,12 @@ struct DaemonConfig {
   SignalMap signal_map = SignalMap::bench_default();
   int max_counter_delta = 8;
   std::string estimator_method = "hwang_integral";
+  EstimatorMethod method = EstimatorMethod::kHwangIntegral;
   HwangIntegralConfig hwang;
+  SinCosLsConfig sincos;
+  AngleFourierConfig fourier;
   bool compensation_enabled = true;
+  CompensationDomain compensation_domain = CompensationDomain::kAngle;
 };
 
 /// Thrown for unreadable or invalid configuration; what() names the file,

@@ -144,14 +144,14 @@ static int run(int argc, char** argv) {
   }
 
   print_run_report(std::cout, *pipeline, info);
-  const HwangIntegralEstimator& est = pipeline->processor().estimator();
-  if (!state_dir.empty() && est.converged()) {
+  const ModelEstimate model = pipeline->processor().estimate();
+  if (!state_dir.empty() && model.converged) {
     Calibration cal;
     cal.p_r = pipeline->processor().config().p_r;
     cal.p = pipeline->processor().config().p;
-    cal.method = "hwang_integral";
-    cal.samples = est.samples_used();
-    cal.params = {{"amplitude_imbalance.alpha", est.alpha(), est.alpha_stderr()}};
+    cal.method = model.method;
+    cal.samples = model.samples;
+    for (const ParamEstimate& prm : model.params) cal.params.push_back({prm.name, prm.value, prm.std_error});
     if (auto problem = save_calibration(state_dir, cal)) {
       std::cerr << "resolverd: " << *problem << "\n";
     } else {

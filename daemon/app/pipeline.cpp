@@ -33,6 +33,10 @@ ProcessorConfig processor_config(const DaemonConfig& c) {
   p.p = c.bench.p;
   p.hwang = c.hwang;
   p.compensate = c.compensation_enabled;
+  p.method = c.method;
+  p.domain = c.compensation_domain;
+  p.sincos = c.sincos;
+  p.fourier = c.fourier;
   p.ripple_revolutions = c.ripple_revolutions;
   return p;
 }
@@ -199,23 +203,25 @@ void Pipeline::on_sample(const BenchSample& sample) {
     d.ripple_valid = r.raw_valid;
     sink_.publish(d);
   }
-  if (out.revolution) publish_estimate(sample.timestamp_us, sample);
+  if (out.estimate_updated) publish_estimate(sample.timestamp_us, sample);
 }
 
 void Pipeline::publish_estimate(std::int64_t utime, const BenchSample& sample) {
-  const HwangIntegralEstimator& est = processor_.estimator();
+  const ModelEstimate est = processor_.estimate();
   estimate_t e;
   e.utime = utime;
   e.sample_index = sample.index;
   e.counter = sample.counter;
-  e.method = "hwang_integral";
-  e.num_params = 1;
-  e.param_name = {"amplitude_imbalance.alpha"};
-  e.value = {est.alpha()};
-  e.std_error = {est.alpha_stderr()};
-  e.samples_used = est.samples_used();
-  e.revolutions_used = static_cast<double>(est.revolutions());
-  e.converged = est.converged();
+  e.method = est.method;
+  for (const ParamEstimate& p : est.params) {
+    e.param_name.push_back(p.name);
+    e.value.push_back(p.value);
+    e.std_error.push_back(p.std_error);
+  }
+  e.num_params = static_cast<int32_t>(est.params.size());
+  e.samples_used = est.samples;
+  e.revolutions_used = est.revolutions;
+  e.converged = est.converged;
   sink_.publish(e);
 }
 

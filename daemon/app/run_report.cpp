@@ -55,12 +55,22 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   }
   const ProcessorConfig& pc = p.processor().config();
   out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
-  out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.6f} (std. error; spread {:.6f} over {} revolutions) {}\n",
-                     est.alpha(), est.alpha_stderr(), est.alpha_spread(), est.revolutions(),
-                     est.converged() ? "converged" : "NOT converged");
-  out << fmt::format("             revolutions rejected: speed not constant {}, too few samples {}, too slow {}\n",
-                     est.rejected(HwangRejection::kSpeedNotConstant), est.rejected(HwangRejection::kTooFewSamples),
-                     est.rejected(HwangRejection::kTooSlow));
+  const ModelEstimate model = p.processor().estimate();
+  if (pc.method == EstimatorMethod::kHwangIntegral) {
+    out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.6f} (std. error; spread {:.6f} over {} revolutions) {}\n",
+                       est.alpha(), est.alpha_stderr(), est.alpha_spread(), est.revolutions(),
+                       est.converged() ? "converged" : "NOT converged");
+    out << fmt::format("             revolutions rejected: speed not constant {}, too few samples {}, too slow {}\n",
+                       est.rejected(HwangRejection::kSpeedNotConstant), est.rejected(HwangRejection::kTooFewSamples),
+                       est.rejected(HwangRejection::kTooSlow));
+  } else {
+    out << fmt::format("  estimate   {}: {} over {:.0f} revolutions{}\n", model.method,
+                       model.converged ? "converged" : "NOT converged", model.revolutions,
+                       model.params.empty() ? " (no fit: missing signals? sincos needs sin/cos, fourier a reference)" : "");
+    for (const ParamEstimate& prm : model.params) {
+      out << fmt::format("             {:<28} = {:+.6e} +- {:.2e}\n", prm.name, prm.value, prm.std_error);
+    }
+  }
   if (s.eps_raw.n > 1) {
     out << fmt::format("  position   error vs reference, RMS about the mean: raw {:.3f} arcmin -> compensated {:.3f} arcmin ({:+.1f} dB)\n",
                        rad_to_arcmin(s.eps_raw.stddev()), rad_to_arcmin(s.eps_comp.stddev()),
@@ -101,9 +111,23 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   }
   j += "},";
   j += fmt::format("\"p_r\":{},\"p\":{},", p.processor().config().p_r, p.processor().config().p);
-  j += fmt::format("\"alpha\":{},\"alpha_stderr\":{},\"alpha_spread\":{},\"revolutions\":{},\"converged\":{},",
-                   json_number(est.alpha()), json_number(est.alpha_stderr()), json_number(est.alpha_spread()),
-                   est.revolutions(), est.converged() ? "true" : "false");
+  const ModelEstimate model = p.processor().estimate();
+  double alpha = est.alpha(), alpha_se = est.alpha_stderr();
+  for (const ParamEstimate& prm : model.params) {
+    if (prm.name == "amplitude_imbalance.alpha") {
+      alpha = prm.value;
+      alpha_se = prm.std_error;
+    }
+  }
+  j += fmt::format("\"method\":{},\"alpha\":{},\"alpha_stderr\":{},\"alpha_spread\":{},\"revolutions\":{},\"converged\":{},",
+                   json_string(model.method), json_number(alpha), json_number(alpha_se), json_number(est.alpha_spread()),
+                   json_number(model.revolutions), model.converged ? "true" : "false");
+  j += "\"params\":{";
+  for (std::size_t i = 0; i < model.params.size(); ++i) {
+    j += fmt::format("{}{}:{{\"value\":{},\"stderr\":{}}}", i ? "," : "", json_string(model.params[i].name),
+                     json_number(model.params[i].value), json_number(model.params[i].std_error));
+  }
+  j += "},";
   j += fmt::format("\"eps_rms_raw_rad\":{},\"eps_rms_comp_rad\":{},", json_number(s.eps_raw.stddev()),
                    json_number(s.eps_comp.stddev()));
   const RippleSet& r = s.ripple;

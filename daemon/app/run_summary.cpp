@@ -3,7 +3,7 @@
 namespace resolver {
 
 void RunSummary::add(const SampleOutput& out, const SampleProcessor& proc) {
-  if (!out.has_angle || !proc.estimator().converged() || proc.active_alpha() == 0.0) return;
+  if (!out.has_angle || !proc.compensating()) return;
   if (!std::isnan(out.eps_ref)) {
     eps_raw.add(out.eps_ref);
     eps_comp.add(wrap_pi(out.eps_ref - out.eps_hat));

@@ -11,9 +11,27 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
+std::optional<EstimatorMethod> estimator_from_name(std::string_view name) {
+  if (name == "hwang_integral") return EstimatorMethod::kHwangIntegral;
+  if (name == "sincos_least_squares") return EstimatorMethod::kSinCosLeastSquares;
+  if (name == "fourier_reference") return EstimatorMethod::kFourierReference;
+  return std::nullopt;
+}
+
+std::string_view estimator_name(EstimatorMethod method) {
+  switch (method) {
+    case EstimatorMethod::kHwangIntegral: return "hwang_integral";
+    case EstimatorMethod::kSinCosLeastSquares: return "sincos_least_squares";
+    case EstimatorMethod::kFourierReference: return "fourier_reference";
+  }
+  return "unknown";
+}
+
 SampleProcessor::SampleProcessor(const ProcessorConfig& config)
     : config_(config),
       estimator_(config.hwang),
+      sincos_ls_(config.sincos),
+      fourier_(config.fourier),
       ripple_raw_(config.ripple_revolutions),
       ripple_comp_(config.ripple_revolutions),
       ripple_ref_(config.ripple_revolutions) {}
@@ -34,14 +52,52 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   out.has_angle = true;
   const double theta_meas = in.has_rd ? wrap_2pi(in.theta_rd) : out.theta_sincos;
   out.theta_rd = theta_meas;
-
-  out.revolution = estimator_.update(in.t, theta_meas);
-  if (out.revolution && config_.compensate && estimator_.converged()) active_alpha_ = estimator_.alpha();
+  rd_unwrap_.update(theta_meas);
 
   const double p_r = config_.p_r;
+  ++samples_;
+  // Feed the active estimator.
+  switch (config_.method) {
+    case EstimatorMethod::kHwangIntegral:
+      out.revolution = estimator_.update(in.t, theta_meas);
+      if (out.revolution) {
+        out.estimate_updated = true;
+        if (config_.compensate && estimator_.converged()) active_alpha_ = estimator_.alpha();
+      }
+      break;
+    case EstimatorMethod::kSinCosLeastSquares:
+      if (in.has_sincos) {
+        if (in.has_ref) {
+          sincos_ls_.add(in.sin, in.cos, p_r * in.theta_m_ref);
+        } else {
+          sincos_ls_.add(in.sin, in.cos);
+        }
+      }
+      break;
+    case EstimatorMethod::kFourierReference:
+      if (in.has_ref) fourier_.add(p_r * in.theta_m_ref, theta_meas);
+      break;
+  }
+  // The other estimators solve once per resolver electrical revolution.
+  const auto rev = static_cast<std::int64_t>(std::floor(rd_unwrap_.continuous / kTwoPi));
+  if (!rev_started_) {
+    rev_started_ = true;
+    rev_index_ = rev;
+  } else if (rev != rev_index_) {
+    rev_index_ = rev;
+    ++revolutions_;
+    if (config_.method == EstimatorMethod::kSinCosLeastSquares) {
+      sincos_fit_ = sincos_ls_.solve();
+      out.estimate_updated = true;
+    } else if (config_.method == EstimatorMethod::kFourierReference) {
+      fourier_fit_ = fourier_.solve();
+      out.estimate_updated = true;
+    }
+  }
+
   out.speed_mech = speed_.update(in.t, theta_meas) / p_r;
-  // Compensation in the angle domain (Hwang Fig. 5, DESIGN 3 sign): theta_c = theta_rd + eps_hat.
-  out.eps_hat = amplitude_imbalance_eps(active_alpha_, theta_meas);
+  // Compensation (DESIGN 3 sign): theta_c = theta_rd + eps_hat.
+  out.eps_hat = compensation_eps(in, theta_meas);
   out.theta_comp = wrap_2pi(theta_meas + out.eps_hat);
 
   double theta_ref_cont = kNaN;
@@ -54,7 +110,7 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
     out.eps_ref = kNaN;
   }
 
-  const double rd_cont = rd_unwrap_.update(theta_meas);
+  const double rd_cont = rd_unwrap_.continuous;
   if (!in.has_currents) return out;
   out.has_dq = true;
   const double ratio = static_cast<double>(config_.p) / p_r;  // theta_e = (p/p_r) theta (Hwang eq. 19)
@@ -95,6 +151,90 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
     out.i_q_ref = kNaN;
   }
   return out;
+}
+
+bool SampleProcessor::compensating() const {
+  if (!config_.compensate) return false;
+  switch (config_.method) {
+    case EstimatorMethod::kHwangIntegral: return active_alpha_ != 0.0;
+    case EstimatorMethod::kSinCosLeastSquares: return sincos_fit_.has_value() && revolutions_ >= 1;
+    case EstimatorMethod::kFourierReference: return fourier_fit_.has_value() && revolutions_ >= 1;
+  }
+  return false;
+}
+
+double SampleProcessor::compensation_eps(const SampleInput& in, double theta_meas) const {
+  if (!compensating()) return 0.0;
+  switch (config_.method) {
+    case EstimatorMethod::kHwangIntegral:
+      return amplitude_imbalance_eps(active_alpha_, theta_meas);
+    case EstimatorMethod::kSinCosLeastSquares: {
+      const SinCosFit& f = *sincos_fit_;
+      if (config_.domain == CompensationDomain::kSignal && in.has_sincos) {
+        // Signal domain: correct the envelopes, take their angle (bypasses the R/D converter).
+        const double corrected = corrected_angle(SinCosCorrection::from_fit(f), in.sin, in.cos);
+        return wrap_pi(corrected - theta_meas);
+      }
+      // Angle domain: first-order signatures of the fitted effects, evaluated at
+      // the measured angle: alpha/2 sin 2theta (Hanselman 5), -(beta/2)(1 - cos 2theta)
+      // (Hanselman 7, sign checked numerically against the exact model),
+      // o_c sin theta - o_s cos theta (offsets).
+      const double th = theta_meas;
+      return 0.5 * f.alpha.value * std::sin(2.0 * th) - 0.5 * f.beta.value * (1.0 - std::cos(2.0 * th)) +
+             f.o_c.value * std::sin(th) - f.o_s.value * std::cos(th);
+    }
+    case EstimatorMethod::kFourierReference:
+      return fourier_fit_->eps(theta_meas);
+  }
+  return 0.0;
+}
+
+ModelEstimate SampleProcessor::estimate() const {
+  ModelEstimate e;
+  e.method = std::string(estimator_name(config_.method));
+  e.samples = samples_;
+  e.revolutions = static_cast<double>(revolutions_);
+  switch (config_.method) {
+    case EstimatorMethod::kHwangIntegral:
+      e.params = {{"amplitude_imbalance.alpha", estimator_.alpha(), estimator_.alpha_stderr()}};
+      e.samples = estimator_.samples_used();
+      e.revolutions = static_cast<double>(estimator_.revolutions());
+      e.converged = estimator_.converged();
+      break;
+    case EstimatorMethod::kSinCosLeastSquares:
+      if (sincos_fit_) {
+        const SinCosFit& f = *sincos_fit_;
+        e.params = {{"amplitude_imbalance.alpha", f.alpha.value, f.alpha.std_error},
+                    {"quadrature.beta", f.beta.value, f.beta.std_error},
+                    {"offsets.o_s", f.o_s.value, f.o_s.std_error},
+                    {"offsets.o_c", f.o_c.value, f.o_c.std_error},
+                    {"signal.amplitude", f.amplitude.value, f.amplitude.std_error}};
+        for (std::size_t i = 0; i < f.k.size() && i < f.harmonic_orders.size(); ++i) {
+          e.params.push_back({"harmonics.k" + std::to_string(f.harmonic_orders[i]), f.k[i].value, f.k[i].std_error});
+        }
+        e.samples = f.samples_seen;
+        e.converged = revolutions_ >= 1;
+      }
+      break;
+    case EstimatorMethod::kFourierReference:
+      if (fourier_fit_) {
+        const AngleErrorFit& f = *fourier_fit_;
+        e.params = {{"amplitude_imbalance.alpha", f.alpha.value, f.alpha.std_error},
+                    {"quadrature.beta", f.beta.value, f.beta.std_error},
+                    {"offsets.o_s", f.o_s.value, f.o_s.std_error},
+                    {"offsets.o_c", f.o_c.value, f.o_c.std_error}};
+        for (int n = 1; n <= f.max_order && static_cast<std::size_t>(n) < f.a.size(); ++n) {
+          e.params.push_back({"fourier.a" + std::to_string(n), f.a[static_cast<std::size_t>(n)].value,
+                              f.a[static_cast<std::size_t>(n)].std_error});
+          e.params.push_back({"fourier.b" + std::to_string(n), f.b[static_cast<std::size_t>(n)].value,
+                              f.b[static_cast<std::size_t>(n)].std_error});
+        }
+        e.samples = static_cast<std::int64_t>(f.samples);
+        e.converged = revolutions_ >= 1;
+      }
+      break;
+  }
+  return e;
 }
 
 }  // namespace resolver

@@ -14,9 +14,14 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/estimation/angle_error_fourier.h"
 #include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/core/estimation/sincos_compensation.h"
+#include "daemon/core/estimation/sincos_least_squares.h"
 #include "daemon/core/estimation/revolution_ripple.h"
 #include "daemon/core/estimation/speed_estimator.h"
 
@@ -34,7 +39,40 @@ struct SampleInput {
   double theta_m_ref = 0.0;      ///< [rad] mechanical reference angle
 };
 
+/// Which estimator runs (DESIGN 6 "Estimators to provide and compare").
+enum class EstimatorMethod : std::uint8_t {
+  kHwangIntegral,      ///< R/D angle only, constant speed: alpha (Hwang 2009)
+  kSinCosLeastSquares, ///< sin/cos envelopes: alpha, beta, offsets (+ harmonics with a reference)
+  kFourierReference,   ///< position error vs reference angle, Fourier series (Hanselman III.A)
+};
+/// Where the compensation acts.
+enum class CompensationDomain : std::uint8_t {
+  kAngle,   ///< theta_c = theta_rd + eps_hat(theta_rd)   (Hwang Fig. 5)
+  kSignal,  ///< correct sin/cos, then atan2               (sin/cos least squares only)
+};
+[[nodiscard]] std::optional<EstimatorMethod> estimator_from_name(std::string_view name);
+[[nodiscard]] std::string_view estimator_name(EstimatorMethod method);
+
+/// One parameter of the active model, named "effect.param" as in the catalog.
+struct ParamEstimate {
+  std::string name;
+  double value = 0.0;
+  double std_error = 0.0;
+};
+/// Everything estimate_t publishes.
+struct ModelEstimate {
+  std::string method;
+  std::vector<ParamEstimate> params;
+  std::int64_t samples = 0;
+  double revolutions = 0.0;
+  bool converged = false;
+};
+
 struct ProcessorConfig {
+  EstimatorMethod method = EstimatorMethod::kHwangIntegral;
+  CompensationDomain domain = CompensationDomain::kAngle;
+  SinCosLsConfig sincos;
+  AngleFourierConfig fourier;
   int p_r = 3;  ///< resolver pole pairs
   int p = 3;    ///< motor pole pairs
   HwangIntegralConfig hwang;
@@ -58,6 +96,7 @@ struct SampleOutput {
   double eps_hat = 0.0;        ///< [rad] compensation term added to theta_rd
   double eps_ref = 0.0;        ///< [rad] theta_ref - theta_rd wrapped to [-pi,pi); NaN without reference
   std::optional<HwangRevolution> revolution;  ///< set when this sample closed a resolver revolution
+  bool estimate_updated = false;              ///< estimate() changed on this sample (once per revolution)
 
   bool has_dq = false;
   double electrical_freq_hz = 0.0;
@@ -81,6 +120,10 @@ class SampleProcessor {
 
   [[nodiscard]] const ProcessorConfig& config() const { return config_; }
   [[nodiscard]] const HwangIntegralEstimator& estimator() const { return estimator_; }
+  /// The active method's current estimate, every parameter with its standard error.
+  [[nodiscard]] ModelEstimate estimate() const;
+  /// True once the compensation uses a converged (or seeded) estimate.
+  [[nodiscard]] bool compensating() const;
   [[nodiscard]] const RippleSet& ripple() const { return ripple_; }
   /// Starts compensating with a previously learned alpha (persisted
   /// calibration) until this run's estimator has converged.
@@ -91,8 +134,18 @@ class SampleProcessor {
   [[nodiscard]] double active_alpha() const { return active_alpha_; }
 
  private:
+  double compensation_eps(const SampleInput& in, double theta_meas) const;
+
   ProcessorConfig config_;
   HwangIntegralEstimator estimator_;
+  SinCosLeastSquares sincos_ls_;
+  AngleErrorFourier fourier_;
+  std::optional<SinCosFit> sincos_fit_;
+  std::optional<AngleErrorFit> fourier_fit_;
+  std::int64_t rev_index_ = 0;
+  std::int64_t revolutions_ = 0;
+  bool rev_started_ = false;
+  std::int64_t samples_ = 0;
   SpeedEstimator speed_;
   AngleUnwrapper rd_unwrap_;
   AngleUnwrapper ref_unwrap_;
