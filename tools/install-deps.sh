@@ -10,6 +10,7 @@ PACKAGES=(
   libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
   can-utils python3 python3-can
   qemu-system-x86 iproute2
+  default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
 )
 
 missing=()
