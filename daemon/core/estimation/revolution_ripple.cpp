@@ -53,9 +53,14 @@ bool RevolutionRipple::update(double theta_e, double i_d, double i_q) {
     sum_x_q_ = 0.0;
   }
   if (in_revolution_) {
+    // One sin/cos per sample: exp(-j 2 theta) and exp(-j 6 theta) are powers of exp(-j theta).
+    const std::complex<double> w1(std::cos(theta_e), -std::sin(theta_e));
+    const std::complex<double> w2 = w1 * w1;
+    const std::complex<double> w6 = w2 * w2 * w2;
+    static_assert(kRippleOrders[0] == 1 && kRippleOrders[1] == 2 && kRippleOrders[2] == 6);
+    const std::array<std::complex<double>, 3> ws{w1, w2, w6};
     for (std::size_t k = 0; k < kRippleOrders.size(); ++k) {
-      const double a = -kRippleOrders[k] * theta_e;
-      const std::complex<double> w(std::cos(a), std::sin(a));
+      const std::complex<double>& w = ws[k];
       sum_d_[k] += i_d * w;
       sum_q_[k] += i_q * w;
       sum_w_[k] += w;
