@@ -129,6 +129,16 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
     pipeline.tick(wall_us());
   }
   if (notify != nullptr) notify->stopping();
+  // Frames already queued in the socket when SIGTERM came are still data:
+  // drain them (bounded) so nothing received is dropped uncounted.
+  if (source) {
+    source->set_read_timeout(std::chrono::milliseconds(0));
+    Pipeline& pipeline = current();
+    for (int i = 0; i < 1'000'000 && source->read(frame) == ReadStatus::kFrame; ++i) {
+      pipeline.feed(frame, 0, Clock::now());
+    }
+    pipeline.set_kernel_drops(static_cast<std::int64_t>(source->stats().kernel_drops));
+  }
   current().finish();
 }
 
