@@ -1,6 +1,7 @@
 #include "daemon/app/daemon_config.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <toml++/toml.h>
 
@@ -115,7 +116,10 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   if (const auto* t = section("bench")) {
     check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source"}, s);
     read(*t, "sample_rate_hz", c.bench.sample_rate_hz, s, "bench");
-    if (c.bench.sample_rate_hz < 0.0) throw ConfigError(s + ": [bench] sample_rate_hz must be >= 0");
+    // Written so NaN fails too (found by fuzzing: NaN < 0 is false).
+    if (!(c.bench.sample_rate_hz >= 0.0) || !std::isfinite(c.bench.sample_rate_hz)) {
+      throw ConfigError(s + ": [bench] sample_rate_hz must be a finite number >= 0 (0 = take it from BENCH_INFO)");
+    }
     std::string time_source = "counter";
     read(*t, "time_source", time_source, s, "bench");
     if (time_source != "counter" && time_source != "frame") {
@@ -208,7 +212,9 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     }
     c.method = *method;
     require_positive(c.hwang.min_revolutions, "[estimator] min_revolutions", s);
-    if (!(c.hwang.max_speed_change > 0.0)) throw ConfigError(s + ": [estimator] max_speed_change must be > 0");
+    if (!(c.hwang.max_speed_change > 0.0) || !std::isfinite(c.hwang.max_speed_change)) {
+      throw ConfigError(s + ": [estimator] max_speed_change must be a finite number > 0");
+    }
   }
   if (const auto* t = section("compensation")) {
     check_keys(*t, "compensation", {"enabled", "domain"}, s);

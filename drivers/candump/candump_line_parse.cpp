@@ -332,6 +332,17 @@ std::optional<LogLineProblem> parse_candump_line(std::string_view line, CanFrame
                    "expected the frame '<id>#<data>' after interface '" + std::string(iface) +
                        "', found end of line" + std::string(kFormatHint));
   }
+  for (std::size_t k = 0; k < iface.size(); ++k) {
+    const auto ch = static_cast<unsigned char>(iface[k]);
+    if (ch < 0x20 || ch == 0x7F) {
+      // Found by fuzzing: a NUL or control byte would be cut or mangled in the
+      // stored name, so the frame could not be written back as the same line.
+      return problem(LogLineError::kMissingInterface, iface_begin + k,
+                     "interface name contains the control byte 0x" + std::string(1, "0123456789abcdef"[ch >> 4U]) +
+                         std::string(1, "0123456789abcdef"[ch & 0xFU]) +
+                         "; interface names are printable (e.g. can0): the log line is corrupted");
+    }
+  }
   if (iface.size() >= CanFrame::kMaxIfaceLen) {
     return problem(LogLineError::kMissingInterface, iface_begin,
                    "interface name '" + std::string(iface) + "' has " + std::to_string(iface.size()) +

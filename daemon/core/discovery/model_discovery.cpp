@@ -1,0 +1,766 @@
+#include "daemon/core/discovery/model_discovery.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/discovery/effect_signatures.h"
+#include "daemon/core/effects/effect_catalog.h"
+
+namespace resolver {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Share of the samples that must carry a signal before it is used [1].
+constexpr double kSignalPresentShare = 0.9;
+/// Highest order of the saturated Fourier fit behind the noise floor (and the
+/// smoothed ideal angle); capped further by the Nyquist limit of each speed bin.
+constexpr int kSaturatedOrder = 16;
+/// Samples each side of the central difference giving the speed.
+constexpr std::size_t kSpeedHalfSpan = 2;
+/// Tracking-loop search: omega_n grid [rad/s] (log spaced), zeta assumed (bench default).
+constexpr double kOmegaNMin = 100.0, kOmegaNMax = 1e5;
+constexpr int kOmegaNGrid = 61;
+constexpr double kAssumedZeta = 0.7;
+/// A candidate that does not reach the floor still counts as "the missing effect"
+/// when it removes at least this share of the residual power above the floor.
+constexpr double kExcessExplainedShare = 0.8;
+
+struct Row {
+  double t = 0.0;
+  double theta = 0.0;    // [rad] true resolver electrical angle (continuous)
+  double theta_m = 0.0;  // [rad] true mechanical angle (reference only)
+  double omega = 0.0;    // [rad/s]
+  double eps = 0.0;      // [rad]
+  double ys = 0.0, yc = 0.0;
+  bool env = false;
+  int bin = 0;
+};
+
+struct Prepared {
+  int p_r = 3, p = 3;
+  bool reference = false;
+  bool env = false;
+  std::vector<Row> rows;
+  std::vector<double> bin_edges;  // size bins + 1 [rad/s]
+  double floor_rd = 0.0, floor_env = 0.0;
+  double sample_period = 0.0;
+  std::vector<std::string> notes;
+};
+
+int nyquist_order(double omega_abs_max, double dt) {
+  if (!(omega_abs_max > 0.0) || !(dt > 0.0)) return kSaturatedOrder;
+  const double step = omega_abs_max * dt;  // [rad] per sample
+  const int n = static_cast<int>(std::floor(0.9 * kPi / step));
+  return std::clamp(n, 2, kSaturatedOrder);
+}
+
+/// Least squares y ~ X, returns residuals. X given as a row generator.
+template <typename Fill>
+std::vector<double> ls_residual(std::size_t n, int k, Fill&& fill, const std::vector<double>& y) {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
+  Eigen::VectorXd x(k);
+  for (std::size_t i = 0; i < n; ++i) {
+    fill(i, x);
+    m.selfadjointView<Eigen::Lower>().rankUpdate(x);
+    b += x * y[i];
+  }
+  m = m.selfadjointView<Eigen::Lower>();
+  const Eigen::VectorXd coef = m.completeOrthogonalDecomposition().solve(b);
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    fill(i, x);
+    r[i] = y[i] - x.dot(coef);
+  }
+  return r;
+}
+
+/// The fully flexible angle model of one bin: [1, sin n theta, cos n theta (n <= order)]
+/// plus 1x/2x mechanical with a reference.
+void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x) {
+  int j = 0;
+  x[j++] = 1.0;
+  for (int n = 1; n <= order; ++n) {
+    x[j++] = std::sin(n * r.theta);
+    x[j++] = std::cos(n * r.theta);
+  }
+  if (mech) {
+    for (int n = 1; n <= 2; ++n) {
+      x[j++] = std::sin(n * r.theta_m);
+      x[j++] = std::cos(n * r.theta_m);
+    }
+  }
+}
+
+/// Noise floor of one signal: residual of the saturated angle model per speed bin,
+/// then second differences of consecutive samples, which remove whatever smooth
+/// structure is left (a drift in time, a slow speed change): for white noise of
+/// standard deviation sigma, var(r[i+1] - 2 r[i] + r[i-1]) = 6 sigma^2.
+double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all,
+                   double (*value)(const Row&)) {
+  const int bins = static_cast<int>(prep.bin_edges.size()) - 1;
+  double sum = 0.0;
+  std::int64_t count = 0;
+  for (int b = 0; b < bins; ++b) {
+    std::vector<std::size_t> idx;
+    double wmax = 0.0;
+    for (std::size_t i : idx_all) {
+      if (prep.rows[i].bin == b) {
+        idx.push_back(i);
+        wmax = std::max(wmax, std::abs(prep.rows[i].omega));
+      }
+    }
+    const int order = nyquist_order(wmax, prep.sample_period);
+    const int k = 1 + 2 * order + (prep.reference ? 4 : 0);
+    if (idx.size() < static_cast<std::size_t>(4 * k)) continue;
+    std::vector<double> y(idx.size());
+    for (std::size_t i = 0; i < idx.size(); ++i) y[i] = value(prep.rows[idx[i]]);
+    const auto r = ls_residual(
+        idx.size(), k, [&](std::size_t i, Eigen::VectorXd& x) { saturated_basis(prep.rows[idx[i]], order, prep.reference, x); },
+        y);
+    for (std::size_t i = 1; i + 1 < idx.size(); ++i) {
+      if (idx[i + 1] - idx[i - 1] != 2) continue;  // consecutive samples only
+      const double d = r[i + 1] - 2.0 * r[i] + r[i - 1];
+      sum += d * d;
+      ++count;
+    }
+  }
+  return count > 0 ? std::sqrt(sum / (6.0 * static_cast<double>(count))) : kNaN;
+}
+
+/// Without a reference: the ideal angle as a quadratic in time per window of at
+/// least two revolutions and 200 samples, fitted jointly with the harmonics of the
+/// R/D angle (angle_error_fourier.h's fit_error_smooth_angle, done per window so
+/// long logs with speed changes work). Returns the smoothed angle per sample.
+std::vector<double> smoothed_ideal_angle(const std::vector<double>& t, const std::vector<double>& phi_c,
+                                         const std::vector<double>& phi_w, double dt) {
+  const std::size_t n = t.size();
+  std::vector<double> out(n);
+  constexpr std::size_t kMinWindow = 200;
+  std::size_t i0 = 0;
+  while (i0 < n) {
+    std::size_t i1 = i0 + 1;
+    while (i1 < n && (i1 - i0 < kMinWindow || std::abs(phi_c[i1 - 1] - phi_c[i0]) < 2.0 * kTwoPi)) ++i1;
+    if (n - i1 < kMinWindow) i1 = n;  // fold a short tail into this window
+    const double ta = t[i0], tb = t[i1 - 1];
+    const double mid = 0.5 * (ta + tb), half = std::max(0.5 * (tb - ta), 1e-12);
+    const double wmax = std::abs(phi_c[i1 - 1] - phi_c[i0]) / std::max(tb - ta, 1e-12);
+    const int order = std::min(8, nyquist_order(wmax, dt));
+    const int k = 3 + 2 * order;
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
+    Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
+    Eigen::VectorXd x(k);
+    auto fill = [&](std::size_t i) {
+      const double tau = (t[i] - mid) / half;
+      x[0] = 1.0;
+      x[1] = tau;
+      x[2] = tau * tau;
+      for (int h = 1; h <= order; ++h) {
+        x[1 + 2 * h] = std::sin(h * phi_w[i]);
+        x[2 + 2 * h] = std::cos(h * phi_w[i]);
+      }
+    };
+    const double base = phi_c[i0];
+    for (std::size_t i = i0; i < i1; ++i) {
+      fill(i);
+      m.selfadjointView<Eigen::Lower>().rankUpdate(x);
+      b += x * (phi_c[i] - base);
+    }
+    m = m.selfadjointView<Eigen::Lower>();
+    const Eigen::VectorXd c = m.completeOrthogonalDecomposition().solve(b);
+    for (std::size_t i = i0; i < i1; ++i) {
+      const double tau = (t[i] - mid) / half;
+      out[i] = base + c[0] + c[1] * tau + c[2] * tau * tau;
+    }
+    i0 = i1;
+  }
+  return out;
+}
+
+Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
+  Prepared p;
+  p.p_r = in.p_r;
+  p.p = in.p;
+  if (in.p_r < 1 || in.p < 1) throw std::invalid_argument("pole pairs p_r and p must be >= 1");
+  std::vector<const DiscoverySample*> s;
+  std::size_t with_ref = 0, with_sc = 0, with_i = 0;
+  for (const auto& x : in.samples) {
+    if (!x.has_rd) continue;
+    s.push_back(&x);
+    with_ref += x.has_ref ? 1 : 0;
+    with_sc += x.has_sincos ? 1 : 0;
+    with_i += x.has_currents ? 1 : 0;
+  }
+  if (s.size() < 64) {
+    throw std::invalid_argument("too few samples with an R/D angle (" + std::to_string(s.size()) +
+                                "): the log has no resolver samples the default layout decodes");
+  }
+  const double share = static_cast<double>(s.size());
+  p.reference = static_cast<double>(with_ref) >= kSignalPresentShare * share;
+  const bool sincos = static_cast<double>(with_sc) >= kSignalPresentShare * share;
+  if (p.reference) {
+    std::vector<const DiscoverySample*> keep;
+    for (auto* x : s) {
+      if (x->has_ref) keep.push_back(x);
+    }
+    s.swap(keep);
+  } else {
+    p.notes.push_back("no reference angle: fitting against the speed-smoothed ideal angle (constant errors, "
+                      "mounting offset and eccentricity are not identifiable)");
+  }
+  if (!sincos) p.notes.push_back("no sin/cos envelopes: only the R/D angle is fitted (k3 and alpha are not separable)");
+  else if (!p.reference) p.notes.push_back("sin/cos envelopes present but not fitted without a reference angle");
+  if (with_i > 0) p.notes.push_back("phase currents present but not fitted in this version (dq residual not reported)");
+  else p.notes.push_back("no phase currents in the log");
+
+  const std::size_t n = s.size();
+  std::vector<double> t(n), truth(n), mech(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) t[i] = s[i]->t;
+  double dt_sum = 0.0;
+  for (std::size_t i = 1; i < n; ++i) dt_sum += t[i] - t[i - 1];
+  p.sample_period = dt_sum / static_cast<double>(n - 1);
+  if (p.reference) {
+    AngleUnwrapper un;
+    for (std::size_t i = 0; i < n; ++i) {
+      mech[i] = un.update(s[i]->theta_m_ref);
+      truth[i] = in.p_r * mech[i];
+    }
+  } else {
+    std::vector<double> phi_c(n), phi_w(n);
+    AngleUnwrapper un;
+    for (std::size_t i = 0; i < n; ++i) {
+      phi_w[i] = s[i]->theta_rd;
+      phi_c[i] = un.update(s[i]->theta_rd);
+    }
+    truth = smoothed_ideal_angle(t, phi_c, phi_w, p.sample_period);
+  }
+  if (std::abs(truth.back() - truth.front()) < 2.0 * kTwoPi) {
+    throw std::invalid_argument("the log covers less than two resolver revolutions: nothing to fit");
+  }
+  double amp = 0.0;
+  if (sincos && p.reference) {
+    double ss = 0.0;
+    std::size_t m = 0;
+    for (auto* x : s) {
+      if (x->has_sincos) {
+        ss += x->sin * x->sin;
+        ++m;
+      }
+    }
+    // [counts] A from the sin channel alone (rms x sqrt 2): the cos channel carries
+    // (1 + alpha), and an A between the two would leave a gain nuisance g ~ -alpha/2
+    // whose product g alpha (second order) the linear model cannot represent.
+    amp = std::sqrt(2.0 * ss / static_cast<double>(m));
+    p.env = amp > 0.0;
+  }
+  p.rows.resize(n);
+  double wlo = std::numeric_limits<double>::infinity(), whi = -wlo;
+  for (std::size_t i = 0; i < n; ++i) {
+    Row& r = p.rows[i];
+    const std::size_t a = i >= kSpeedHalfSpan ? i - kSpeedHalfSpan : 0;
+    const std::size_t b = std::min(n - 1, i + kSpeedHalfSpan);
+    r.t = t[i];
+    r.theta = truth[i];
+    r.theta_m = mech[i];
+    r.omega = t[b] > t[a] ? (truth[b] - truth[a]) / (t[b] - t[a]) : 0.0;
+    r.eps = wrap_pi(truth[i] - s[i]->theta_rd);
+    if (p.env && s[i]->has_sincos) {
+      r.env = true;
+      r.ys = s[i]->sin / amp - std::sin(r.theta);
+      r.yc = s[i]->cos / amp - std::cos(r.theta);
+    }
+    wlo = std::min(wlo, r.omega);
+    whi = std::max(whi, r.omega);
+  }
+  const int bins = (whi - wlo) > 0.02 * std::max(std::abs(whi), std::abs(wlo)) ? std::max(1, opt.speed_bins) : 1;
+  for (int b = 0; b <= bins; ++b) p.bin_edges.push_back(wlo + (whi - wlo) * b / bins);
+  for (auto& r : p.rows) {
+    r.bin = bins == 1 ? 0 : std::clamp(static_cast<int>((r.omega - wlo) / (whi - wlo) * bins), 0, bins - 1);
+  }
+  std::vector<std::size_t> all(n), env_idx;
+  for (std::size_t i = 0; i < n; ++i) {
+    all[i] = i;
+    if (p.rows[i].env) env_idx.push_back(i);
+  }
+  p.floor_rd = noise_floor(p, all, [](const Row& r) { return r.eps; });
+  if (p.env) {
+    const double fs = noise_floor(p, env_idx, [](const Row& r) { return r.ys; });
+    const double fc = noise_floor(p, env_idx, [](const Row& r) { return r.yc; });
+    p.floor_env = std::sqrt(0.5 * (fs * fs + fc * fc));
+  }
+  if (!(p.floor_rd > 0.0)) throw std::invalid_argument("could not estimate the noise floor (too few samples per speed)");
+  if (p.env && !(p.floor_env > 0.0)) p.env = false;
+  return p;
+}
+
+// ---------------------------------------------------------------- fitting
+
+struct Design {
+  std::vector<const EffectSignature*> effects;  // linear ones
+  bool tracking = false;
+  bool const_nuisance = false;  // rd constant (no reference: the smoothed angle absorbs it)
+  bool gain_nuisance = false;   // envelope amplitude
+  std::vector<std::string> names;
+  int k = 0;
+};
+
+Design make_design(const Prepared& p, std::span<const std::string> effects) {
+  Design d;
+  d.const_nuisance = !p.reference;
+  d.gain_nuisance = p.env;
+  if (d.const_nuisance) d.names.emplace_back("nuisance.rd_constant");
+  if (d.gain_nuisance) d.names.emplace_back("nuisance.sincos_gain");
+  for (const auto& e : effects) {
+    const EffectSignature* sig = find_signature(e);
+    if (sig == nullptr) {
+      std::string list;
+      for (const auto& x : effect_signatures()) list += (list.empty() ? "" : ", ") + std::string(x.effect);
+      throw std::invalid_argument("effect '" + e + "' " +
+                                  (find_effect(e) != nullptr ? "is in the catalog but not fittable in this version"
+                                                             : "is not in the effect catalog") +
+                                  "; fittable: " + list);
+    }
+    if (sig->needs_reference && !p.reference) {
+      throw std::invalid_argument("effect '" + e + "' needs the reference angle, which this log does not have");
+    }
+    if (sig->nonlinear) {
+      d.tracking = true;
+      continue;
+    }
+    if (std::find(d.effects.begin(), d.effects.end(), sig) != d.effects.end()) continue;
+    d.effects.push_back(sig);
+    for (auto name : sig->params) d.names.push_back(std::string(sig->effect) + "." + std::string(name));
+  }
+  d.k = static_cast<int>(d.names.size());
+  return d;
+}
+
+struct Solved {
+  bool ok = false;
+  Eigen::VectorXd x;
+  Eigen::VectorXd se;
+  double rss_w = 0.0;
+  double rss_rd = 0.0, rss_env = 0.0;
+  std::int64_t n_rd = 0, n_env = 0;
+  double omega_n = 0.0, omega_n_se = kNaN;
+  std::vector<double> resid_rd;
+};
+
+/// Regressor rows for one sample: rd, s, c each of length k.
+void fill_rows(const Prepared& p, const Design& d, const Row& r, double omega_n, double alpha_hat, Eigen::VectorXd& xr,
+               Eigen::VectorXd& xs, Eigen::VectorXd& xc) {
+  xr.setZero();
+  xs.setZero();
+  xc.setZero();
+  int j = 0;
+  if (d.const_nuisance) xr[j++] = 1.0;
+  if (d.gain_nuisance) {
+    xs[j] = std::sin(r.theta);
+    xc[j] = std::cos(r.theta);
+    ++j;
+  }
+  SignatureContext ctx{r.theta, r.theta_m, r.omega, p.p_r, p.p, omega_n, kAssumedZeta, alpha_hat};
+  double br[4], bs[4], bc[4];
+  for (const auto* e : d.effects) {
+    e->regress(ctx, br, bs, bc);
+    for (std::size_t i = 0; i < e->params.size(); ++i, ++j) {
+      xr[j] = br[i];
+      xs[j] = bs[i];
+      xc[j] = bc[i];
+    }
+  }
+}
+
+Solved solve_linear(const Prepared& p, const Design& d, double omega_n, bool keep_residual, double alpha_hat) {
+  Solved out;
+  out.omega_n = omega_n;
+  const int k = d.k;
+  const double wr = 1.0 / p.floor_rd, we = p.env ? 1.0 / p.floor_env : 0.0;
+  Eigen::VectorXd xr(k), xs(k), xc(k);
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
+  for (const auto& r : p.rows) {
+    if (k == 0) break;
+    fill_rows(p, d, r, omega_n, alpha_hat, xr, xs, xc);
+    m.selfadjointView<Eigen::Lower>().rankUpdate(xr, wr * wr);
+    b += xr * (wr * wr * r.eps);
+    if (r.env) {
+      m.selfadjointView<Eigen::Lower>().rankUpdate(xs, we * we);
+      m.selfadjointView<Eigen::Lower>().rankUpdate(xc, we * we);
+      b += xs * (we * we * r.ys) + xc * (we * we * r.yc);
+    }
+  }
+  Eigen::VectorXd coef = Eigen::VectorXd::Zero(k);
+  Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(k, k);
+  if (k > 0) {
+    m = m.selfadjointView<Eigen::Lower>();
+    // Scale columns to unit diagonal so the rank test is about collinearity, not units.
+    Eigen::VectorXd dg = m.diagonal().cwiseMax(1e-300).cwiseSqrt();
+    const Eigen::MatrixXd ms = dg.cwiseInverse().asDiagonal() * m * dg.cwiseInverse().asDiagonal();
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(ms);
+    cod.setThreshold(1e-9);
+    if (cod.rank() < k) return out;  // not separable with the signals present
+    coef = dg.cwiseInverse().asDiagonal() * cod.solve(dg.cwiseInverse().asDiagonal() * b);
+    minv = dg.cwiseInverse().asDiagonal() * cod.pseudoInverse() * dg.cwiseInverse().asDiagonal();
+  }
+  if (keep_residual) out.resid_rd.reserve(p.rows.size());
+  for (const auto& r : p.rows) {
+    double fr = 0.0, fs = 0.0, fc = 0.0;
+    if (k > 0) {
+      fill_rows(p, d, r, omega_n, alpha_hat, xr, xs, xc);
+      fr = xr.dot(coef);
+      fs = xs.dot(coef);
+      fc = xc.dot(coef);
+    }
+    const double er = r.eps - fr;
+    out.rss_rd += er * er;
+    ++out.n_rd;
+    if (keep_residual) out.resid_rd.push_back(er);
+    if (r.env) {
+      const double es = r.ys - fs, ec = r.yc - fc;
+      out.rss_env += es * es + ec * ec;
+      out.n_env += 2;
+    }
+  }
+  out.rss_w = out.rss_rd * wr * wr + out.rss_env * we * we;
+  const double dof = static_cast<double>(out.n_rd + out.n_env - k - (d.tracking ? 1 : 0));
+  const double s2 = out.rss_w / std::max(dof, 1.0);
+  out.x = coef;
+  out.se = (s2 * minv.diagonal()).cwiseMax(0.0).cwiseSqrt();
+  out.ok = true;
+  return out;
+}
+
+/// Index of amplitude_imbalance.alpha in the design, or -1.
+int alpha_column(const Design& d) {
+  for (int j = 0; j < d.k; ++j) {
+    if (d.names[j] == "amplitude_imbalance.alpha") return j;
+  }
+  return -1;
+}
+
+Solved solve(const Prepared& p, const Design& d, bool keep_residual) {
+  // Preliminary linear pass for alpha_hat (see SignatureContext::alpha_hat).
+  double alpha_hat = 0.0;
+  if (const int ja = alpha_column(d); ja >= 0) {
+    const Solved pre = solve_linear(p, d, 0.0, false, 0.0);
+    if (pre.ok) alpha_hat = pre.x[ja];
+  }
+  if (!d.tracking) return solve_linear(p, d, 0.0, keep_residual, alpha_hat);
+  // omega_n: log grid, then golden-section refinement in log omega_n.
+  auto cost = [&](double lw) {
+    const Solved s = solve_linear(p, d, std::exp(lw), false, alpha_hat);
+    return s.ok ? s.rss_w : std::numeric_limits<double>::infinity();
+  };
+  const double l0 = std::log(kOmegaNMin), l1 = std::log(kOmegaNMax);
+  double best_l = l0, best_c = std::numeric_limits<double>::infinity();
+  const double step = (l1 - l0) / (kOmegaNGrid - 1);
+  for (int i = 0; i < kOmegaNGrid; ++i) {
+    const double l = l0 + step * i;
+    const double c = cost(l);
+    if (c < best_c) {
+      best_c = c;
+      best_l = l;
+    }
+  }
+  double a = best_l - step, b = best_l + step;
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double c1 = b - g * (b - a), c2 = a + g * (b - a);
+  double f1 = cost(c1), f2 = cost(c2);
+  for (int it = 0; it < 40; ++it) {
+    if (f1 < f2) {
+      b = c2;
+      c2 = c1;
+      f2 = f1;
+      c1 = b - g * (b - a);
+      f1 = cost(c1);
+    } else {
+      a = c1;
+      c1 = c2;
+      f1 = f2;
+      c2 = a + g * (b - a);
+      f2 = cost(c2);
+    }
+  }
+  const double lopt = 0.5 * (a + b);
+  Solved out = solve_linear(p, d, std::exp(lopt), keep_residual, alpha_hat);
+  if (!out.ok) return out;
+  // Standard error from the curvature of the weighted RSS (chi^2 / s^2 rises by 1 at 1 sigma).
+  const double h = 0.01;
+  const double curv = (cost(lopt + h) - 2.0 * out.rss_w + cost(lopt - h)) / (h * h);
+  const double dof = static_cast<double>(out.n_rd + out.n_env - d.k - 1);
+  const double s2 = out.rss_w / std::max(dof, 1.0);
+  out.omega_n_se = curv > 0.0 ? std::exp(lopt) * std::sqrt(2.0 * s2 / curv) : kNaN;
+  return out;
+}
+
+double bic(const Solved& s, const Design& d) {
+  const double n = static_cast<double>(s.n_rd + s.n_env);
+  const double k = static_cast<double>(d.k + (d.tracking ? 1 : 0));
+  return n * std::log(s.rss_w / n) + k * std::log(n);
+}
+
+double rms(double rss, std::int64_t n) { return n > 0 ? std::sqrt(rss / static_cast<double>(n)) : 0.0; }
+
+std::vector<HarmonicResidual> harmonic_breakdown(const Prepared& p, const std::vector<double>& r, int max_order) {
+  const int k = 1 + 2 * max_order;
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(k), x(k);
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    saturated_basis(p.rows[i], max_order, false, x);
+    m.selfadjointView<Eigen::Lower>().rankUpdate(x);
+    b += x * r[i];
+  }
+  m = m.selfadjointView<Eigen::Lower>();
+  const Eigen::VectorXd c = m.completeOrthogonalDecomposition().solve(b);
+  std::vector<HarmonicResidual> out;
+  out.push_back({0, std::abs(c[0]), c[0] >= 0.0 ? 0.0 : kPi});
+  for (int n = 1; n <= max_order; ++n) {
+    const double a = c[2 * n - 1], bb = c[2 * n];
+    out.push_back({n, std::hypot(a, bb), std::atan2(bb, a)});
+  }
+  return out;
+}
+
+std::vector<SpeedBinResidual> speed_breakdown(const Prepared& p, const std::vector<double>& r) {
+  const int bins = static_cast<int>(p.bin_edges.size()) - 1;
+  std::vector<SpeedBinResidual> out;
+  for (int b = 0; b < bins; ++b) {
+    SpeedBinResidual s;
+    s.omega_lo = p.bin_edges[b];
+    s.omega_hi = p.bin_edges[b + 1];
+    s.rpm_mid = 0.5 * (s.omega_lo + s.omega_hi) / p.p_r * 60.0 / kTwoPi;
+    Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    double ss = 0.0;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      if (p.rows[i].bin != b) continue;
+      ++s.samples;
+      ss += r[i] * r[i];
+      const Eigen::Vector3d x(1.0, std::sin(2.0 * p.rows[i].theta), std::cos(2.0 * p.rows[i].theta));
+      m += x * x.transpose();
+      v += x * r[i];
+    }
+    if (s.samples < 16) continue;
+    s.rms = std::sqrt(ss / static_cast<double>(s.samples));
+    const Eigen::Vector3d c = m.completeOrthogonalDecomposition().solve(v);
+    s.order2_amplitude = std::hypot(c[1], c[2]);
+    out.push_back(s);
+  }
+  return out;
+}
+
+bool signals_explained(const Prepared& p, const Solved& s, double ratio) {
+  if (rms(s.rss_rd, s.n_rd) > ratio * p.floor_rd) return false;
+  if (p.env && rms(s.rss_env, s.n_env) > ratio * p.floor_env) return false;
+  return true;
+}
+
+std::vector<ParamValue> params_of(const Design& d, const Solved& s, bool with_nuisance) {
+  std::vector<ParamValue> out;
+  for (int j = 0; j < d.k; ++j) {
+    if (!with_nuisance && d.names[j].rfind("nuisance.", 0) == 0) continue;
+    out.push_back({d.names[j], s.x[j], s.se[j]});
+  }
+  if (d.tracking) out.push_back({"tracking_loop.omega_n", s.omega_n, s.omega_n_se});
+  return out;
+}
+
+ModelFit fit_prepared(const Prepared& p, std::span<const std::string> effects, const DiscoveryOptions& opt,
+                      Design& d, Solved& s) {
+  d = make_design(p, effects);
+  s = solve(p, d, true);
+  if (!s.ok) {
+    throw std::invalid_argument("the model's effects are not separable with the signals in this log "
+                                "(e.g. harmonics and amplitude_imbalance both land on 2 theta without sin/cos)");
+  }
+  const Solved raw = solve_linear(p, make_design(p, {}), 0.0, false, 0.0);
+  ModelFit f;
+  for (const auto& e : effects) {
+    if (std::find(f.effects.begin(), f.effects.end(), e) == f.effects.end()) f.effects.push_back(e);
+  }
+  f.params = params_of(d, s, false);
+  f.signals.push_back({"position_error", rms(s.rss_rd, s.n_rd), p.floor_rd, rms(raw.rss_rd, raw.n_rd), s.n_rd});
+  if (p.env) f.signals.push_back({"sin_cos", rms(s.rss_env, s.n_env), p.floor_env, rms(raw.rss_env, raw.n_env), s.n_env});
+  f.residual_rms_rad = rms(s.rss_rd, s.n_rd);
+  f.noise_floor_rad = p.floor_rd;
+  f.harmonics = harmonic_breakdown(p, s.resid_rd, std::max(0, opt.max_report_order));
+  f.speed_bins = speed_breakdown(p, s.resid_rd);
+  f.bic = bic(s, d);
+  f.rows = s.n_rd + s.n_env;
+  f.parameters = d.k + (d.tracking ? 1 : 0);
+  f.reference = p.reference;
+  f.sincos_used = p.env;
+  f.explained = signals_explained(p, s, opt.explained_ratio);
+  f.notes = p.notes;
+  if (d.tracking) f.notes.push_back("tracking_loop: zeta assumed 0.7, omega_n searched on [100, 1e5] rad/s");
+  return f;
+}
+
+std::string fmt_num(double v, const char* f = "%.3g") {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, double ratio) {
+  std::vector<std::string> out;
+  for (const auto& s : f.signals) {
+    if (s.rms <= ratio * s.floor) continue;
+    out.push_back(s.signal + ": residual " + fmt_num(s.rms) + (s.signal == "position_error" ? " rad (" + fmt_num(rad_to_arcmin(s.rms)) + " arcmin)" : " of the amplitude") +
+                  " is " + fmt_num(s.rms / s.floor, "%.1f") + "x the noise floor " + fmt_num(s.floor));
+  }
+  if (out.empty()) return out;
+  // Which harmonics: those above a fifth of the floor, largest first.
+  std::vector<HarmonicResidual> h = f.harmonics;
+  std::sort(h.begin(), h.end(), [](const auto& a, const auto& b) { return a.amplitude > b.amplitude; });
+  std::string hs;
+  for (const auto& x : h) {
+    if (x.amplitude < 0.2 * p.floor_rd || hs.size() > 200) break;
+    const double deg = x.phase * 180.0 / kPi;
+    std::string phase;
+    if (x.order > 0) {
+      const double a = std::fmod(std::abs(deg), 180.0);
+      phase = a < 20.0 || a > 160.0 ? " (in phase with sin)" : (std::abs(a - 90.0) < 20.0 ? " (in phase with cos)" : " (phase " + fmt_num(deg, "%.0f") + " deg)");
+    }
+    hs += (hs.empty() ? "" : ", ") + (x.order == 0 ? std::string("constant") : std::to_string(x.order) + " theta") +
+          " " + fmt_num(x.amplitude) + " rad" + phase;
+  }
+  if (!hs.empty()) out.push_back("position-error residual by harmonic: " + hs);
+  else if (f.signals[0].rms > ratio * f.signals[0].floor)
+    out.push_back("position-error residual is not locked to the angle (no harmonic of theta above a fifth of the floor): it changes over time");
+  if (f.speed_bins.size() > 1) {
+    std::string bs;
+    for (const auto& b : f.speed_bins) {
+      bs += (bs.empty() ? "" : ", ") + fmt_num(b.rpm_mid, "%.0f") + " r/min: " + fmt_num(b.rms / p.floor_rd, "%.1f") + "x floor";
+    }
+    out.push_back("by speed: " + bs);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string_view to_string(Verdict v) {
+  switch (v) {
+    case Verdict::kExplained: return "explained";
+    case Verdict::kMissingEffect: return "missing_effect";
+    case Verdict::kUnexplained: return "unexplained";
+  }
+  return "?";
+}
+
+std::span<const std::string_view> fittable_effects() {
+  static const std::vector<std::string_view> names = [] {
+    std::vector<std::string_view> v;
+    for (const auto& s : effect_signatures()) v.push_back(s.effect);
+    return v;
+  }();
+  return names;
+}
+
+ModelFit fit_model(const DiscoveryInput& input, std::span<const std::string> effects, const DiscoveryOptions& options) {
+  const Prepared p = prepare(input, options);
+  Design d;
+  Solved s;
+  return fit_prepared(p, effects, options, d, s);
+}
+
+Explanation explain_model(const DiscoveryInput& input, std::span<const std::string> effects,
+                          const DiscoveryOptions& options) {
+  const Prepared p = prepare(input, options);
+  if (options.progress) options.progress(0.05);
+  Explanation ex;
+  Design d;
+  Solved base;
+  ex.fit = fit_prepared(p, effects, options, d, base);
+  const double base_bic = ex.fit.bic;
+  const auto sigs = effect_signatures();
+  std::size_t done = 0;
+  for (const auto& sig : sigs) {
+    ++done;
+    if (options.progress) options.progress(0.05 + 0.95 * static_cast<double>(done) / static_cast<double>(sigs.size()));
+    const std::string name(sig.effect);
+    if (std::find(ex.fit.effects.begin(), ex.fit.effects.end(), name) != ex.fit.effects.end()) continue;
+    if (sig.needs_reference && !p.reference) {
+      ex.not_evaluated.push_back(name + ": needs the reference angle");
+      continue;
+    }
+    std::vector<std::string> with(ex.fit.effects.begin(), ex.fit.effects.end());
+    with.push_back(name);
+    const Design dc = make_design(p, with);
+    const Solved sc = solve(p, dc, false);
+    if (!sc.ok) {
+      ex.not_evaluated.push_back(name + ": not separable from the model with the signals in this log" +
+                                 (p.env ? std::string() : std::string(" (needs sin/cos with a reference)")));
+      continue;
+    }
+    Candidate c;
+    c.effect = name;
+    c.residual_after_rad = rms(sc.rss_rd, sc.n_rd);
+    c.sincos_residual_after = rms(sc.rss_env, sc.n_env);
+    c.score = bic(sc, dc);
+    c.bic_drop = base_bic - c.score;
+    c.proposed = c.bic_drop > options.proposal_bic_drop;
+    c.reaches_floor = signals_explained(p, sc, options.explained_ratio);
+    for (const auto& pv : params_of(dc, sc, false)) {
+      if (pv.name.rfind(name + ".", 0) == 0) c.params.push_back(pv);
+    }
+    std::string vals;
+    for (const auto& pv : c.params) vals += (vals.empty() ? "" : ", ") + pv.name.substr(name.size() + 1) + " = " + fmt_num(pv.value) + " +- " + fmt_num(pv.std_error, "%.2g");
+    c.reason = std::string(sig.physics) + " (fit: " + vals + ").";
+    ex.candidates.push_back(std::move(c));
+  }
+  for (const auto& e : effect_catalog()) {
+    if (find_signature(e.name) != nullptr) continue;
+    const std::string n(e.name);
+    if (n == "quantization" || n == "noise") ex.not_evaluated.push_back(n + ": sets the noise floor, not a candidate");
+    else ex.not_evaluated.push_back(n + ": acts on the phase currents; the dq fit is not in this version");
+  }
+  std::sort(ex.candidates.begin(), ex.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
+
+  if (ex.fit.explained) {
+    // Nothing to propose: a BIC gain below the floor's resolution is not a missing
+    // effect (e.g. second-order terms between effects); the scores stay listed.
+    for (auto& c : ex.candidates) c.proposed = false;
+    ex.verdict = Verdict::kExplained;
+    ex.summary = "explained: every signal's residual is within " + fmt_num(options.explained_ratio) +
+                 "x its noise floor; no effect is needed.";
+    return ex;
+  }
+  ex.where_it_fails = describe_failure(p, ex.fit, options.explained_ratio);
+  const Candidate* best = ex.candidates.empty() || !ex.candidates.front().proposed ? nullptr : &ex.candidates.front();
+  bool named = false;
+  if (best != nullptr) {
+    if (best->reaches_floor) {
+      named = true;
+    } else {
+      // Share of the weighted residual power above the floor that the candidate removes.
+      const double nr = static_cast<double>(base.n_rd), ne = static_cast<double>(base.n_env);
+      const double excess = base.rss_w - (nr + ne);
+      const double fr = best->residual_after_rad / p.floor_rd;
+      const double fe = p.env ? best->sincos_residual_after / p.floor_env : 0.0;
+      const double after = fr * fr * nr + fe * fe * ne - (nr + ne);
+      named = excess > 0.0 && (excess - after) >= kExcessExplainedShare * excess;
+    }
+  }
+  if (named) {
+    ex.verdict = Verdict::kMissingEffect;
+    ex.summary = "missing_effect: adding " + best->effect + " brings the position-error residual from " +
+                 fmt_num(ex.fit.residual_rms_rad) + " to " + fmt_num(best->residual_after_rad) + " rad (floor " +
+                 fmt_num(p.floor_rd) + "); " + best->reason;
+  } else {
+    ex.verdict = Verdict::kUnexplained;
+    ex.summary = "unexplained: no catalog effect brings the residual near the noise floor; the residual is described "
+                 "above instead of naming an effect.";
+  }
+  return ex;
+}
+
+}  // namespace resolver

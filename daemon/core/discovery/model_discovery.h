@@ -1,0 +1,147 @@
+// Model discovery (DESIGN 7): fit a set of catalog effects to a log's samples,
+// compare the residual with the noise floor, and rank the catalog effects not
+// in the model by how much of the residual each explains.
+//
+// Data flow (pure maths, no I/O; the caller reads the log):
+//
+//   samples ─► prepare: true angle theta (reference, or a speed-smoothed ideal
+//   │          angle when there is none), speed omega, rows
+//   │            position error  eps = theta_true - theta_rd           [rad]
+//   │            sin/cos         s/A - sin theta, c/A - cos theta     [1 ~ rad] (reference only)
+//   │          noise floor of each signal (second differences of a saturated fit)
+//   └► fit: weighted linear least squares, one column per effect parameter
+//      (effect_signatures.h), rows weighted by 1/floor so signals combine;
+//      tracking_loop is the one nonlinear effect (omega_n, searched on a grid)
+//   └► explain: refit with each missing catalog effect, BIC ranking, verdict.
+//
+// Units: angles [rad] (resolver electrical unless a name says mechanical),
+// speeds [rad/s] resolver electrical, time [s].
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace resolver {
+
+/// One joined bench sample. NaN-free fields are flagged by has_*.
+struct DiscoverySample {
+  double t = 0.0;            ///< [s] sample time (any origin, increasing)
+  double theta_rd = 0.0;     ///< [rad] R/D converter angle, resolver electrical, wrapped
+  bool has_rd = false;
+  double sin = 0.0;          ///< [counts] demodulated sin envelope
+  double cos = 0.0;          ///< [counts] demodulated cos envelope
+  bool has_sincos = false;
+  double theta_m_ref = 0.0;  ///< [rad] reference encoder, mechanical, wrapped
+  bool has_ref = false;
+  bool has_currents = false;  ///< phase currents present (not fitted in this version)
+};
+
+struct DiscoveryInput {
+  int p_r = 3;  ///< resolver pole pairs
+  int p = 3;    ///< motor pole pairs
+  std::vector<DiscoverySample> samples;
+};
+
+struct DiscoveryOptions {
+  /// A signal is explained when its residual rms <= explained_ratio x its noise floor (issue 4: 1.5).
+  double explained_ratio = 1.5;
+  /// A candidate is proposed when it lowers the BIC by more than this (Kass & Raftery:
+  /// a difference above 10 is "very strong" evidence).
+  double proposal_bic_drop = 10.0;
+  /// Harmonic orders 0..max_report_order of theta in the residual breakdown.
+  int max_report_order = 8;
+  /// Speed bins of the residual breakdown (equal width over the speeds seen; empty bins dropped).
+  int speed_bins = 6;
+  /// Called with the fraction done in [0, 1] during explain (may be empty).
+  std::function<void(double)> progress;
+};
+
+/// A value with its standard error (NaN: not identifiable / not computed).
+struct ParamValue {
+  std::string name;  ///< "effect.param", e.g. "amplitude_imbalance.alpha"
+  double value = 0.0;
+  double std_error = 0.0;
+};
+
+struct SignalResidual {
+  std::string signal;       ///< "position_error" [rad] or "sin_cos" [fraction of amplitude]
+  double rms = 0.0;         ///< residual rms after the fit
+  double floor = 0.0;       ///< noise floor estimated from the data
+  double raw_rms = 0.0;     ///< rms before any effect is fitted (nuisance only)
+  std::int64_t rows = 0;
+};
+
+struct HarmonicResidual {
+  int order = 0;            ///< harmonic order n of theta (resolver electrical)
+  double amplitude = 0.0;   ///< [rad] amplitude of a_n sin + b_n cos (|a_0| for n = 0)
+  double phase = 0.0;       ///< [rad] atan2(b_n, a_n): 0 = in phase with sin n theta
+};
+
+struct SpeedBinResidual {
+  double omega_lo = 0.0, omega_hi = 0.0;  ///< [rad/s] resolver electrical
+  double rpm_mid = 0.0;                   ///< [r/min] mechanical, bin centre
+  double rms = 0.0;                       ///< [rad] position-error residual
+  double order2_amplitude = 0.0;          ///< [rad] residual amplitude at 2 theta
+  std::int64_t samples = 0;
+};
+
+struct ModelFit {
+  std::vector<std::string> effects;
+  std::vector<ParamValue> params;
+  std::vector<SignalResidual> signals;
+  double residual_rms_rad = 0.0;  ///< position error residual [rad]
+  double noise_floor_rad = 0.0;   ///< position error floor [rad]
+  std::vector<HarmonicResidual> harmonics;  ///< position error residual by order
+  std::vector<SpeedBinResidual> speed_bins;
+  double bic = 0.0;               ///< n ln(RSS_w / n) + k ln n over all weighted rows
+  std::int64_t rows = 0;
+  int parameters = 0;             ///< k, including nuisance columns
+  bool reference = false;         ///< eps against the reference encoder (else smoothed ideal angle)
+  bool sincos_used = false;       ///< sin/cos rows entered the fit
+  bool explained = false;         ///< every signal <= explained_ratio x floor
+  std::vector<std::string> notes; ///< what is missing from the log, assumptions
+};
+
+struct Candidate {
+  std::string effect;
+  double residual_after_rad = 0.0;  ///< position error residual rms with the effect added
+  double sincos_residual_after = 0.0;  ///< sin/cos residual rms (0 when not used)
+  double score = 0.0;               ///< BIC of the model with the effect added (lower is better)
+  double bic_drop = 0.0;            ///< BIC(model) - score (> 0: better)
+  bool proposed = false;            ///< bic_drop > proposal_bic_drop
+  bool reaches_floor = false;       ///< every signal <= explained_ratio x floor after adding it
+  std::string reason;               ///< one sentence of physics
+  std::vector<ParamValue> params;   ///< the added effect's parameters
+};
+
+enum class Verdict : std::uint8_t { kExplained, kMissingEffect, kUnexplained };
+[[nodiscard]] std::string_view to_string(Verdict v);
+
+struct Explanation {
+  ModelFit fit;
+  std::vector<Candidate> candidates;      ///< best (lowest score) first
+  Verdict verdict = Verdict::kExplained;
+  std::vector<std::string> where_it_fails;  ///< sentences; empty when explained
+  std::string summary;                      ///< one or two sentences
+  std::vector<std::string> not_evaluated;   ///< catalog effects skipped, with why
+};
+
+/// Effects this version can fit (catalog names).
+[[nodiscard]] std::span<const std::string_view> fittable_effects();
+
+/// Fits `effects` (catalog names; may be empty = nuisance only). Throws
+/// std::invalid_argument naming the effect when it is unknown or not fittable,
+/// when a needed signal is absent (eccentricity and mounting_offset need the
+/// reference), or when fewer than two resolver revolutions of R/D samples exist.
+[[nodiscard]] ModelFit fit_model(const DiscoveryInput& input, std::span<const std::string> effects,
+                                 const DiscoveryOptions& options = {});
+
+/// fit_model plus the ranked candidates and the verdict. Throws like fit_model.
+[[nodiscard]] Explanation explain_model(const DiscoveryInput& input, std::span<const std::string> effects,
+                                        const DiscoveryOptions& options = {});
+
+}  // namespace resolver

@@ -1,0 +1,255 @@
+#!/usr/bin/python3
+"""Writes the bad-input cases of tests/bad_input/cases/ (run once; the output is checked in).
+
+Every log case starts from the same clean log of the default bench layout
+(DESIGN 4, proto/resolver_bench.dbc): one BENCH_INFO frame, then N_SAMPLES
+control periods of RESOLVER_SAMPLE (0x100), PHASE_CURRENTS (0x101) and
+REFERENCE_ANGLE (0x102), 500 us apart (2 kHz). Each case then makes exactly one
+kind of damage, and where possible *adds* the bad line/frame rather than
+replacing a good one, so the damage shows up in one counter only and the
+manifest can insist that no other reject appears.
+
+Frames carry real CRCs, computed here independently of the C++ code:
+CRC-8 SAE J1850 (poly 0x1D, init 0xFF, no reflection, xorout 0xFF) over data
+bytes 0..6 followed by the low byte of the CAN ID (check value of
+b"123456789" = 0x4B, asserted below).
+
+    /usr/bin/python3 tests/bad_input/make_cases.py     # rewrites cases/ and cases.json
+"""
+import json
+import math
+import os
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+CASES = os.path.join(HERE, "cases")
+
+ID_SAMPLE, ID_CURRENTS, ID_REF, ID_INFO = 0x100, 0x101, 0x102, 0x1F0
+N_SAMPLES = 24
+T0_US = 1_700_000_000_000_000  # [us] first frame
+PERIOD_US = 500  # [us] 2 kHz control period
+
+
+def crc8_j1850(data):
+    crc = 0xFF
+    for b in data:
+        crc ^= b
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1D) & 0xFF if crc & 0x80 else (crc << 1) & 0xFF
+    return crc ^ 0xFF
+
+
+assert crc8_j1850(b"123456789") == 0x4B, "CRC-8 J1850 check value"
+
+
+def seal(can_id, payload7):
+    """8 data bytes: the 7 given plus the bench CRC over them and the ID's low byte."""
+    assert len(payload7) == 7
+    return payload7 + bytes([crc8_j1850(payload7 + bytes([can_id & 0xFF]))])
+
+
+def line(t_us, can_id, data, iface="can0"):
+    return "(%d.%06d) %s %03X#%s" % (t_us // 1_000_000, t_us % 1_000_000, iface, can_id, data.hex().upper())
+
+
+def sample_lines(k):
+    """The three frames of control period k (counter k & 0xFF): 30 r/min-ish rotation."""
+    t = T0_US + PERIOD_US * (k + 1)
+    theta = 2 * math.pi * k / 40.0  # resolver electrical angle [rad]
+    sin_c, cos_c = int(20000 * math.sin(theta)), int(20000 * math.cos(theta))
+    rd = int(theta / (2 * math.pi) * 65536) & 0xFFFF
+    counter = k & 0xFF
+    res = seal(ID_SAMPLE, struct.pack("<BhhH", counter, sin_c, cos_c, rd))
+    i_a = int(1000 * math.cos(theta))
+    i_b = int(1000 * math.cos(theta - 2 * math.pi / 3))
+    i_c = -i_a - i_b
+    cur = seal(ID_CURRENTS, struct.pack("<Bhhh", counter, i_a, i_b, i_c))
+    ref = seal(ID_REF, struct.pack("<BIH", counter, int(theta / 3 / (2 * math.pi) * 2**32) & 0xFFFFFFFF, 0))
+    return [line(t, ID_SAMPLE, res), line(t + 1, ID_CURRENTS, cur), line(t + 2, ID_REF, ref)]
+
+
+def clean_log():
+    """List of lines: BENCH_INFO then N_SAMPLES periods (3 lines each)."""
+    info = seal(ID_INFO, struct.pack("<BBBBHB", 1, 3, 4, 16, 2000, 0))
+    lines = [line(T0_US, ID_INFO, info)]
+    for k in range(N_SAMPLES):
+        lines.extend(sample_lines(k))
+    return lines
+
+
+def index_of(k, slot):
+    """Line index (0-based) of control period k's frame in slot 0/1/2."""
+    return 1 + 3 * k + slot
+
+
+def time_of(text):
+    return text[: text.index(")") + 1]
+
+
+def replace_data(text, new_frame):
+    """Same timestamp and interface, another '<id>#<data>'."""
+    head, _, _ = text.rpartition(" ")
+    return head + " " + new_frame
+
+
+def data_of(text):
+    return bytes.fromhex(text.rpartition("#")[2])
+
+
+cases = []
+
+
+def log_case(name, lines, reason, count, message, also=None, note=""):
+    path = os.path.join(CASES, name + ".log")
+    with open(path, "w", encoding="ascii", newline="\n") as f:
+        f.write("\n".join(lines) + "\n")
+    case = {"file": "cases/" + name + ".log", "kind": "log", "expected_reason": reason,
+            "expected_count": count, "expected_message_substring": message}
+    if also:
+        case["also_expected"] = also
+    if note:
+        case["note"] = note
+    cases.append(case)
+
+
+def text_case(name, ext, kind, text, message, note="", dbc=None):
+    path = os.path.join(CASES, name + ext)
+    with open(path, "w", encoding="ascii", newline="\n") as f:
+        f.write(text)
+    case = {"file": "cases/" + name + ext, "kind": kind, "expected_reason": None, "expected_count": 0,
+            "expected_message_substring": message}
+    if dbc:
+        case["dbc"] = "cases/" + dbc
+    if note:
+        case["note"] = note
+    cases.append(case)
+
+
+def inserted(at, new_line):
+    lines = clean_log()
+    lines.insert(at, new_line)
+    return lines
+
+
+def main():
+    os.makedirs(CASES, exist_ok=True)
+    for old in os.listdir(CASES):
+        os.remove(os.path.join(CASES, old))
+    base = clean_log()
+    # Line numbers below are 1-based file lines: an inserted line at index i is line i + 1.
+    after = index_of(5, 2) + 1  # right after period 5's last frame
+    t5 = time_of(base[index_of(5, 2)])
+
+    log_case("clean", base, None, 0, "", note="the unmodified base log: no rejects at all")
+
+    # ---- malformed lines (candump_line.h LogLineError); added lines, so nothing else is touched
+    log_case("bad_hex", inserted(after, t5 + " can0 101#0A3200CEFF4G01E8"), "bad_hex", 1,
+             "bad_hex.log:%d:41: expected a hex digit 0-9/A-F in the data, found 'G'" % (after + 1))
+    log_case("odd_nibbles", inserted(after, t5 + " can0 101#0A3200CEFF4C01E"), "odd_nibbles", 1,
+             "odd_nibbles.log:%d:" % (after + 1))
+    log_case("dlc_too_long_classic", inserted(after, t5 + " can0 101#0A3200CEFF4C01E8AA"), "dlc_too_long", 1,
+             "classic CAN frame has 9 data bytes, at most 8 are allowed")
+    log_case("missing_timestamp", inserted(after, "can0 101#0A3200CEFF4C01E8"), "missing_timestamp", 1,
+             "missing_timestamp.log:%d:1: expected '(' opening the timestamp" % (after + 1))
+    earlier = replace_data(base[index_of(2, 0)], "7FF#00")  # period 2's time, after period 5
+    log_case("non_monotonic_timestamp", inserted(after, earlier), "non_monotonic_timestamp", 1,
+             "non_monotonic_timestamp.log:%d:" % (after + 1))
+    log_case("bad_fd_flags", inserted(after, t5 + " can0 101##80A3200CEFF4C01E8"), "bad_fd_flags", 1,
+             "expected the CAN FD flags nibble 0-7")
+    log_case("bad_fd_length", inserted(after, t5 + " can0 101##10A3200CEFF4C01E8AA"), "dlc_too_long", 1,
+             "not a valid FD length")
+    log_case("bad_id_digits", inserted(after, t5 + " can0 1010#0A3200CEFF4C01E8"), "bad_id", 1,
+             "CAN id '1010' has 4 hex digits")
+    log_case("bad_id_range", inserted(after, t5 + " can0 800#0A3200CEFF4C01E8"), "bad_id", 1,
+             "standard CAN id 0x800 is above 0x7FF")
+    log_case("bad_timestamp", inserted(after, "(17000000x0.000000) can0 101#00"), "bad_timestamp", 1,
+             "bad_timestamp.log:%d:10:" % (after + 1))
+    log_case("missing_frame", inserted(after, t5 + " can0"), "missing_frame", 1,
+             "missing_frame.log:%d:25: expected the frame '<id>#<data>' after interface 'can0'" % (after + 1))
+    log_case("missing_frame_trailing_blanks", inserted(after, t5 + " can0 \t \r"), "missing_frame", 1,
+             "missing_frame_trailing_blanks.log:%d:25: expected the frame" % (after + 1),
+             note="trailing blanks and CR are trimmed before parsing")
+    log_case("missing_interface", inserted(after, t5), "missing_interface", 1,
+             "missing_interface.log:%d:20: expected the interface name (e.g. can0) after the timestamp" % (after + 1))
+    log_case("bad_separator", inserted(after, t5 + " can0 101#0A3200CEFF4C01E8 junk"), "bad_separator", 1,
+             "unexpected text after the frame, found 'j'")
+    log_case("line_too_long", inserted(after, t5 + " can0 101#" + "A" * 5000), "line_too_long", 1,
+             "line_too_long.log:%d:4097: line is" % (after + 1))
+    flood = clean_log()
+    for n in range(12):
+        flood.insert(after + n, t5 + " can0 101#ZZ")
+    log_case("bad_hex_flood", flood, "bad_hex", 12,
+             "further 'bad_hex' problems are counted (health_t, final report), not printed",
+             note="only the first ten of a kind are printed; all twelve are counted")
+
+    # ---- frames that parse but fail the bench layout (frame_decoder.h FrameReject)
+    bad = bytearray(data_of(base[index_of(5, 1)]))
+    bad[2] ^= 0x10  # one bit flipped, CRC byte kept: a CRC mismatch
+    log_case("crc_mismatch", inserted(index_of(5, 1) + 1, replace_data(base[index_of(5, 1)], "101#" + bad.hex().upper())),
+             "crc", 1, "line %d: frame 101 at (1700000000.003001): CRC-8 J1850 mismatch" % (index_of(5, 1) + 2), note="corrupted copy added next to the good frame, so counters stay clean")
+    last5 = base[index_of(5, 2)]  # added frames take the previous frame's time (equal times are fine)
+    log_case("unknown_id", inserted(after, replace_data(last5, "321#" + data_of(base[index_of(5, 1)]).hex().upper())),
+             "unknown_id", 1, "line %d: frame 321 at (1700000000.003002): unknown CAN ID" % (after + 1))
+    log_case("wrong_dlc", inserted(after, replace_data(last5, "101#" + data_of(base[index_of(5, 1)])[:6].hex().upper())),
+             "wrong_dlc", 1, "line %d: frame 101 at (1700000000.003002): length 6 differs from the DBC's DLC" % (after + 1))
+    log_case("remote_frame", inserted(after, replace_data(last5, "101#R")),
+             "remote_frame", 1, "line %d: frame 101 at (1700000000.003002): remote (RTR) frame" % (after + 1))
+
+    # ---- counter supervision (counter_check.h) and joining (sample_joiner.h)
+    dup = clean_log()
+    dup.insert(index_of(6, 1) + 1, dup[index_of(6, 1)])  # exact copy right after the original
+    log_case("counter_repeated", dup, "counter_repeated", 1,
+             "line %d: frame 101 at (1700000000.003501): PHASE_CURRENTS counter 6 repeated" % (index_of(6, 1) + 2))
+    gap = clean_log()
+    del gap[index_of(7, 0): index_of(8, 2) + 1]  # periods 7 and 8 lost entirely
+    log_case("counter_gap", gap, "counter_gap", 3, "RESOLVER_SAMPLE counter jumped to 9, 2 frame(s) lost",
+             also={"frames_lost": 6},
+             note="each of the three sample messages sees its counter jump 6 -> 9 once; frames_lost = 6")
+    jump = clean_log()
+    del jump[index_of(7, 0): index_of(18, 2) + 1]  # 12 periods lost: more than max_counter_delta = 8
+    log_case("counter_wrong_sequence", jump, "counter_wrong_sequence", 3,
+             "RESOLVER_SAMPLE counter jumped to 19 (more than 8 lost): resynchronised",
+             note="12 periods lost, more than max_counter_delta = 8: each message resynchronises once")
+    missing = clean_log()
+    del missing[index_of(10, 1)]  # period 10 without its PHASE_CURRENTS frame
+    log_case("sample_missing_frame", missing, "sample_incomplete", 1, "sample counter 10 (index 10) is missing PHASE_CURRENTS",
+             also={"counter_gap": 1, "frames_lost": 1},
+             note="PHASE_CURRENTS' counter also jumps 9 -> 11 (one frame lost)")
+
+    # ---- configuration and DBC: resolverd must refuse to start, exit 2, say where and why
+    text_case("bad_toml", ".toml", "config", "[bench]\np_r = = 3\n",
+              "bad_toml.toml:2:7: TOML syntax error")
+    text_case("unknown_config_key", ".toml", "config", "[bench]\np_r = 3\npole_pairs = 4\n",
+              "unknown key 'pole_pairs' in [bench]")
+    text_case("bad_config_value", ".toml", "config", "[output]\nangle_decimation = 0\n",
+              "[output] angle_decimation must be >= 1, got 0")
+    text_case("bad_signal_map", ".toml", "config",
+              "[layout.signals]\nsin = \"RESOLVER_SAMPLE.sine\"\ncos = \"RESOLVER_SAMPLE.cos\"\n",
+              "message 'RESOLVER_SAMPLE' has no signal 'sine'")
+    with open(os.path.join(HERE, "..", "..", "proto", "resolver_bench.dbc"), encoding="ascii") as f:
+        bench_dbc = f.read()
+    broken = bench_dbc.replace("BO_ 257 PHASE_CURRENTS: 8 INVERTER", "BO_ 257 PHASE_CURRENTS 8 INVERTER")
+    assert broken != bench_dbc
+    broken_line = broken[: broken.index("BO_ 257 PHASE_CURRENTS 8")].count("\n") + 1
+    text_case("dbc_syntax_error", ".dbc", "dbc", broken, "dbc_syntax_error.dbc:%d:" % broken_line,
+              note="the bench DBC with the ':' after PHASE_CURRENTS removed; loaded through a config")
+    with open(os.path.join(CASES, "dbc_syntax_error.toml"), "w", encoding="ascii") as f:
+        f.write("[layout]\ndbc = \"cases/dbc_syntax_error.dbc\"\n")
+    cases[-1]["config"] = "cases/dbc_syntax_error.toml"
+    signal_past = bench_dbc.replace("SG_ crc : 56|8@1+", "SG_ crc : 60|8@1+", 1)
+    assert signal_past != bench_dbc
+    text_case("dbc_signal_past_dlc", ".dbc", "dbc", signal_past, "dbc_signal_past_dlc.dbc:",
+              note="RESOLVER_SAMPLE.crc moved to bits 60..67 of an 8-byte message")
+    with open(os.path.join(CASES, "dbc_signal_past_dlc.toml"), "w", encoding="ascii") as f:
+        f.write("[layout]\ndbc = \"cases/dbc_signal_past_dlc.dbc\"\n")
+    cases[-1]["config"] = "cases/dbc_signal_past_dlc.toml"
+
+    with open(os.path.join(HERE, "cases.json"), "w", encoding="ascii") as f:
+        json.dump({"comment": "Written by make_cases.py; read by run_bad_inputs.py. Paths are relative to "
+                              "tests/bad_input/, where resolverd runs.", "cases": cases}, f, indent=2)
+        f.write("\n")
+    print("wrote %d cases to %s" % (len(cases), CASES))
+
+
+if __name__ == "__main__":
+    main()

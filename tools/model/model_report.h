@@ -1,0 +1,18 @@
+// Text and JSON renderings of a model-discovery result (resolver-model).
+// JSON keys (issue 4): effects, params {name: {value, stderr}}, residual_rms_rad,
+// noise_floor_rad, candidates [{effect, residual_after_rad, score, reason, ...}]
+// best first, verdict; plus signals, harmonics, speed_bins, notes.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "daemon/core/discovery/model_discovery.h"
+
+namespace resolver {
+
+/// `explained` = false: the fit only (candidates and verdict omitted).
+[[nodiscard]] std::string format_model_text(const Explanation& ex, bool explain, const std::vector<std::string>& notes);
+[[nodiscard]] std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes);
+
+}  // namespace resolver
