@@ -334,13 +334,13 @@ std::optional<LogLineProblem> parse_candump_line(std::string_view line, CanFrame
   }
   for (std::size_t k = 0; k < iface.size(); ++k) {
     const auto ch = static_cast<unsigned char>(iface[k]);
-    if (ch < 0x20 || ch == 0x7F) {
-      // Found by fuzzing: a NUL or control byte would be cut or mangled in the
+    if (ch < 0x20 || ch >= 0x7F) {
+      // Found by fuzzing: a NUL, control or non-ASCII byte would be cut or mangled in the
       // stored name, so the frame could not be written back as the same line.
       return problem(LogLineError::kMissingInterface, iface_begin + k,
-                     "interface name contains the control byte 0x" + std::string(1, "0123456789abcdef"[ch >> 4U]) +
+                     "interface name contains the byte 0x" + std::string(1, "0123456789abcdef"[ch >> 4U]) +
                          std::string(1, "0123456789abcdef"[ch & 0xFU]) +
-                         "; interface names are printable (e.g. can0): the log line is corrupted");
+                         "; interface names are printable ASCII (e.g. can0): the log line is corrupted");
     }
   }
   if (iface.size() >= CanFrame::kMaxIfaceLen) {

@@ -53,10 +53,6 @@ fi
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 cmake_args=(-S "$repo" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
             -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_C_FLAGS=$san" "-DCMAKE_CXX_FLAGS=$san")
-# Until tests/CMakeLists.txt lists the folder, attach it through a project hook.
-if ! grep -Eq '^[[:space:]]*add_subdirectory\([[:space:]]*fuzz[[:space:]]*\)' "$repo/tests/CMakeLists.txt"; then
-  cmake_args+=("-DCMAKE_PROJECT_INCLUDE=$repo/tests/fuzz/attach_test_dirs.cmake" "-DRESOLVER_ATTACH_TEST_DIRS=fuzz")
-fi
 echo "== configuring $build (clang, ASan + UBSan + libFuzzer)"
 cmake "${cmake_args[@]}" >"$build.configure.log" 2>&1 || { cat "$build.configure.log" >&2; exit 2; }
 echo "== building ${targets[*]}"
