@@ -57,7 +57,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
   const ModelEstimate model = p.processor().estimate();
   if (pc.method == EstimatorMethod::kHwangIntegral) {
-    out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.6f} (std. error; spread {:.6f} over {} revolutions) {}\n",
+    out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.2e} (std. error; spread {:.2e} over {} revolutions) {}\n",
                        est.alpha(), est.alpha_stderr(), est.alpha_spread(), est.revolutions(),
                        est.converged() ? "converged" : "NOT converged");
     out << fmt::format("             revolutions rejected: speed not constant {}, too few samples {}, too slow {}\n",
