@@ -4,7 +4,7 @@
 
 namespace resolver {
 
-bool RevolutionRipple::update(double theta_e, double i_d, double i_q) {
+bool RevolutionRipple::update(double theta_e, double cos_e, double sin_e, double i_d, double i_q) {
   const auto index = static_cast<std::int64_t>(std::floor(theta_e / kTwoPi));
   bool completed = false;
   if (!started_) {
@@ -54,7 +54,7 @@ bool RevolutionRipple::update(double theta_e, double i_d, double i_q) {
   }
   if (in_revolution_) {
     // One sin/cos per sample: exp(-j 2 theta) and exp(-j 6 theta) are powers of exp(-j theta).
-    const std::complex<double> w1(std::cos(theta_e), -std::sin(theta_e));
+    const std::complex<double> w1(cos_e, -sin_e);
     const std::complex<double> w2 = w1 * w1;
     const std::complex<double> w6 = w2 * w2 * w2;
     static_assert(kRippleOrders[0] == 1 && kRippleOrders[1] == 2 && kRippleOrders[2] == 6);

@@ -42,7 +42,11 @@ class RevolutionRipple {
   /// Feeds one sample: theta_e continuous (unwrapped) [rad], i_d, i_q [A].
   /// Returns true when this sample completed a revolution; `last()` then holds
   /// the ripple of that revolution.
-  bool update(double theta_e, double i_d, double i_q);
+  bool update(double theta_e, double i_d, double i_q) {
+    return update(theta_e, std::cos(theta_e), std::sin(theta_e), i_d, i_q);
+  }
+  /// Same, with cos/sin of theta_e already computed (the caller's Park transform has them).
+  bool update(double theta_e, double cos_e, double sin_e, double i_d, double i_q);
 
   [[nodiscard]] const RippleAmplitudes& last() const { return last_; }
   [[nodiscard]] bool valid() const { return revolutions_ > 0; }

@@ -117,35 +117,27 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   out.electrical_freq_hz = config_.p * out.speed_mech / kTwoPi;
   const ClarkeTransform ab(in.i_a, in.i_b, in.i_c);
 
-  const double e_raw = ratio * rd_cont;
-  const ParkTransform raw(ab.alpha, ab.beta, e_raw);
-  out.i_d_raw = raw.d;
-  out.i_q_raw = raw.q;
-  const double e_comp = ratio * (rd_cont + out.eps_hat);
-  const ParkTransform comp(ab.alpha, ab.beta, e_comp);
-  out.i_d_comp = comp.d;
-  out.i_q_comp = comp.q;
-
-  if (ripple_raw_.update(e_raw, raw.d, raw.q)) {
-    ripple_.raw = ripple_raw_.last();
-    ripple_.raw_valid = true;
-    out.ripple_raw_updated = true;
-  }
-  if (ripple_comp_.update(e_comp, comp.d, comp.q)) {
-    ripple_.comp = ripple_comp_.last();
-    ripple_.comp_valid = true;
-    out.ripple_comp_updated = true;
-  }
+  // dq and ripple with one angle: cos/sin of theta_e computed once, shared by
+  // the Park transform and the ripple DFT.
+  auto dq_with = [&ab](double theta_e, RevolutionRipple& tracker, RippleAmplitudes& ripple, bool& valid,
+                       double& i_d, double& i_q) {
+    const double c = std::cos(theta_e);
+    const double s = std::sin(theta_e);
+    const ParkTransform dq(ab.alpha, ab.beta, c, s);
+    i_d = dq.d;
+    i_q = dq.q;
+    if (!tracker.update(theta_e, c, s, dq.d, dq.q)) return false;
+    ripple = tracker.last();
+    valid = true;
+    return true;
+  };
+  out.ripple_raw_updated =
+      dq_with(ratio * rd_cont, ripple_raw_, ripple_.raw, ripple_.raw_valid, out.i_d_raw, out.i_q_raw);
+  out.ripple_comp_updated = dq_with(ratio * (rd_cont + out.eps_hat), ripple_comp_, ripple_.comp, ripple_.comp_valid,
+                                    out.i_d_comp, out.i_q_comp);
   if (in.has_ref) {
-    const double e_ref = config_.p * theta_ref_cont;
-    const ParkTransform ref(ab.alpha, ab.beta, e_ref);
-    out.i_d_ref = ref.d;
-    out.i_q_ref = ref.q;
-    if (ripple_ref_.update(e_ref, ref.d, ref.q)) {
-      ripple_.ref = ripple_ref_.last();
-      ripple_.ref_valid = true;
-      out.ripple_ref_updated = true;
-    }
+    out.ripple_ref_updated = dq_with(config_.p * theta_ref_cont, ripple_ref_, ripple_.ref, ripple_.ref_valid,
+                                     out.i_d_ref, out.i_q_ref);
   } else {
     out.i_d_ref = kNaN;
     out.i_q_ref = kNaN;
