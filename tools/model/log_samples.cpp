@@ -44,6 +44,9 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
                            d.has_ref = s.has(Role::kRefAngle);
                            d.theta_m_ref = s.get(Role::kRefAngle);
                            d.has_currents = s.has(Role::kIA) && s.has(Role::kIB) && s.has(Role::kIC);
+                           d.i_a = s.get(Role::kIA);
+                           d.i_b = s.get(Role::kIB);
+                           d.i_c = s.get(Role::kIC);
                            out.input.samples.push_back(d);
                          },
                          [&](const BenchInfo& i) {

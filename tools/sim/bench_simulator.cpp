@@ -94,6 +94,14 @@ SimConfig validated(SimConfig c) {
   require(c.chain.tracking_loop.zeta > 0.0, "SimConfig chain.tracking_loop.zeta (--effect tracking_loop:zeta=) must be > 0");
   require(c.chain.noise.sigma_sc >= 0.0 && c.chain.noise.sigma_i >= 0.0, "SimConfig chain.noise sigma_sc/sigma_i (--effect noise:...) must be >= 0");
   require(std::isfinite(c.theta_m0), "SimConfig theta_m0 must be finite [rad]");
+  if (c.alpha_drift_per_s != 0.0) {
+    // alpha(t) is linear: checking the end of the run checks every sample.
+    const double end = c.chain.amplitude_imbalance.alpha + c.alpha_drift_per_s * SpeedProfile(c.profile).duration();
+    require(std::isfinite(c.alpha_drift_per_s) && end > -1.0 && end < 0.2,
+            fmt::format("SimConfig alpha_drift_per_s (--alpha-drift) = {}: alpha reaches {} at the end of the run; it "
+                        "must stay in (-1, 0.2)",
+                        c.alpha_drift_per_s, end));
+  }
   // The envelopes must stay inside the ADC: check the peak over a fine theta grid.
   double peak = 0.0;
   for (int i = 0; i < 3600; ++i) {
@@ -122,7 +130,8 @@ BenchSimulator::BenchSimulator(SimConfig config)
     : config_(validated(std::move(config))),
       profile_(config_.profile),
       loop_(config_.chain.tracking_loop),
-      engine_(config_.seed) {
+      engine_(config_.seed),
+      alpha0_(config_.chain.amplitude_imbalance.alpha) {
   // Samples at t = 0, 1/fs, ... strictly inside the profile's duration.
   const double n = std::ceil(profile_.duration() * config_.sample_rate_hz - 1e-9);
   total_ = static_cast<std::uint64_t>(std::max(n, 1.0));
@@ -150,6 +159,8 @@ bool BenchSimulator::next(SimSample& out) {
   if (index_ >= total_) return false;
   const double t = sample_time_s(index_);
   const double p_r = config_.p_r;
+  // Drift: alpha is held for each sample period (the loop step below sees the new value).
+  if (config_.alpha_drift_per_s != 0.0) config_.chain.amplitude_imbalance.alpha = alpha0_ + config_.alpha_drift_per_s * t;
   if (index_ > 0) {
     const double t_prev = sample_time_s(index_ - 1);
     loop_.advance([&](double tt) { return sensor_envelopes(config_.chain, resolver_angle_at(tt)); }, t_prev,

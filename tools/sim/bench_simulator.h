@@ -66,6 +66,10 @@ struct SimConfig {
   std::uint64_t seed = 1;
   std::int64_t start_time_us = 1700000000000000;  ///< [us] timestamp of sample 0
   double theta_m0 = 0;                            ///< [rad] mechanical angle at t = 0
+  /// [1/s] the amplitude imbalance drifts linearly in time, alpha(t) = alpha + drift t
+  /// (a winding warming up). NOT a catalog effect: it exists so tests can check that
+  /// model discovery does not force a catalog name onto an error outside the catalog.
+  double alpha_drift_per_s = 0;
   std::string iface = "can0";                     ///< interface name written into the frames
 };
 
@@ -120,6 +124,7 @@ class BenchSimulator {
   NoiseEngine engine_;
   std::uint64_t total_ = 0;
   std::uint64_t index_ = 0;
+  double alpha0_ = 0.0;  ///< chain alpha at t = 0 (config_.chain's alpha follows the drift)
 };
 
 /// Frames per second the configuration puts on the bus (for the bus-load check).

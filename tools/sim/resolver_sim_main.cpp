@@ -60,6 +60,7 @@ struct Options {
   double sample_rate = 2000.0;
   double amplitude = 26000.0;
   double iq = 10.0;
+  double alpha_drift = 0.0;
   double id = 0.0;
   std::vector<std::string> effects;
   bool no_reference = false;
@@ -108,6 +109,7 @@ void apply_toml(const std::string& path, const CLI::App& app, Options& o, std::v
     else if (key == "sample_rate") { if (unset("--sample-rate")) o.sample_rate = number(key, node); }
     else if (key == "amplitude") { if (unset("--amplitude")) o.amplitude = number(key, node); }
     else if (key == "iq") { if (unset("--iq")) o.iq = number(key, node); }
+    else if (key == "alpha_drift") { if (unset("--alpha-drift")) o.alpha_drift = number(key, node); }
     else if (key == "id") { if (unset("--id")) o.id = number(key, node); }
     else if (key == "seed") { if (unset("--seed")) o.seed = static_cast<std::uint64_t>(integer(key, node)); }
     else if (key == "iface") { if (unset("--iface")) o.iface = text(key, node); }
@@ -145,6 +147,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
   c.sample_rate_hz = o.sample_rate;
   c.amplitude_counts = o.amplitude;
   c.i_q_cmd = o.iq;
+  c.alpha_drift_per_s = o.alpha_drift;
   c.i_d_cmd = o.id;
   c.reference = !o.no_reference;
   c.seed = o.seed;
@@ -183,6 +186,9 @@ int main(int argc, char** argv) {
   app.add_option("--amplitude", o.amplitude, "sin/cos envelope amplitude [ADC counts] (default 26000)");
   app.add_option("--iq", o.iq, "commanded q current [A] (default 10)");
   app.add_option("--id", o.id, "commanded d current [A] (default 0)");
+  app.add_option("--alpha-drift", o.alpha_drift,
+                 "[1/s] let amplitude imbalance drift linearly in time (a winding warming up); NOT a catalog effect: "
+                 "a test log for an error the model cannot name (default 0)");
   app.add_option("--effect,-e", o.effects, "effect spec effect:param=value,... (repeatable; see the catalog below)");
   app.add_flag("--no-reference", o.no_reference, "do not send REFERENCE_ANGLE frames");
   app.add_option("--seed", o.seed, "noise seed (default 1; same seed, same log)");

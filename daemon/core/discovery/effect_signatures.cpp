@@ -4,6 +4,10 @@
 #include <cmath>
 #include <complex>
 
+#include "daemon/core/effects/current_gain_mismatch.h"
+#include "daemon/core/effects/current_offsets.h"
+#include "daemon/core/effects/dead_time.h"
+
 namespace resolver {
 
 namespace {
@@ -66,6 +70,32 @@ void eccentricity(const SignatureContext& x, double* rd, double* s, double* c) {
   }
 }
 
+// Current side: each signature is linear in its parameters, so the column of a
+// parameter is the effect's dq error with that parameter at 1 and the others at 0.
+void current_offsets(const SignatureContext& x, double* d, double* q) {
+  const DqCurrents a = current_offsets_dq_error(CurrentOffsets{1.0, 0.0}, x.theta_e);
+  const DqCurrents b = current_offsets_dq_error(CurrentOffsets{0.0, 1.0}, x.theta_e);
+  d[0] = a.d;
+  q[0] = a.q;
+  d[1] = b.d;
+  q[1] = b.q;
+}
+
+void current_gain_mismatch(const SignatureContext& x, double* d, double* q) {
+  const DqCurrents a = current_gain_mismatch_dq_error(CurrentGainMismatch{1.0, 0.0}, x.i_d0, x.i_q0, x.theta_e);
+  const DqCurrents b = current_gain_mismatch_dq_error(CurrentGainMismatch{0.0, 1.0}, x.i_d0, x.i_q0, x.theta_e);
+  d[0] = a.d;
+  q[0] = a.q;
+  d[1] = b.d;
+  q[1] = b.q;
+}
+
+void dead_time(const SignatureContext& x, double* d, double* q) {
+  const DqCurrents a = dead_time_dq_error(DeadTime{1.0}, x.i_d0, x.i_q0, x.theta_e);  // per second of t_d
+  d[0] = a.d;
+  q[0] = a.q;
+}
+
 constexpr std::array<std::string_view, 1> kAlpha{"alpha"};
 constexpr std::array<std::string_view, 1> kBeta{"beta"};
 constexpr std::array<std::string_view, 2> kOffsets{"o_s", "o_c"};
@@ -74,8 +104,11 @@ constexpr std::array<std::string_view, 1> kTau{"tau"};
 constexpr std::array<std::string_view, 1> kOmegaN{"omega_n"};
 constexpr std::array<std::string_view, 1> kTheta0{"theta_0"};
 constexpr std::array<std::string_view, 2> kEcc{"e_cos_phase", "e_sin_phase"};
+constexpr std::array<std::string_view, 2> kCurrentOffsets{"off_a", "off_b"};
+constexpr std::array<std::string_view, 2> kGains{"gain_a", "gain_b"};
+constexpr std::array<std::string_view, 1> kDeadTime{"t_d"};
 
-constexpr std::array<EffectSignature, 8> kSignatures{{
+constexpr std::array<EffectSignature, 11> kSignatures{{
     {"amplitude_imbalance", kAlpha, false, false,
      "a gain error of the cos channel: position error at 2 theta in phase with sin 2 theta, independent of speed, "
      "and a cos-envelope amplitude off by alpha",
@@ -106,6 +139,18 @@ constexpr std::array<EffectSignature, 8> kSignatures{{
     {"mounting_offset", kTheta0, true, false,
      "the resolver is mounted at an angle: a constant position error against the reference, at every speed",
      mounting_offset},
+    {"current_offsets", kCurrentOffsets, true, false,
+     "DC offsets of the phase current sensors: i_d and i_q ripple at 1x theta_e, a quarter period apart, "
+     "independent of load and speed; the resolver signals are clean",
+     nullptr, current_offsets},
+    {"current_gain_mismatch", kGains, true, false,
+     "the phase current sensors differ in gain: i_d and i_q ripple at 2x theta_e proportional to the current, "
+     "while the resolver signals are clean (so it is not the resolver's amplitude imbalance)",
+     nullptr, current_gain_mismatch},
+    {"dead_time", kDeadTime, true, false,
+     "inverter dead time: 5th and 7th harmonics of the phase currents, i.e. a 6x theta_e ripple on i_d and i_q "
+     "perpendicular to the current vector",
+     nullptr, dead_time},
 }};
 
 }  // namespace

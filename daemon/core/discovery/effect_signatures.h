@@ -21,6 +21,15 @@
 //                        so every rd term at frequency k omega is multiplied by
 //                        H(j k omega) = g e^{j phi}: sin(k theta) -> g sin(k theta + phi).
 //                        Constant speed has no lag (type II); acceleration lag is ignored.
+// Current-side effects act on the phase currents only. Their rows are the dq
+// currents computed with the reference angle (theta_e = p theta_m), so the resolver's
+// own errors do not enter them; the regressors are the effects' exact dq signatures
+// (daemon/core/effects/*_dq_error) per unit parameter, taken at the mean measured
+// current I0 = (i_d0, i_q0) (the machine carries the commanded current, Hwang's
+// ideal-control picture; products of a gain error with its own DC shift are dropped):
+//   current_offsets       off_a, off_b [A]: 1x theta_e ripple            (current_offsets.h)
+//   current_gain_mismatch gain_a, gain_b [1]: DC shift + 2x theta_e ripple (current_gain_mismatch.h)
+//   dead_time             t_d [s]: 6x theta_e ripple perpendicular to I0   (dead_time.h)
 // Omitted terms are second order in the parameters (products of effects).
 #pragma once
 
@@ -41,6 +50,9 @@ struct SignatureContext {
   /// alpha / (2 + alpha) (angle_error_fourier.h), while the cos envelope carries alpha
   /// itself; linearising at alpha_hat keeps the two signals consistent to O(alpha^3).
   double alpha_hat = 0.0;
+  double theta_e = 0.0;  ///< [rad] true motor electrical angle (current rows only)
+  double i_d0 = 0.0;     ///< [A] mean measured d current (current rows only)
+  double i_q0 = 0.0;     ///< [A] mean measured q current
 };
 
 struct EffectSignature {
@@ -49,8 +61,11 @@ struct EffectSignature {
   bool needs_reference;  ///< mechanical angle or absolute constant needed
   bool nonlinear;        ///< tracking_loop: searched, no columns
   std::string_view physics;  ///< one sentence: what the effect does to the signals
-  /// Fills rd[i], s[i], c[i] for each parameter i. nullptr for nonlinear effects.
+  /// Fills rd[i], s[i], c[i] for each parameter i. nullptr for nonlinear and current-side effects.
   void (*regress)(const SignatureContext&, double* rd, double* s, double* c);
+  /// Current-side effects: fills d[i], q[i] [A per unit parameter]. nullptr for resolver effects.
+  void (*regress_dq)(const SignatureContext&, double* d, double* q) = nullptr;
+  [[nodiscard]] bool current_side() const { return regress_dq != nullptr; }
 };
 
 /// The fittable effects, in catalog order.

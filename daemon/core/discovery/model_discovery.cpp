@@ -10,6 +10,7 @@
 #include "daemon/core/angles.h"
 #include "daemon/core/discovery/effect_signatures.h"
 #include "daemon/core/effects/effect_catalog.h"
+#include "daemon/core/estimation/dq_transform.h"
 
 namespace resolver {
 
@@ -39,6 +40,10 @@ struct Row {
   double eps = 0.0;      // [rad]
   double ys = 0.0, yc = 0.0;
   bool env = false;
+  double theta_e = 0.0;           // [rad] true motor electrical angle (currents only)
+  double i_al = 0.0, i_be = 0.0;  // [A] Clarke of the measured phase currents
+  double id = 0.0, iq = 0.0;      // [A] Park at theta_e
+  bool cur = false;
   int bin = 0;
 };
 
@@ -46,9 +51,11 @@ struct Prepared {
   int p_r = 3, p = 3;
   bool reference = false;
   bool env = false;
+  bool cur = false;
   std::vector<Row> rows;
   std::vector<double> bin_edges;  // size bins + 1 [rad/s]
-  double floor_rd = 0.0, floor_env = 0.0;
+  double floor_rd = 0.0, floor_env = 0.0, floor_i = 0.0;
+  double i_d0 = 0.0, i_q0 = 0.0;  // [A] mean measured dq current
   double sample_period = 0.0;
   std::vector<std::string> notes;
 };
@@ -83,12 +90,13 @@ std::vector<double> ls_residual(std::size_t n, int k, Fill&& fill, const std::ve
 
 /// The fully flexible angle model of one bin: [1, sin n theta, cos n theta (n <= order)]
 /// plus 1x/2x mechanical with a reference.
-void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x) {
+void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x, bool electrical = false) {
+  const double a = electrical ? r.theta_e : r.theta;
   int j = 0;
   x[j++] = 1.0;
   for (int n = 1; n <= order; ++n) {
-    x[j++] = std::sin(n * r.theta);
-    x[j++] = std::cos(n * r.theta);
+    x[j++] = std::sin(n * a);
+    x[j++] = std::cos(n * a);
   }
   if (mech) {
     for (int n = 1; n <= 2; ++n) {
@@ -102,8 +110,10 @@ void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x) {
 /// then second differences of consecutive samples, which remove whatever smooth
 /// structure is left (a drift in time, a slow speed change): for white noise of
 /// standard deviation sigma, var(r[i+1] - 2 r[i] + r[i-1]) = 6 sigma^2.
-double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all,
-                   double (*value)(const Row&)) {
+/// `electrical`: the signal's harmonics are of theta_e (currents), not theta.
+double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all, double (*value)(const Row&),
+                   bool electrical = false) {
+  const double speed_ratio = electrical ? static_cast<double>(prep.p) / static_cast<double>(prep.p_r) : 1.0;
   const int bins = static_cast<int>(prep.bin_edges.size()) - 1;
   double sum = 0.0;
   std::int64_t count = 0;
@@ -113,7 +123,7 @@ double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all
     for (std::size_t i : idx_all) {
       if (prep.rows[i].bin == b) {
         idx.push_back(i);
-        wmax = std::max(wmax, std::abs(prep.rows[i].omega));
+        wmax = std::max(wmax, speed_ratio * std::abs(prep.rows[i].omega));
       }
     }
     const int order = nyquist_order(wmax, prep.sample_period);
@@ -122,7 +132,8 @@ double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all
     std::vector<double> y(idx.size());
     for (std::size_t i = 0; i < idx.size(); ++i) y[i] = value(prep.rows[idx[i]]);
     const auto r = ls_residual(
-        idx.size(), k, [&](std::size_t i, Eigen::VectorXd& x) { saturated_basis(prep.rows[idx[i]], order, prep.reference, x); },
+        idx.size(), k,
+        [&](std::size_t i, Eigen::VectorXd& x) { saturated_basis(prep.rows[idx[i]], order, prep.reference, x, electrical); },
         y);
     for (std::size_t i = 1; i + 1 < idx.size(); ++i) {
       if (idx[i + 1] - idx[i - 1] != 2) continue;  // consecutive samples only
@@ -216,8 +227,9 @@ Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
   }
   if (!sincos) p.notes.push_back("no sin/cos envelopes: only the R/D angle is fitted (k3 and alpha are not separable)");
   else if (!p.reference) p.notes.push_back("sin/cos envelopes present but not fitted without a reference angle");
-  if (with_i > 0) p.notes.push_back("phase currents present but not fitted in this version (dq residual not reported)");
-  else p.notes.push_back("no phase currents in the log");
+  const bool currents = static_cast<double>(with_i) >= kSignalPresentShare * share;
+  if (!currents) p.notes.push_back("no phase currents in the log: current-side effects are not evaluated");
+  else if (!p.reference) p.notes.push_back("phase currents present but not fitted without a reference angle (dq needs the true theta_e)");
 
   const std::size_t n = s.size();
   std::vector<double> t(n), truth(n), mech(n, 0.0);
@@ -275,6 +287,16 @@ Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
       r.ys = s[i]->sin / amp - std::sin(r.theta);
       r.yc = s[i]->cos / amp - std::cos(r.theta);
     }
+    if (currents && p.reference && s[i]->has_currents) {
+      r.cur = true;
+      r.theta_e = static_cast<double>(p.p) * mech[i];
+      const ClarkeTransform ab(s[i]->i_a, s[i]->i_b, s[i]->i_c);
+      const ParkTransform dq(ab.alpha, ab.beta, r.theta_e);
+      r.i_al = ab.alpha;
+      r.i_be = ab.beta;
+      r.id = dq.d;
+      r.iq = dq.q;
+    }
     wlo = std::min(wlo, r.omega);
     whi = std::max(whi, r.omega);
   }
@@ -283,10 +305,27 @@ Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
   for (auto& r : p.rows) {
     r.bin = bins == 1 ? 0 : std::clamp(static_cast<int>((r.omega - wlo) / (whi - wlo) * bins), 0, bins - 1);
   }
-  std::vector<std::size_t> all(n), env_idx;
+  std::vector<std::size_t> all(n), env_idx, cur_idx;
   for (std::size_t i = 0; i < n; ++i) {
     all[i] = i;
     if (p.rows[i].env) env_idx.push_back(i);
+    if (p.rows[i].cur) {
+      cur_idx.push_back(i);
+      p.i_d0 += p.rows[i].id;
+      p.i_q0 += p.rows[i].iq;
+    }
+  }
+  p.cur = !cur_idx.empty();
+  if (p.cur) {
+    p.i_d0 /= static_cast<double>(cur_idx.size());
+    p.i_q0 /= static_cast<double>(cur_idx.size());
+    const double fd = noise_floor(p, cur_idx, [](const Row& r) { return r.id; }, true);
+    const double fq = noise_floor(p, cur_idx, [](const Row& r) { return r.iq; }, true);
+    p.floor_i = std::sqrt(0.5 * (fd * fd + fq * fq));
+    if (!(p.floor_i > 0.0)) {
+      p.cur = false;
+      p.notes.push_back("phase currents present but their noise floor could not be estimated: not fitted");
+    }
   }
   p.floor_rd = noise_floor(p, all, [](const Row& r) { return r.eps; });
   if (p.env) {
@@ -306,6 +345,7 @@ struct Design {
   bool tracking = false;
   bool const_nuisance = false;  // rd constant (no reference: the smoothed angle absorbs it)
   bool gain_nuisance = false;   // envelope amplitude
+  bool current_nuisance = false;  // DC i_d, i_q (the operating point)
   std::vector<std::string> names;
   int k = 0;
 };
@@ -316,6 +356,11 @@ Design make_design(const Prepared& p, std::span<const std::string> effects) {
   d.gain_nuisance = p.env;
   if (d.const_nuisance) d.names.emplace_back("nuisance.rd_constant");
   if (d.gain_nuisance) d.names.emplace_back("nuisance.sincos_gain");
+  d.current_nuisance = p.cur;
+  if (d.current_nuisance) {
+    d.names.emplace_back("nuisance.i_d");
+    d.names.emplace_back("nuisance.i_q");
+  }
   for (const auto& e : effects) {
     const EffectSignature* sig = find_signature(e);
     if (sig == nullptr) {
@@ -328,6 +373,9 @@ Design make_design(const Prepared& p, std::span<const std::string> effects) {
     }
     if (sig->needs_reference && !p.reference) {
       throw std::invalid_argument("effect '" + e + "' needs the reference angle, which this log does not have");
+    }
+    if (sig->current_side() && !p.cur) {
+      throw std::invalid_argument("effect '" + e + "' acts on the phase currents, which this log does not have");
     }
     if (sig->nonlinear) {
       d.tracking = true;
@@ -346,33 +394,54 @@ struct Solved {
   Eigen::VectorXd x;
   Eigen::VectorXd se;
   double rss_w = 0.0;
-  double rss_rd = 0.0, rss_env = 0.0;
-  std::int64_t n_rd = 0, n_env = 0;
+  double rss_rd = 0.0, rss_env = 0.0, rss_i = 0.0;
+  std::int64_t n_rd = 0, n_env = 0, n_i = 0;
   double omega_n = 0.0, omega_n_se = kNaN;
   std::vector<double> resid_rd;
+  std::vector<double> resid_d, resid_q;  // [A] per row; 0 where the row has no currents
 };
 
-/// Regressor rows for one sample: rd, s, c each of length k.
-void fill_rows(const Prepared& p, const Design& d, const Row& r, double omega_n, double alpha_hat, Eigen::VectorXd& xr,
-               Eigen::VectorXd& xs, Eigen::VectorXd& xc) {
-  xr.setZero();
-  xs.setZero();
-  xc.setZero();
+/// Regressor rows of one sample, one entry per column.
+struct RowRegressors {
+  Eigen::VectorXd rd, s, c, d, q;
+  explicit RowRegressors(int k) : rd(k), s(k), c(k), d(k), q(k) {}
+};
+
+/// Regressor rows for one sample: rd, s, c, d, q each of length k.
+void fill_rows(const Prepared& p, const Design& d, const Row& r, double omega_n, double alpha_hat, RowRegressors& x) {
+  x.rd.setZero();
+  x.s.setZero();
+  x.c.setZero();
+  x.d.setZero();
+  x.q.setZero();
   int j = 0;
-  if (d.const_nuisance) xr[j++] = 1.0;
+  if (d.const_nuisance) x.rd[j++] = 1.0;
   if (d.gain_nuisance) {
-    xs[j] = std::sin(r.theta);
-    xc[j] = std::cos(r.theta);
+    x.s[j] = std::sin(r.theta);
+    x.c[j] = std::cos(r.theta);
     ++j;
   }
-  SignatureContext ctx{r.theta, r.theta_m, r.omega, p.p_r, p.p, omega_n, kAssumedZeta, alpha_hat};
-  double br[4], bs[4], bc[4];
+  if (d.current_nuisance) {
+    x.d[j++] = 1.0;
+    x.q[j++] = 1.0;
+  }
+  SignatureContext ctx{r.theta, r.theta_m, r.omega, p.p_r, p.p, omega_n, kAssumedZeta, alpha_hat,
+                       r.theta_e, p.i_d0, p.i_q0};
+  double b0[4], b1[4], b2[4];
   for (const auto* e : d.effects) {
-    e->regress(ctx, br, bs, bc);
+    if (e->current_side()) {
+      e->regress_dq(ctx, b0, b1);
+      for (std::size_t i = 0; i < e->params.size(); ++i, ++j) {
+        x.d[j] = b0[i];
+        x.q[j] = b1[i];
+      }
+      continue;
+    }
+    e->regress(ctx, b0, b1, b2);
     for (std::size_t i = 0; i < e->params.size(); ++i, ++j) {
-      xr[j] = br[i];
-      xs[j] = bs[i];
-      xc[j] = bc[i];
+      x.rd[j] = b0[i];
+      x.s[j] = b1[i];
+      x.c[j] = b2[i];
     }
   }
 }
@@ -381,19 +450,24 @@ Solved solve_linear(const Prepared& p, const Design& d, double omega_n, bool kee
   Solved out;
   out.omega_n = omega_n;
   const int k = d.k;
-  const double wr = 1.0 / p.floor_rd, we = p.env ? 1.0 / p.floor_env : 0.0;
-  Eigen::VectorXd xr(k), xs(k), xc(k);
+  const double wr = 1.0 / p.floor_rd, we = p.env ? 1.0 / p.floor_env : 0.0, wi = p.cur ? 1.0 / p.floor_i : 0.0;
+  RowRegressors x(k);
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
   for (const auto& r : p.rows) {
     if (k == 0) break;
-    fill_rows(p, d, r, omega_n, alpha_hat, xr, xs, xc);
-    m.selfadjointView<Eigen::Lower>().rankUpdate(xr, wr * wr);
-    b += xr * (wr * wr * r.eps);
+    fill_rows(p, d, r, omega_n, alpha_hat, x);
+    m.selfadjointView<Eigen::Lower>().rankUpdate(x.rd, wr * wr);
+    b += x.rd * (wr * wr * r.eps);
     if (r.env) {
-      m.selfadjointView<Eigen::Lower>().rankUpdate(xs, we * we);
-      m.selfadjointView<Eigen::Lower>().rankUpdate(xc, we * we);
-      b += xs * (we * we * r.ys) + xc * (we * we * r.yc);
+      m.selfadjointView<Eigen::Lower>().rankUpdate(x.s, we * we);
+      m.selfadjointView<Eigen::Lower>().rankUpdate(x.c, we * we);
+      b += x.s * (we * we * r.ys) + x.c * (we * we * r.yc);
+    }
+    if (r.cur) {
+      m.selfadjointView<Eigen::Lower>().rankUpdate(x.d, wi * wi);
+      m.selfadjointView<Eigen::Lower>().rankUpdate(x.q, wi * wi);
+      b += x.d * (wi * wi * r.id) + x.q * (wi * wi * r.iq);
     }
   }
   Eigen::VectorXd coef = Eigen::VectorXd::Zero(k);
@@ -409,14 +483,22 @@ Solved solve_linear(const Prepared& p, const Design& d, double omega_n, bool kee
     coef = dg.cwiseInverse().asDiagonal() * cod.solve(dg.cwiseInverse().asDiagonal() * b);
     minv = dg.cwiseInverse().asDiagonal() * cod.pseudoInverse() * dg.cwiseInverse().asDiagonal();
   }
-  if (keep_residual) out.resid_rd.reserve(p.rows.size());
+  if (keep_residual) {
+    out.resid_rd.reserve(p.rows.size());
+    if (p.cur) {
+      out.resid_d.reserve(p.rows.size());
+      out.resid_q.reserve(p.rows.size());
+    }
+  }
   for (const auto& r : p.rows) {
-    double fr = 0.0, fs = 0.0, fc = 0.0;
+    double fr = 0.0, fs = 0.0, fc = 0.0, fd = 0.0, fq = 0.0;
     if (k > 0) {
-      fill_rows(p, d, r, omega_n, alpha_hat, xr, xs, xc);
-      fr = xr.dot(coef);
-      fs = xs.dot(coef);
-      fc = xc.dot(coef);
+      fill_rows(p, d, r, omega_n, alpha_hat, x);
+      fr = x.rd.dot(coef);
+      fs = x.s.dot(coef);
+      fc = x.c.dot(coef);
+      fd = x.d.dot(coef);
+      fq = x.q.dot(coef);
     }
     const double er = r.eps - fr;
     out.rss_rd += er * er;
@@ -427,9 +509,18 @@ Solved solve_linear(const Prepared& p, const Design& d, double omega_n, bool kee
       out.rss_env += es * es + ec * ec;
       out.n_env += 2;
     }
+    const double ed = r.cur ? r.id - fd : 0.0, eq = r.cur ? r.iq - fq : 0.0;
+    if (r.cur) {
+      out.rss_i += ed * ed + eq * eq;
+      out.n_i += 2;
+    }
+    if (keep_residual && p.cur) {
+      out.resid_d.push_back(ed);
+      out.resid_q.push_back(eq);
+    }
   }
-  out.rss_w = out.rss_rd * wr * wr + out.rss_env * we * we;
-  const double dof = static_cast<double>(out.n_rd + out.n_env - k - (d.tracking ? 1 : 0));
+  out.rss_w = out.rss_rd * wr * wr + out.rss_env * we * we + out.rss_i * wi * wi;
+  const double dof = static_cast<double>(out.n_rd + out.n_env + out.n_i - k - (d.tracking ? 1 : 0));
   const double s2 = out.rss_w / std::max(dof, 1.0);
   out.x = coef;
   out.se = (s2 * minv.diagonal()).cwiseMax(0.0).cwiseSqrt();
@@ -494,26 +585,29 @@ Solved solve(const Prepared& p, const Design& d, bool keep_residual) {
   // Standard error from the curvature of the weighted RSS (chi^2 / s^2 rises by 1 at 1 sigma).
   const double h = 0.01;
   const double curv = (cost(lopt + h) - 2.0 * out.rss_w + cost(lopt - h)) / (h * h);
-  const double dof = static_cast<double>(out.n_rd + out.n_env - d.k - 1);
+  const double dof = static_cast<double>(out.n_rd + out.n_env + out.n_i - d.k - 1);
   const double s2 = out.rss_w / std::max(dof, 1.0);
   out.omega_n_se = curv > 0.0 ? std::exp(lopt) * std::sqrt(2.0 * s2 / curv) : kNaN;
   return out;
 }
 
 double bic(const Solved& s, const Design& d) {
-  const double n = static_cast<double>(s.n_rd + s.n_env);
+  const double n = static_cast<double>(s.n_rd + s.n_env + s.n_i);
   const double k = static_cast<double>(d.k + (d.tracking ? 1 : 0));
   return n * std::log(s.rss_w / n) + k * std::log(n);
 }
 
 double rms(double rss, std::int64_t n) { return n > 0 ? std::sqrt(rss / static_cast<double>(n)) : 0.0; }
 
-std::vector<HarmonicResidual> harmonic_breakdown(const Prepared& p, const std::vector<double>& r, int max_order) {
+/// `electrical`: orders of theta_e over the rows with currents (else of theta over all rows).
+std::vector<HarmonicResidual> harmonic_breakdown(const Prepared& p, const std::vector<double>& r, int max_order,
+                                                 bool electrical = false) {
   const int k = 1 + 2 * max_order;
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(k), x(k);
   for (std::size_t i = 0; i < r.size(); ++i) {
-    saturated_basis(p.rows[i], max_order, false, x);
+    if (electrical && !p.rows[i].cur) continue;
+    saturated_basis(p.rows[i], max_order, false, x, electrical);
     m.selfadjointView<Eigen::Lower>().rankUpdate(x);
     b += x * r[i];
   }
@@ -556,9 +650,39 @@ std::vector<SpeedBinResidual> speed_breakdown(const Prepared& p, const std::vect
   return out;
 }
 
+std::vector<TimeBinResidual> time_breakdown(const Prepared& p, const std::vector<double>& r, int bins) {
+  std::vector<TimeBinResidual> out;
+  if (r.empty() || bins < 1) return out;
+  const double t0 = p.rows.front().t, t1 = p.rows.back().t;
+  const double span = std::max(t1 - t0, 1e-12);
+  std::vector<Eigen::Matrix3d> m(bins, Eigen::Matrix3d::Zero());
+  std::vector<Eigen::Vector3d> v(bins, Eigen::Vector3d::Zero());
+  std::vector<double> ss(bins, 0.0);
+  out.resize(bins);
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const int b = std::clamp(static_cast<int>((p.rows[i].t - t0) / span * bins), 0, bins - 1);
+    const Eigen::Vector3d x(1.0, std::sin(2.0 * p.rows[i].theta), std::cos(2.0 * p.rows[i].theta));
+    m[b] += x * x.transpose();
+    v[b] += x * r[i];
+    ss[b] += r[i] * r[i];
+    ++out[b].samples;
+  }
+  for (int b = 0; b < bins; ++b) {
+    out[b].t_lo = span * b / bins;
+    out[b].t_hi = span * (b + 1) / bins;
+    if (out[b].samples < 16) continue;
+    out[b].rms = std::sqrt(ss[b] / static_cast<double>(out[b].samples));
+    const Eigen::Vector3d c = m[b].completeOrthogonalDecomposition().solve(v[b]);
+    out[b].order2_amplitude = std::hypot(c[1], c[2]);
+  }
+  std::erase_if(out, [](const TimeBinResidual& x) { return x.samples < 16; });
+  return out;
+}
+
 bool signals_explained(const Prepared& p, const Solved& s, double ratio) {
   if (rms(s.rss_rd, s.n_rd) > ratio * p.floor_rd) return false;
   if (p.env && rms(s.rss_env, s.n_env) > ratio * p.floor_env) return false;
+  if (p.cur && rms(s.rss_i, s.n_i) > ratio * p.floor_i) return false;
   return true;
 }
 
@@ -569,6 +693,33 @@ std::vector<ParamValue> params_of(const Design& d, const Solved& s, bool with_nu
     out.push_back({d.names[j], s.x[j], s.se[j]});
   }
   if (d.tracking) out.push_back({"tracking_loop.omega_n", s.omega_n, s.omega_n_se});
+  return out;
+}
+
+ResidualSeries residual_series(const Prepared& p, const Solved& s, int points) {
+  ResidualSeries out;
+  const std::size_t n = p.rows.size();
+  const std::size_t step = std::max<std::size_t>(1, n / static_cast<std::size_t>(points));
+  const double e_per_r = static_cast<double>(p.p) / static_cast<double>(p.p_r);
+  for (std::size_t i = 0; i < n; i += step) {
+    const Row& r = p.rows[i];
+    out.t.push_back(r.t);
+    out.theta.push_back(wrap_2pi(r.theta));
+    out.rpm.push_back(r.omega / p.p_r * 60.0 / kTwoPi);
+    out.eps_measured.push_back(r.eps);
+    const double model = r.eps - s.resid_rd[i];
+    out.eps_model.push_back(model);
+    if (!r.cur) continue;
+    // The drive's angle: the R/D angle theta - eps, raw or corrected by the model's eps.
+    const ParkTransform raw(r.i_al, r.i_be, e_per_r * (r.theta - r.eps));
+    const ParkTransform comp(r.i_al, r.i_be, e_per_r * (r.theta - r.eps + model));
+    out.i_d_raw.push_back(raw.d);
+    out.i_q_raw.push_back(raw.q);
+    out.i_d_comp.push_back(comp.d);
+    out.i_q_comp.push_back(comp.q);
+    out.i_d_ref.push_back(r.id);
+    out.i_q_ref.push_back(r.iq);
+  }
   return out;
 }
 
@@ -588,15 +739,23 @@ ModelFit fit_prepared(const Prepared& p, std::span<const std::string> effects, c
   f.params = params_of(d, s, false);
   f.signals.push_back({"position_error", rms(s.rss_rd, s.n_rd), p.floor_rd, rms(raw.rss_rd, raw.n_rd), s.n_rd});
   if (p.env) f.signals.push_back({"sin_cos", rms(s.rss_env, s.n_env), p.floor_env, rms(raw.rss_env, raw.n_env), s.n_env});
+  if (p.cur) f.signals.push_back({"i_dq", rms(s.rss_i, s.n_i), p.floor_i, rms(raw.rss_i, raw.n_i), s.n_i});
   f.residual_rms_rad = rms(s.rss_rd, s.n_rd);
   f.noise_floor_rad = p.floor_rd;
   f.harmonics = harmonic_breakdown(p, s.resid_rd, std::max(0, opt.max_report_order));
   f.speed_bins = speed_breakdown(p, s.resid_rd);
+  f.time_bins = time_breakdown(p, s.resid_rd, opt.time_bins);
+  if (p.cur) {
+    f.harmonics_id = harmonic_breakdown(p, s.resid_d, std::max(0, opt.max_report_order), true);
+    f.harmonics_iq = harmonic_breakdown(p, s.resid_q, std::max(0, opt.max_report_order), true);
+  }
+  if (opt.series_points > 0) f.series = residual_series(p, s, opt.series_points);
   f.bic = bic(s, d);
-  f.rows = s.n_rd + s.n_env;
+  f.rows = s.n_rd + s.n_env + s.n_i;
   f.parameters = d.k + (d.tracking ? 1 : 0);
   f.reference = p.reference;
   f.sincos_used = p.env;
+  f.currents_used = p.cur;
   f.explained = signals_explained(p, s, opt.explained_ratio);
   f.notes = p.notes;
   if (d.tracking) f.notes.push_back("tracking_loop: zeta assumed 0.7, omega_n searched on [100, 1e5] rad/s");
@@ -613,7 +772,10 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
   std::vector<std::string> out;
   for (const auto& s : f.signals) {
     if (s.rms <= ratio * s.floor) continue;
-    out.push_back(s.signal + ": residual " + fmt_num(s.rms) + (s.signal == "position_error" ? " rad (" + fmt_num(rad_to_arcmin(s.rms)) + " arcmin)" : " of the amplitude") +
+    const std::string unit = s.signal == "position_error" ? " rad (" + fmt_num(rad_to_arcmin(s.rms)) + " arcmin)"
+                             : s.signal == "i_dq"         ? " A"
+                                                          : " of the amplitude";
+    out.push_back(s.signal + ": residual " + fmt_num(s.rms) + unit +
                   " is " + fmt_num(s.rms / s.floor, "%.1f") + "x the noise floor " + fmt_num(s.floor));
   }
   if (out.empty()) return out;
@@ -635,6 +797,34 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
   if (!hs.empty()) out.push_back("position-error residual by harmonic: " + hs);
   else if (f.signals[0].rms > ratio * f.signals[0].floor)
     out.push_back("position-error residual is not locked to the angle (no harmonic of theta above a fifth of the floor): it changes over time");
+  // The dq currents, by order of theta_e: which ripple the current sensors or the inverter leave.
+  for (const auto& s : f.signals) {
+    if (s.signal != "i_dq" || s.rms <= ratio * s.floor) continue;
+    std::string cs;
+    for (std::size_t n = 1; n < f.harmonics_id.size() && n < f.harmonics_iq.size(); ++n) {
+      const double ad = f.harmonics_id[n].amplitude, aq = f.harmonics_iq[n].amplitude;
+      if (std::max(ad, aq) < 0.2 * p.floor_i) continue;
+      cs += (cs.empty() ? "" : ", ") + std::to_string(n) + " theta_e: i_d " + fmt_num(ad) + " A, i_q " + fmt_num(aq) + " A";
+    }
+    out.push_back(cs.empty() ? "i_dq residual is not locked to theta_e (no harmonic above a fifth of the floor)"
+                             : "i_dq residual by harmonic of theta_e: " + cs);
+  }
+  // Over time: the catalog's effects are fixed in time, so a residual that grows or
+  // shrinks from window to window (at whatever speed) is something the catalog lacks.
+  if (f.time_bins.size() > 1) {
+    double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+    std::string ts;
+    for (const auto& b : f.time_bins) {
+      lo = std::min(lo, b.rms);
+      hi = std::max(hi, b.rms);
+      ts += (ts.empty() ? "" : ", ") + fmt_num(b.t_lo, "%.3g") + "-" + fmt_num(b.t_hi, "%.3g") + " s: " +
+            fmt_num(b.rms / p.floor_rd, "%.1f") + "x floor (2 theta " + fmt_num(b.order2_amplitude) + " rad)";
+    }
+    if (hi > ratio * p.floor_rd && hi > 2.0 * lo) {
+      out.push_back("the position-error residual changes over time (" + ts +
+                    "): no catalog effect depends on time (a drift, e.g. with temperature, is outside the catalog)");
+    }
+  }
   if (f.speed_bins.size() > 1) {
     std::string bs;
     for (const auto& b : f.speed_bins) {
@@ -682,6 +872,7 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
   ex.fit = fit_prepared(p, effects, options, d, base);
   const double base_bic = ex.fit.bic;
   const auto sigs = effect_signatures();
+  std::vector<double> weighted_rss_after;  // per candidate, for the excess rule below
   std::size_t done = 0;
   for (const auto& sig : sigs) {
     ++done;
@@ -690,6 +881,10 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
     if (std::find(ex.fit.effects.begin(), ex.fit.effects.end(), name) != ex.fit.effects.end()) continue;
     if (sig.needs_reference && !p.reference) {
       ex.not_evaluated.push_back(name + ": needs the reference angle");
+      continue;
+    }
+    if (sig.current_side() && !p.cur) {
+      ex.not_evaluated.push_back(name + ": needs the phase currents");
       continue;
     }
     std::vector<std::string> with(ex.fit.effects.begin(), ex.fit.effects.end());
@@ -705,6 +900,8 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
     c.effect = name;
     c.residual_after_rad = rms(sc.rss_rd, sc.n_rd);
     c.sincos_residual_after = rms(sc.rss_env, sc.n_env);
+    c.dq_residual_after = rms(sc.rss_i, sc.n_i);
+    c.weighted_rss = sc.rss_w;
     c.score = bic(sc, dc);
     c.bic_drop = base_bic - c.score;
     c.proposed = c.bic_drop > options.proposal_bic_drop;
@@ -721,7 +918,7 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
     if (find_signature(e.name) != nullptr) continue;
     const std::string n(e.name);
     if (n == "quantization" || n == "noise") ex.not_evaluated.push_back(n + ": sets the noise floor, not a candidate");
-    else ex.not_evaluated.push_back(n + ": acts on the phase currents; the dq fit is not in this version");
+    else ex.not_evaluated.push_back(n + ": no signature in this version");
   }
   std::sort(ex.candidates.begin(), ex.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
 
@@ -741,20 +938,26 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
     if (best->reaches_floor) {
       named = true;
     } else {
-      // Share of the weighted residual power above the floor that the candidate removes.
-      const double nr = static_cast<double>(base.n_rd), ne = static_cast<double>(base.n_env);
-      const double excess = base.rss_w - (nr + ne);
-      const double fr = best->residual_after_rad / p.floor_rd;
-      const double fe = p.env ? best->sincos_residual_after / p.floor_env : 0.0;
-      const double after = fr * fr * nr + fe * fe * ne - (nr + ne);
+      // Share of the weighted residual power above the floor that the candidate removes
+      // (each row's weight is 1/floor, so a row at the floor contributes 1).
+      const double rows = static_cast<double>(base.n_rd + base.n_env + base.n_i);
+      const double excess = base.rss_w - rows;
+      const double after = best->weighted_rss - rows;
       named = excess > 0.0 && (excess - after) >= kExcessExplainedShare * excess;
     }
   }
   if (named) {
     ex.verdict = Verdict::kMissingEffect;
-    ex.summary = "missing_effect: adding " + best->effect + " brings the position-error residual from " +
-                 fmt_num(ex.fit.residual_rms_rad) + " to " + fmt_num(best->residual_after_rad) + " rad (floor " +
-                 fmt_num(p.floor_rd) + "); " + best->reason;
+    const EffectSignature* bs = find_signature(best->effect);
+    if (bs != nullptr && bs->current_side()) {
+      const SignalResidual& dq = ex.fit.signals.back();  // "i_dq" is last when currents are fitted
+      ex.summary = "missing_effect: adding " + best->effect + " brings the i_dq residual from " + fmt_num(dq.rms) +
+                   " to " + fmt_num(best->dq_residual_after) + " A (floor " + fmt_num(p.floor_i) + "); " + best->reason;
+    } else {
+      ex.summary = "missing_effect: adding " + best->effect + " brings the position-error residual from " +
+                   fmt_num(ex.fit.residual_rms_rad) + " to " + fmt_num(best->residual_after_rad) + " rad (floor " +
+                   fmt_num(p.floor_rd) + "); " + best->reason;
+    }
   } else {
     ex.verdict = Verdict::kUnexplained;
     ex.summary = "unexplained: no catalog effect brings the residual near the noise floor; the residual is described "

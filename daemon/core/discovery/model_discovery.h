@@ -8,6 +8,7 @@
 //   │          angle when there is none), speed omega, rows
 //   │            position error  eps = theta_true - theta_rd           [rad]
 //   │            sin/cos         s/A - sin theta, c/A - cos theta     [1 ~ rad] (reference only)
+//   │            dq currents     i_d, i_q in the frame at theta_e = p theta_m  [A] (reference only)
 //   │          noise floor of each signal (second differences of a saturated fit)
 //   └► fit: weighted linear least squares, one column per effect parameter
 //      (effect_signatures.h), rows weighted by 1/floor so signals combine;
@@ -37,7 +38,8 @@ struct DiscoverySample {
   bool has_sincos = false;
   double theta_m_ref = 0.0;  ///< [rad] reference encoder, mechanical, wrapped
   bool has_ref = false;
-  bool has_currents = false;  ///< phase currents present (not fitted in this version)
+  double i_a = 0.0, i_b = 0.0, i_c = 0.0;  ///< [A] measured phase currents
+  bool has_currents = false;
 };
 
 struct DiscoveryInput {
@@ -56,8 +58,14 @@ struct DiscoveryOptions {
   int max_report_order = 8;
   /// Speed bins of the residual breakdown (equal width over the speeds seen; empty bins dropped).
   int speed_bins = 6;
+  /// Time windows of the residual breakdown (a residual that changes over time is
+  /// outside the catalog: no effect here is a function of time).
+  int time_bins = 5;
   /// Called with the fraction done in [0, 1] during explain (may be empty).
   std::function<void(double)> progress;
+  /// Points of the per-sample series kept in ModelFit::series for plots (evenly
+  /// decimated); 0 = none.
+  int series_points = 0;
 };
 
 /// A value with its standard error (NaN: not identifiable / not computed).
@@ -68,7 +76,7 @@ struct ParamValue {
 };
 
 struct SignalResidual {
-  std::string signal;       ///< "position_error" [rad] or "sin_cos" [fraction of amplitude]
+  std::string signal;       ///< "position_error" [rad], "sin_cos" [fraction of amplitude] or "i_dq" [A]
   double rms = 0.0;         ///< residual rms after the fit
   double floor = 0.0;       ///< noise floor estimated from the data
   double raw_rms = 0.0;     ///< rms before any effect is fitted (nuisance only)
@@ -89,6 +97,26 @@ struct SpeedBinResidual {
   std::int64_t samples = 0;
 };
 
+/// Decimated per-sample series of the final fit, for plots. Vectors are empty when
+/// the signal is absent (currents need phase currents and the reference).
+struct ResidualSeries {
+  std::vector<double> t;             ///< [s]
+  std::vector<double> theta;         ///< [rad] true resolver electrical angle, wrapped to [0, 2 pi)
+  std::vector<double> rpm;           ///< [r/min] mechanical speed
+  std::vector<double> eps_measured;  ///< [rad] position error theta_true - theta_rd
+  std::vector<double> eps_model;     ///< [rad] the model's prediction of it
+  std::vector<double> i_d_raw, i_q_raw;    ///< [A] dq currents with the raw R/D angle
+  std::vector<double> i_d_comp, i_q_comp;  ///< [A] with the R/D angle corrected by the model
+  std::vector<double> i_d_ref, i_q_ref;    ///< [A] with the reference angle
+};
+
+struct TimeBinResidual {
+  double t_lo = 0.0, t_hi = 0.0;   ///< [s] from the first sample
+  double rms = 0.0;                ///< [rad] position-error residual
+  double order2_amplitude = 0.0;   ///< [rad] residual amplitude at 2 theta
+  std::int64_t samples = 0;
+};
+
 struct ModelFit {
   std::vector<std::string> effects;
   std::vector<ParamValue> params;
@@ -96,26 +124,33 @@ struct ModelFit {
   double residual_rms_rad = 0.0;  ///< position error residual [rad]
   double noise_floor_rad = 0.0;   ///< position error floor [rad]
   std::vector<HarmonicResidual> harmonics;  ///< position error residual by order
+  std::vector<HarmonicResidual> harmonics_id;  ///< [A] i_d residual by order of theta_e (currents only)
+  std::vector<HarmonicResidual> harmonics_iq;  ///< [A] i_q residual by order of theta_e
   std::vector<SpeedBinResidual> speed_bins;
+  std::vector<TimeBinResidual> time_bins;  ///< equal-length windows of the log
   double bic = 0.0;               ///< n ln(RSS_w / n) + k ln n over all weighted rows
   std::int64_t rows = 0;
   int parameters = 0;             ///< k, including nuisance columns
   bool reference = false;         ///< eps against the reference encoder (else smoothed ideal angle)
   bool sincos_used = false;       ///< sin/cos rows entered the fit
+  bool currents_used = false;     ///< dq current rows entered the fit
   bool explained = false;         ///< every signal <= explained_ratio x floor
   std::vector<std::string> notes; ///< what is missing from the log, assumptions
+  ResidualSeries series;          ///< only with DiscoveryOptions::series_points > 0
 };
 
 struct Candidate {
   std::string effect;
   double residual_after_rad = 0.0;  ///< position error residual rms with the effect added
   double sincos_residual_after = 0.0;  ///< sin/cos residual rms (0 when not used)
+  double dq_residual_after = 0.0;      ///< [A] i_d/i_q residual rms (0 when not used)
   double score = 0.0;               ///< BIC of the model with the effect added (lower is better)
   double bic_drop = 0.0;            ///< BIC(model) - score (> 0: better)
   bool proposed = false;            ///< bic_drop > proposal_bic_drop
   bool reaches_floor = false;       ///< every signal <= explained_ratio x floor after adding it
   std::string reason;               ///< one sentence of physics
   std::vector<ParamValue> params;   ///< the added effect's parameters
+  double weighted_rss = 0.0;        ///< sum of (residual / floor)^2 over all rows with the effect added
 };
 
 enum class Verdict : std::uint8_t { kExplained, kMissingEffect, kUnexplained };
@@ -136,7 +171,8 @@ struct Explanation {
 /// Fits `effects` (catalog names; may be empty = nuisance only). Throws
 /// std::invalid_argument naming the effect when it is unknown or not fittable,
 /// when a needed signal is absent (eccentricity and mounting_offset need the
-/// reference), or when fewer than two resolver revolutions of R/D samples exist.
+/// reference, current-side effects need the reference and phase currents), or
+/// when fewer than two resolver revolutions of R/D samples exist.
 [[nodiscard]] ModelFit fit_model(const DiscoveryInput& input, std::span<const std::string> effects,
                                  const DiscoveryOptions& options = {});
 

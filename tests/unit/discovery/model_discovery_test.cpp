@@ -13,14 +13,17 @@
 #include "daemon/core/angles.h"
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/effects/effect_catalog.h"
+#include "daemon/decode/bench_layout.h"
 #include "tools/sim/bench_simulator.h"
 
 namespace resolver {
 namespace {
 
-DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<SpeedSegment> profile = {{5.0, 200.0, 200.0}}) {
+DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<SpeedSegment> profile = {{5.0, 200.0, 200.0}},
+                        double alpha_drift_per_s = 0.0) {
   SimConfig cfg;
   cfg.profile = std::move(profile);
+  cfg.alpha_drift_per_s = alpha_drift_per_s;
   for (const auto& s : specs) {
     const auto err = apply_effect_spec(cfg.chain, s);
     EXPECT_FALSE(err.has_value()) << *err;
@@ -40,6 +43,10 @@ DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<Speed
     d.cos = s.cos_counts;
     d.has_ref = true;
     d.theta_m_ref = static_cast<double>(s.ref_counts) * (kTwoPi / 4294967296.0);
+    d.has_currents = true;
+    d.i_a = s.i_a_ma * bench::kCurrentAmpsPerBit;
+    d.i_b = s.i_b_ma * bench::kCurrentAmpsPerBit;
+    d.i_c = s.i_c_ma * bench::kCurrentAmpsPerBit;
     in.samples.push_back(d);
   }
   return in;
@@ -126,6 +133,61 @@ TEST(ModelDiscovery, TrackingLoopOverTwoSpeeds) {
   EXPECT_EQ(ex.candidates.front().effect, "tracking_loop");
   const std::vector<std::string> with{"amplitude_imbalance", "tracking_loop"};
   expect_within_floor(fit_model(in, with));
+}
+
+// Current-side effects: the resolver signals are clean of them, the dq currents
+// (with the reference angle) are not. Sizes: sensor noise 0.02 A per phase at
+// i_q = 10 A; a 1 % gain mismatch leaves a 2x theta_e ripple of ~0.05 A, a 1 us
+// dead time a 6x ripple of 2 k_dt |i_q| = 0.2 A on i_d: both far above the floor
+// of a 5 s log, both below what would saturate the 16-bit current fields.
+void expect_current_effect_found(const std::string& spec, const std::string& effect, const std::string& param,
+                                 double truth) {
+  const auto in = simulate({"amplitude_imbalance:alpha=0.003", spec});
+  const Explanation ex = explain_model(in, kDefault);
+  EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
+  ASSERT_FALSE(ex.candidates.empty());
+  EXPECT_EQ(ex.candidates.front().effect, effect) << ex.summary;
+  EXPECT_TRUE(ex.fit.currents_used);
+  // The resolver side is already explained: the failure is on i_dq only.
+  EXPECT_LE(ex.fit.residual_rms_rad, 1.5 * ex.fit.noise_floor_rad);
+  const std::vector<std::string> with{"amplitude_imbalance", effect};
+  const ModelFit after = fit_model(in, with);
+  expect_within_floor(after);
+  bool seen = false;
+  for (const auto& p : after.params) {
+    if (p.name == effect + "." + param) {
+      seen = true;
+      EXPECT_NEAR(p.value, truth, 5.0 * p.std_error + 1e-3 * std::abs(truth)) << p.name;
+    }
+  }
+  EXPECT_TRUE(seen) << param;
+}
+
+TEST(ModelDiscovery, HiddenCurrentGainMismatchIsNamedFirst) {
+  expect_current_effect_found("current_gain_mismatch:gain_a=0.01,gain_b=-0.005", "current_gain_mismatch", "gain_a",
+                              0.01);
+}
+
+TEST(ModelDiscovery, HiddenDeadTimeIsNamedFirst) {
+  expect_current_effect_found("dead_time:t_d=1e-6", "dead_time", "t_d", 1e-6);
+}
+
+TEST(ModelDiscovery, HiddenCurrentOffsetsAreNamedFirst) {
+  expect_current_effect_found("current_offsets:off_a=0.05,off_b=-0.03", "current_offsets", "off_a", 0.05);
+}
+
+TEST(ModelDiscovery, AlphaDriftingInTimeIsNotExplainedByACatalogEffect) {
+  // Outside the catalog: alpha rises 0.003 -> 0.006 over the 5 s log (a winding
+  // warming up). No catalog effect is a function of time, so none may be named:
+  // the verdict must be "unexplained", with the residual described instead.
+  const auto in = simulate({"amplitude_imbalance:alpha=0.003"}, {{5.0, 200.0, 200.0}}, 0.0006);
+  const Explanation ex = explain_model(in, kDefault);
+  EXPECT_EQ(ex.verdict, Verdict::kUnexplained) << ex.summary;
+  EXPECT_GT(ex.fit.residual_rms_rad, 1.5 * ex.fit.noise_floor_rad);
+  for (const auto& c : ex.candidates) EXPECT_FALSE(c.reaches_floor) << c.effect;
+  bool described = false;
+  for (const auto& w : ex.where_it_fails) described = described || w.find("time") != std::string::npos;
+  EXPECT_TRUE(described) << "where_it_fails should say the residual changes over time";
 }
 
 TEST(ModelDiscovery, NoReferenceFitsAgainstSmoothedAngle) {

@@ -1,0 +1,261 @@
+// Live latency benchmark: how long resolverd's live path takes from a frame's
+// arrival to the return of the LCM publish it causes, at full bus rate, and
+// what share of one core that costs. Prints a table; not a timed test.
+//
+//   writer thread: default-bench frames (BenchSimulator) paced at --rate frames/s
+//       │ struct can_frame bytes
+//       ▼
+//   host:  socketpair(AF_UNIX, SOCK_SEQPACKET) ── SocketCanSource::adopt
+//   guest: vcan0 (CAN_RAW, --iface) ────────────── SocketCanSource::open
+//       │ recvmsg + SO_TIMESTAMPNS (the kernel stamps at send / netif_rx)
+//       ▼
+//   this thread: the per-frame work of run_live (live_runner.cpp): read,
+//       Pipeline::feed, set_kernel_drops, tick; LcmOutput behind a sink that
+//       notes when each publish returned.
+//
+// The host kernel here has no PF_CAN, so the socket pair stands in for the
+// CAN_RAW socket: the driver's real read path (poll, recvmsg, cmsg parsing,
+// wire decoding) runs unchanged on it. run_live itself is not called because
+// it can only open an interface by name; the loop below is its hot path.
+//
+// Latency "arrival": the frame's kernel receive timestamp (CLOCK_REALTIME,
+// 1 us resolution as the driver reports it), so the time the frame waited in
+// the socket queue and the reader's wake-up are included. "recvmsg": from the
+// return of SocketCanSource::read, the in-process part only. Only frames that
+// published something (the one completing a sample: angle_t + dq_t, plus
+// health_t once a second) have a publish latency; "all frames" is arrival to
+// the end of Pipeline::feed for every frame.
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <time.h>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/app/daemon_config.h"
+#include "daemon/app/lcm_output.h"
+#include "daemon/app/pipeline.h"
+#include "drivers/socketcan/socketcan_source.h"
+#include "tests/bench/live_latency_feed.h"
+#include "tests/bench/live_latency_stats.h"
+
+namespace {
+
+using resolver::bench_live::FrameFeed;
+using resolver::bench_live::PaceConfig;
+using resolver::bench_live::RunResult;
+using resolver::bench_live::SendCounts;
+
+struct Options {
+  double seconds = 30.0;
+  int runs = 1;
+  double rate = 8000.0;
+  int burst = 1;
+  double warmup = 1.0;
+  std::string lcm = "memq://";
+  std::string iface;  // empty: socket pair on the host
+  std::string json;
+};
+
+std::int64_t realtime_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+/// Forwards to LCM and remembers when the last publish returned, so the
+/// reader can tell which frame published and when its output left.
+class TimingSink final : public resolver::OutputSink {
+ public:
+  explicit TimingSink(resolver::OutputSink& out) : out_(out) {}
+  void publish(const resolver::angle_t& m) override { note(out_, m); }
+  void publish(const resolver::dq_t& m) override { note(out_, m); }
+  void publish(const resolver::estimate_t& m) override { note(out_, m); }
+  void publish(const resolver::model_fit_t& m) override { note(out_, m); }
+  void publish(const resolver::health_t& m) override { note(out_, m); }
+  [[nodiscard]] std::uint64_t count() const { return count_; }
+  [[nodiscard]] std::int64_t last_return_ns() const { return last_return_ns_; }
+
+ private:
+  template <typename T>
+  void note(resolver::OutputSink& out, const T& m) {
+    out.publish(m);
+    last_return_ns_ = realtime_ns();
+    ++count_;
+  }
+  resolver::OutputSink& out_;
+  std::uint64_t count_ = 0;
+  std::int64_t last_return_ns_ = 0;
+};
+
+/// The reading end and the writing end of one run.
+struct Endpoints {
+  resolver::SocketCanSource reader;
+  resolver::UniqueFd writer_owned;  // socket pair: the other end
+  std::optional<resolver::SocketCanSource> writer_can;  // vcan: a second CAN_RAW socket
+  [[nodiscard]] int writer_fd() const { return writer_can ? writer_can->fd() : writer_owned.get(); }
+};
+
+Endpoints open_endpoints(const Options& o) {
+  if (!o.iface.empty()) {
+    resolver::SocketCanOptions ro;
+    ro.iface = o.iface;
+    ro.receive_buffer_bytes = resolver::CanOptions{}.receive_buffer_bytes;  // resolverd's default
+    resolver::SocketCanOptions wo;
+    wo.iface = o.iface;
+    wo.receive_error_frames = false;
+    return Endpoints{resolver::SocketCanSource::open(ro), resolver::UniqueFd(), resolver::SocketCanSource::open(wo)};
+  }
+  int fds[2] = {-1, -1};
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds) < 0) {
+    throw resolver::SocketCanError("socketpair(AF_UNIX, SOCK_SEQPACKET)", "sockpair", errno);
+  }
+  // What open() enables on a CAN_RAW socket; AF_UNIX stamps each datagram
+  // when it is sent (there is no receive interrupt to stamp at).
+  const int on = 1;
+  ::setsockopt(fds[0], SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
+  ::setsockopt(fds[0], SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
+  return Endpoints{resolver::SocketCanSource::adopt(fds[0], "sockpair0"), resolver::UniqueFd(fds[1]), std::nullopt};
+}
+
+RunResult run_once(const Options& o) {
+  resolver::DaemonConfig config;
+  config.lcm_url = o.lcm;
+  resolver::LcmOutput lcm(o.lcm, config.channels);
+  TimingSink sink(lcm);
+  resolver::Pipeline pipeline(config, sink, std::cerr);
+  Endpoints ends = open_endpoints(o);
+  FrameFeed feed(o.rate, o.seconds);
+
+  RunResult r;
+  const auto expected = static_cast<std::size_t>(o.rate * o.seconds * 1.05) + 64;
+  r.publish_kernel_us.reserve(expected / 3 + 64);
+  r.publish_read_us.reserve(expected / 3 + 64);
+  r.all_kernel_us.reserve(expected);
+
+  std::atomic<bool> stop{false};
+  std::atomic<bool> writer_done{false};
+  SendCounts sent;
+  PaceConfig pace{o.rate, o.burst, o.seconds, 0.0};
+  std::thread writer([&] {
+    sent = resolver::bench_live::send_paced(ends.writer_fd(), feed, pace, stop);
+    // Socket pair: end of stream for the reader (0-byte read + POLLHUP).
+    if (!ends.writer_can) ::shutdown(ends.writer_owned.get(), SHUT_WR);
+    writer_done.store(true);
+  });
+
+  using Clock = resolver::Pipeline::Clock;
+  const double warmup = std::min(o.warmup, o.seconds / 4.0);
+  std::optional<Clock::time_point> first_frame;
+  std::optional<Clock::time_point> window_start;
+  Clock::time_point last_frame{};
+  double cpu_start = thread_cpu_s();
+  rusage ru_start{};
+  getrusage(RUSAGE_THREAD, &ru_start);
+  resolver::CanFrame frame;
+  for (;;) {
+    const resolver::ReadStatus status = ends.reader.read(frame);
+    if (status == resolver::ReadStatus::kFrame) {
+      const Clock::time_point t_read = Clock::now();
+      const std::int64_t read_ns = realtime_ns();
+      const std::uint64_t before = sink.count();
+      pipeline.feed(frame, 0, t_read);
+      const std::int64_t done_ns = realtime_ns();
+      ++r.frames_read;
+      last_frame = Clock::now();
+      if (!first_frame) first_frame = t_read;
+      if (!window_start && t_read - *first_frame >= std::chrono::duration<double>(warmup)) {
+        window_start = t_read;
+        cpu_start = thread_cpu_s();
+        getrusage(RUSAGE_THREAD, &ru_start);
+      }
+      if (window_start) {
+        const double arrival_us = static_cast<double>(frame.timestamp_us);
+        r.all_kernel_us.push_back(static_cast<float>(static_cast<double>(done_ns) * 1e-3 - arrival_us));
+        if (sink.count() != before) {
+          // All on CLOCK_REALTIME, the clock of the kernel's stamp.
+          const double ret_us = static_cast<double>(sink.last_return_ns()) * 1e-3;
+          r.publish_kernel_us.push_back(static_cast<float>(ret_us - arrival_us));
+          r.publish_read_us.push_back(static_cast<float>(static_cast<double>(sink.last_return_ns() - read_ns) * 1e-3));
+        }
+      }
+    } else if (status == resolver::ReadStatus::kDeviceGone) {
+      break;  // socket pair closed by the writer
+    } else if (status == resolver::ReadStatus::kTimeout && writer_done.load()) {
+      break;  // vcan: nothing for read_timeout after the writer finished
+    }
+    pipeline.set_kernel_drops(static_cast<std::int64_t>(ends.reader.stats().kernel_drops));
+    pipeline.tick(realtime_ns() / 1000);
+  }
+  const double cpu_end = thread_cpu_s();
+  rusage ru_end{};
+  getrusage(RUSAGE_THREAD, &ru_end);
+  stop.store(true);
+  writer.join();
+  pipeline.finish();
+
+  r.sent = sent;
+  r.wall_s = window_start ? std::chrono::duration<double>(last_frame - *window_start).count() : 0.0;
+  r.cpu_s = cpu_end - cpu_start;
+  r.ctx_switches = (ru_end.ru_nvcsw - ru_start.ru_nvcsw) + (ru_end.ru_nivcsw - ru_start.ru_nivcsw);
+  r.kernel_drops = ends.reader.stats().kernel_drops;
+  r.frames_seen = pipeline.intake().stats().frames_seen;
+  r.frames_decoded = pipeline.intake().stats().frames_decoded;
+  r.rejects = pipeline.intake().rejects().total();
+  r.lcm_failures = lcm.publish_failures();
+  r.sample_rate_hz = feed.sample_rate_hz();
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Live latency of resolverd's SocketCAN read path: frame arrival -> LCM publish return, and CPU share.\n"
+               "Host (no PF_CAN): frames go through socketpair(AF_UNIX, SOCK_SEQPACKET) into SocketCanSource::adopt.\n"
+               "With --iface vcan0 (vcan guest): a real CAN_RAW socket. See docs/PERFORMANCE.md, 'Live latency'."};
+  Options o;
+  app.add_option("--seconds", o.seconds, "traffic per run [s]")->check(CLI::PositiveNumber);
+  app.add_option("--runs", o.runs, "runs; the table's last row is the median of each column")->check(CLI::PositiveNumber);
+  app.add_option("--rate", o.rate, "frames per second (8000 ~ a saturated 1 Mbit/s bus)")->check(CLI::PositiveNumber);
+  app.add_option("--burst", o.burst, "frames sent back to back per sender wake-up (1 = evenly spaced)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--warmup", o.warmup, "first seconds of each run not counted (capped at a quarter of the run) [s]");
+  app.add_option("--lcm", o.lcm, "LCM URL of the output (memq://, or udpm://239.255.76.67:7667?ttl=0)");
+  app.add_option("--iface", o.iface, "read a real SocketCAN interface (vcan0) instead of a socket pair");
+  app.add_option("--json", o.json, "also write the results as JSON to this file");
+  CLI11_PARSE(app, argc, argv);
+
+  std::vector<RunResult> runs;
+  try {
+    for (int i = 0; i < o.runs; ++i) runs.push_back(run_once(o));
+  } catch (const std::exception& e) {
+    std::cerr << "live_latency_bench: " << e.what() << "\n";
+    return 2;
+  }
+  const resolver::bench_live::Setup setup{o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
+                                                          : o.iface + " (CAN_RAW) -> SocketCanSource::open",
+                                          o.lcm, o.rate, o.burst, o.seconds, std::min(o.warmup, o.seconds / 4.0)};
+  resolver::bench_live::print_table(std::cout, setup, runs);
+  if (!o.json.empty()) {
+    std::ofstream out(o.json);
+    resolver::bench_live::write_json(out, setup, runs);
+  }
+  // Not a timing test: only a lost or mangled frame makes this fail.
+  return resolver::bench_live::all_frames_accounted(runs) ? 0 : 1;
+}
