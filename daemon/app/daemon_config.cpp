@@ -1,12 +1,14 @@
 #include "daemon/app/daemon_config.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <toml++/toml.h>
-
 #include <fstream>
 #include <sstream>
+#include <toml++/toml.h>
+
+#include "daemon/core/discovery/model_discovery.h"
 
 namespace resolver {
 
@@ -65,6 +67,35 @@ void require_positive(int value, const char* name, const std::string& source) {
   if (value < 1) throw ConfigError(source + ": " + name + " must be >= 1, got " + std::to_string(value));
 }
 
+void read_model_section(const toml::table& t, ModelFitOptions& m, const std::string& s) {
+  check_keys(t, "model", {"enabled", "effects", "window_revolutions", "candidates"}, s);
+  read(t, "enabled", m.enabled, s, "model");
+  read(t, "candidates", m.candidates, s, "model");
+  read(t, "window_revolutions", m.window_revolutions, s, "model");
+  if (!(m.window_revolutions >= 2.0) || !std::isfinite(m.window_revolutions)) {
+    throw ConfigError(s + ": [model] window_revolutions must be a number >= 2 (the fit needs two revolutions)");
+  }
+  const toml::node* e = t.get("effects");
+  if (e == nullptr) return;
+  std::string fittable;
+  for (auto name : fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(name);
+  const toml::array* arr = e->as_array();
+  if (arr == nullptr) {
+    throw ConfigError(where(s, *e) + ": [model] effects must be an array of effect names, e.g. [\"amplitude_imbalance\"]");
+  }
+  m.effects.clear();
+  for (const auto& item : *arr) {
+    const auto name = item.value<std::string>();
+    if (!name) throw ConfigError(where(s, item) + ": [model] effects: each entry must be a string");
+    const auto list = fittable_effects();
+    if (std::find(list.begin(), list.end(), *name) == list.end()) {
+      throw ConfigError(where(s, item) + ": [model] effects: '" + *name + "' is not a fittable catalog effect; one of: " +
+                        fittable);
+    }
+    m.effects.push_back(*name);
+  }
+}
+
 }  // namespace
 
 DaemonConfig parse_daemon_config(std::string_view text, const std::string& source_name) {
@@ -78,7 +109,8 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   DaemonConfig c;
   c.source = source_name;
   const std::string& s = source_name;
-  check_keys(root, "top level", {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation"}, s);
+  check_keys(root, "top level",
+             {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation", "model"}, s);
 
   auto section = [&root, &s](const char* name) -> const toml::table* {
     const toml::node* n = root.get(name);
@@ -229,6 +261,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
       throw ConfigError(s + ": [compensation] domain must be \"angle\" or \"signal\", got \"" + domain + "\"");
     }
   }
+  if (const auto* t = section("model")) read_model_section(*t, c.model, s);
   if (c.compensation_domain == CompensationDomain::kSignal && c.method != EstimatorMethod::kSinCosLeastSquares) {
     throw ConfigError(s + ": [compensation] domain = \"signal\" needs [estimator] method = \"sincos_least_squares\" "
                           "(only it estimates the sin/cos signal parameters)");

@@ -38,11 +38,17 @@
 //   [compensation]
 //   enabled = true
 //   domain = "angle"           # or "signal" (sincos_least_squares: correct sin/cos, then atan2)
+//   [model]                    # live model discovery: model_fit_t once per window
+//   enabled = true
+//   effects = ["amplitude_imbalance"]   # the active model; SIGHUP reloads it
+//   window_revolutions = 16    # resolver electrical revolutions per window
+//   candidates = true          # also rank the catalog effects not in the model
 #pragma once
 
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "daemon/core/estimation/hwang_integral.h"
 #include "daemon/core/estimation/sample_processor.h"
@@ -79,6 +85,14 @@ struct BenchDefaults {
   bool time_from_counter = true;
 };
 
+/// Live model discovery (DESIGN 7): the active effect list and its window.
+struct ModelFitOptions {
+  bool enabled = true;
+  std::vector<std::string> effects{"amplitude_imbalance"};  ///< the seed's model
+  double window_revolutions = 16.0;  ///< resolver electrical revolutions per model_fit_t
+  bool candidates = true;            ///< rank the missing catalog effects (explain) or only fit
+};
+
 struct DaemonConfig {
   std::string source;  ///< file the config came from ("" = built-in defaults)
   std::string lcm_url;  ///< "" = LCM's default (udpm multicast)
@@ -98,6 +112,7 @@ struct DaemonConfig {
   AngleFourierConfig fourier;
   bool compensation_enabled = true;
   CompensationDomain compensation_domain = CompensationDomain::kAngle;
+  ModelFitOptions model;
 };
 
 /// Thrown for unreadable or invalid configuration; what() names the file,

@@ -80,7 +80,7 @@ static int run(int argc, char** argv) {
   std::unique_ptr<Pipeline> pipeline;
   try {
     output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
-    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr);
+    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty());
   } catch (const std::exception& e) {
     std::cerr << "resolverd: " << e.what() << "\n";
     return 2;
@@ -123,7 +123,7 @@ static int run(int argc, char** argv) {
         try {
           DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
           if (lcm_url) fresh.lcm_url = *lcm_url;
-          auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr);
+          auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr, true);
           pipeline->finish();
           pipeline = std::move(rebuilt);
           config = fresh;

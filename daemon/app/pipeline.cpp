@@ -64,7 +64,7 @@ void copy3(double (&dst)[3], const std::array<double, 3>& src, bool valid) {
 
 }  // namespace
 
-Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics)
+Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics, bool realtime)
     : config_(config),
       sink_(sink),
       problems_(diagnostics, "resolverd: "),
@@ -74,7 +74,9 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
                   [this](const BenchInfo& i) { on_bench_info(i); },
                   [this](std::string_view reason, const std::string& msg) { problems_.report(reason, msg); }}),
       processor_(processor_config(config)),
-      sample_rate_hz_(config.bench.sample_rate_hz) {}
+      sample_rate_hz_(config.bench.sample_rate_hz),
+      model_fit_(config.model.enabled ? std::make_unique<LiveModelFit>(config.model, sink, diagnostics, realtime)
+                                      : nullptr) {}
 
 double Pipeline::sample_time(const BenchSample& sample) {
   const double frame_t = static_cast<double>(sample.timestamp_us) * 1e-6;
@@ -132,6 +134,7 @@ void Pipeline::tick(std::int64_t now_us) {
 
 void Pipeline::finish() {
   intake_.flush();
+  if (model_fit_) model_fit_->finish();
   publish_health(last_frame_us_);
 }
 
@@ -161,7 +164,9 @@ void Pipeline::on_sample(const BenchSample& sample) {
   ++samples_;
   last_sample_index_ = sample.index;
   last_counter_ = sample.counter;
-  const SampleOutput out = processor_.process(to_input(sample, sample_time(sample)));
+  const SampleInput in = to_input(sample, sample_time(sample));
+  const SampleOutput out = processor_.process(in);
+  if (model_fit_) feed_model_fit(in, sample);
   summary_.add(out, processor_);
   if (!out.has_angle) return;
 
@@ -204,6 +209,24 @@ void Pipeline::on_sample(const BenchSample& sample) {
     sink_.publish(d);
   }
   if (out.estimate_updated) publish_estimate(sample.timestamp_us, sample);
+}
+
+void Pipeline::feed_model_fit(const SampleInput& in, const BenchSample& sample) {
+  DiscoverySample d;
+  d.t = in.t;
+  d.has_rd = in.has_rd;
+  d.theta_rd = in.theta_rd;
+  d.has_sincos = in.has_sincos;
+  d.sin = in.sin;
+  d.cos = in.cos;
+  d.has_ref = in.has_ref;
+  d.theta_m_ref = in.theta_m_ref;
+  d.has_currents = in.has_currents;
+  d.i_a = in.i_a;
+  d.i_b = in.i_b;
+  d.i_c = in.i_c;
+  const ProcessorConfig& pc = processor_.config();
+  model_fit_->add(d, pc.p_r, pc.p, {sample.timestamp_us, sample.index, sample.counter});
 }
 
 void Pipeline::publish_estimate(std::int64_t utime, const BenchSample& sample) {

@@ -10,6 +10,7 @@
 //     │ SampleOutput
 //     ▼
 //   Pipeline: build angle_t / dq_t / estimate_t / health_t, decimate, publish
+//     └─ LiveModelFit: model_fit_t per window of revolutions (second thread)  live_model_fit.h
 //     │
 //     ▼
 //   OutputSink (LcmOutput on LCM, or a recorder in tests)
@@ -26,6 +27,7 @@
 
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/latency_histogram.h"
+#include "daemon/app/live_model_fit.h"
 #include "daemon/app/output_sink.h"
 #include "daemon/app/problem_log.h"
 #include "daemon/app/run_summary.h"
@@ -39,7 +41,8 @@ class Pipeline {
   using Clock = std::chrono::steady_clock;
 
   /// Loads the DBC and builds the chain. Throws ConfigError (bad DBC, signal map).
-  Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics);
+  /// `realtime`: live input (the model fit never holds up the reader; see live_model_fit.h).
+  Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics, bool realtime = false);
 
   /// Runs one frame through the chain. `line` is its log line (0 live),
   /// `arrival` when it was read (for latency). Cannot fail.
@@ -66,11 +69,14 @@ class Pipeline {
   [[nodiscard]] const RunSummary& summary() const { return summary_; }
   [[nodiscard]] const LatencyHistogram& latency_total() const { return latency_total_; }
   [[nodiscard]] std::int64_t samples() const { return samples_; }
+  /// nullptr when [model] enabled = false.
+  [[nodiscard]] const LiveModelFit* model_fit() const { return model_fit_.get(); }
 
  private:
   void on_sample(const BenchSample& sample);
   void on_bench_info(const BenchInfo& info);
   void publish_estimate(std::int64_t utime, const BenchSample& sample);
+  void feed_model_fit(const SampleInput& in, const BenchSample& sample);
   void publish_health(std::int64_t utime);
 
   DaemonConfig config_;
@@ -97,6 +103,7 @@ class Pipeline {
   double last_frame_t_ = 0.0;     ///< [s] frame time of the previous sample
   double sample_time(const BenchSample& sample);
   std::int64_t kernel_drops_ = 0;
+  std::unique_ptr<LiveModelFit> model_fit_;
 };
 
 }  // namespace resolver

@@ -90,6 +90,20 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   } else {
     out << "  dq ripple  not measured (no phase currents, or no converged estimate)\n";
   }
+  if (const LiveModelFit* mf = p.model_fit()) {
+    const auto& c = mf->counters();
+    const model_fit_t& last = mf->last();
+    out << fmt::format("  model fit  {} windows fitted, {} insufficient, {} skipped; last window: verdict {}", c.windows_fitted,
+                       c.windows_insufficient, c.windows_skipped, last.verdict.empty() ? "(none)" : last.verdict);
+    if (!last.verdict.empty() && std::isfinite(last.residual_rms_rad)) {
+      out << fmt::format(", residual {:.3g} rad ({:.2f}x floor)", last.residual_rms_rad,
+                         last.residual_rms_rad / last.noise_floor_rad);
+      if (last.verdict == "missing_effect" && !last.candidate_effect.empty()) {
+        out << ", add " << last.candidate_effect.front();
+      }
+    }
+    out << "\n";
+  }
   const LatencyHistogram& lat = p.latency_total();
   out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us\n",
                      lat.percentile(0.5), lat.percentile(0.99), lat.max());
@@ -140,6 +154,15 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
        ",\"i_d_ripple_ref\":" + arr(r.ref.d, r.ref_valid) + ",";
   j += "\"i_q_ripple_raw\":" + arr(r.raw.q, r.raw_valid) + ",\"i_q_ripple_comp\":" + arr(r.comp.q, r.comp_valid) +
        ",\"i_q_ripple_ref\":" + arr(r.ref.q, r.ref_valid);
+  if (const LiveModelFit* mf = p.model_fit()) {
+    const auto& c = mf->counters();
+    const model_fit_t& last = mf->last();
+    j += fmt::format(",\"model_fit\":{{\"windows_fitted\":{},\"windows_insufficient\":{},\"windows_skipped\":{},"
+                     "\"last_verdict\":{},\"last_residual_rms_rad\":{},\"last_noise_floor_rad\":{},\"last_best_candidate\":{}}}",
+                     c.windows_fitted, c.windows_insufficient, c.windows_skipped, json_string(last.verdict),
+                     json_number(last.residual_rms_rad), json_number(last.noise_floor_rad),
+                     json_string(last.candidate_effect.empty() ? std::string() : last.candidate_effect.front()));
+  }
   j += "}\n";
   return j;
 }

@@ -67,19 +67,61 @@ int nyquist_order(double omega_abs_max, double dt) {
   return std::clamp(n, 2, kSaturatedOrder);
 }
 
+/// Normal equations M = sum x x', b = sum x y, y'y of a row stream. Rows are
+/// buffered and added a block at a time: one matrix product per block is several
+/// times faster than a rank-1 update per row, and the fits here see every row of
+/// a log dozens of times.
+class Gram {
+ public:
+  explicit Gram(int k)
+      : m_(Eigen::MatrixXd::Zero(k, k)), b_(Eigen::VectorXd::Zero(k)), rows_(kBlock, k), y_(kBlock) {}
+  void add(const Eigen::VectorXd& x, double y) {
+    rows_.row(used_) = x.transpose();
+    y_[used_] = y;
+    yy_ += y * y;
+    ++n_;
+    if (++used_ == kBlock) flush();
+  }
+  /// Adds the buffered rows; call before reading m() and b().
+  void flush() {
+    if (used_ == 0) return;
+    const auto block = rows_.topRows(used_);
+    m_.noalias() += block.transpose() * block;
+    b_.noalias() += block.transpose() * y_.head(used_);
+    used_ = 0;
+  }
+  [[nodiscard]] const Eigen::MatrixXd& m() const { return m_; }
+  [[nodiscard]] const Eigen::VectorXd& b() const { return b_; }
+  [[nodiscard]] double yy() const { return yy_; }
+  [[nodiscard]] std::int64_t n() const { return n_; }
+  /// Residual sum of squares of coefficients c: y'y - 2 c'b + c'Mc (>= 0).
+  [[nodiscard]] double rss(const Eigen::VectorXd& c) const {
+    if (c.size() == 0) return yy_;
+    return std::max(0.0, yy_ - 2.0 * c.dot(b_) + c.dot(m_ * c));
+  }
+
+ private:
+  static constexpr int kBlock = 64;
+  Eigen::MatrixXd m_;
+  Eigen::VectorXd b_;
+  Eigen::MatrixXd rows_;
+  Eigen::VectorXd y_;
+  int used_ = 0;
+  double yy_ = 0.0;
+  std::int64_t n_ = 0;
+};
+
 /// Least squares y ~ X, returns residuals. X given as a row generator.
 template <typename Fill>
 std::vector<double> ls_residual(std::size_t n, int k, Fill&& fill, const std::vector<double>& y) {
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
+  Gram g(k);
   Eigen::VectorXd x(k);
   for (std::size_t i = 0; i < n; ++i) {
     fill(i, x);
-    m.selfadjointView<Eigen::Lower>().rankUpdate(x);
-    b += x * y[i];
+    g.add(x, y[i]);
   }
-  m = m.selfadjointView<Eigen::Lower>();
-  const Eigen::VectorXd coef = m.completeOrthogonalDecomposition().solve(b);
+  g.flush();
+  const Eigen::VectorXd coef = g.m().completeOrthogonalDecomposition().solve(g.b());
   std::vector<double> r(n);
   for (std::size_t i = 0; i < n; ++i) {
     fill(i, x);
@@ -92,11 +134,17 @@ std::vector<double> ls_residual(std::size_t n, int k, Fill&& fill, const std::ve
 /// plus 1x/2x mechanical with a reference.
 void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x, bool electrical = false) {
   const double a = electrical ? r.theta_e : r.theta;
+  // sin/cos of n a by rotation (one sincos per row; the error grows ~n ulp).
+  const double s1 = std::sin(a), c1 = std::cos(a);
+  double sn = s1, cn = c1;
   int j = 0;
   x[j++] = 1.0;
   for (int n = 1; n <= order; ++n) {
-    x[j++] = std::sin(n * a);
-    x[j++] = std::cos(n * a);
+    x[j++] = sn;
+    x[j++] = cn;
+    const double next_s = sn * c1 + cn * s1;
+    cn = cn * c1 - sn * s1;
+    sn = next_s;
   }
   if (mech) {
     for (int n = 1; n <= 2; ++n) {
@@ -452,28 +500,29 @@ Solved solve_linear(const Prepared& p, const Design& d, double omega_n, bool kee
   const int k = d.k;
   const double wr = 1.0 / p.floor_rd, we = p.env ? 1.0 / p.floor_env : 0.0, wi = p.cur ? 1.0 / p.floor_i : 0.0;
   RowRegressors x(k);
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
+  // Normal equations per signal, so each signal's RSS follows from them
+  // (Gram::rss) without a second pass over the rows.
+  Gram nr(k), ne(k), ni(k);
   for (const auto& r : p.rows) {
-    if (k == 0) break;
     fill_rows(p, d, r, omega_n, alpha_hat, x);
-    m.selfadjointView<Eigen::Lower>().rankUpdate(x.rd, wr * wr);
-    b += x.rd * (wr * wr * r.eps);
+    nr.add(x.rd, r.eps);
     if (r.env) {
-      m.selfadjointView<Eigen::Lower>().rankUpdate(x.s, we * we);
-      m.selfadjointView<Eigen::Lower>().rankUpdate(x.c, we * we);
-      b += x.s * (we * we * r.ys) + x.c * (we * we * r.yc);
+      ne.add(x.s, r.ys);
+      ne.add(x.c, r.yc);
     }
     if (r.cur) {
-      m.selfadjointView<Eigen::Lower>().rankUpdate(x.d, wi * wi);
-      m.selfadjointView<Eigen::Lower>().rankUpdate(x.q, wi * wi);
-      b += x.d * (wi * wi * r.id) + x.q * (wi * wi * r.iq);
+      ni.add(x.d, r.id);
+      ni.add(x.q, r.iq);
     }
   }
+  nr.flush();
+  ne.flush();
+  ni.flush();
+  Eigen::MatrixXd m = nr.m() * (wr * wr) + ne.m() * (we * we) + ni.m() * (wi * wi);
+  const Eigen::VectorXd b = nr.b() * (wr * wr) + ne.b() * (we * we) + ni.b() * (wi * wi);
   Eigen::VectorXd coef = Eigen::VectorXd::Zero(k);
   Eigen::MatrixXd minv = Eigen::MatrixXd::Zero(k, k);
   if (k > 0) {
-    m = m.selfadjointView<Eigen::Lower>();
     // Scale columns to unit diagonal so the rank test is about collinearity, not units.
     Eigen::VectorXd dg = m.diagonal().cwiseMax(1e-300).cwiseSqrt();
     const Eigen::MatrixXd ms = dg.cwiseInverse().asDiagonal() * m * dg.cwiseInverse().asDiagonal();
@@ -483,40 +532,35 @@ Solved solve_linear(const Prepared& p, const Design& d, double omega_n, bool kee
     coef = dg.cwiseInverse().asDiagonal() * cod.solve(dg.cwiseInverse().asDiagonal() * b);
     minv = dg.cwiseInverse().asDiagonal() * cod.pseudoInverse() * dg.cwiseInverse().asDiagonal();
   }
-  if (keep_residual) {
+  out.n_rd = nr.n();
+  out.n_env = ne.n();
+  out.n_i = ni.n();
+  if (!keep_residual) {
+    out.rss_rd = nr.rss(coef);
+    out.rss_env = ne.rss(coef);
+    out.rss_i = ni.rss(coef);
+  } else {
+    // The residual per row is wanted (breakdowns, plots): a second pass, exact.
     out.resid_rd.reserve(p.rows.size());
     if (p.cur) {
       out.resid_d.reserve(p.rows.size());
       out.resid_q.reserve(p.rows.size());
     }
-  }
-  for (const auto& r : p.rows) {
-    double fr = 0.0, fs = 0.0, fc = 0.0, fd = 0.0, fq = 0.0;
-    if (k > 0) {
+    for (const auto& r : p.rows) {
       fill_rows(p, d, r, omega_n, alpha_hat, x);
-      fr = x.rd.dot(coef);
-      fs = x.s.dot(coef);
-      fc = x.c.dot(coef);
-      fd = x.d.dot(coef);
-      fq = x.q.dot(coef);
-    }
-    const double er = r.eps - fr;
-    out.rss_rd += er * er;
-    ++out.n_rd;
-    if (keep_residual) out.resid_rd.push_back(er);
-    if (r.env) {
-      const double es = r.ys - fs, ec = r.yc - fc;
-      out.rss_env += es * es + ec * ec;
-      out.n_env += 2;
-    }
-    const double ed = r.cur ? r.id - fd : 0.0, eq = r.cur ? r.iq - fq : 0.0;
-    if (r.cur) {
+      const double er = r.eps - x.rd.dot(coef);
+      out.rss_rd += er * er;
+      out.resid_rd.push_back(er);
+      if (r.env) {
+        const double es = r.ys - x.s.dot(coef), ec = r.yc - x.c.dot(coef);
+        out.rss_env += es * es + ec * ec;
+      }
+      const double ed = r.cur ? r.id - x.d.dot(coef) : 0.0, eq = r.cur ? r.iq - x.q.dot(coef) : 0.0;
       out.rss_i += ed * ed + eq * eq;
-      out.n_i += 2;
-    }
-    if (keep_residual && p.cur) {
-      out.resid_d.push_back(ed);
-      out.resid_q.push_back(eq);
+      if (p.cur) {
+        out.resid_d.push_back(ed);
+        out.resid_q.push_back(eq);
+      }
     }
   }
   out.rss_w = out.rss_rd * wr * wr + out.rss_env * we * we + out.rss_i * wi * wi;
@@ -536,10 +580,12 @@ int alpha_column(const Design& d) {
   return -1;
 }
 
-Solved solve(const Prepared& p, const Design& d, bool keep_residual) {
+/// `alpha_hint`: alpha_hat from an earlier fit of the same log (a candidate's fit
+/// reuses the model's); NaN = run the preliminary pass.
+Solved solve(const Prepared& p, const Design& d, bool keep_residual, double alpha_hint = kNaN) {
   // Preliminary linear pass for alpha_hat (see SignatureContext::alpha_hat).
-  double alpha_hat = 0.0;
-  if (const int ja = alpha_column(d); ja >= 0) {
+  double alpha_hat = std::isfinite(alpha_hint) ? alpha_hint : 0.0;
+  if (const int ja = alpha_column(d); ja >= 0 && !std::isfinite(alpha_hint)) {
     const Solved pre = solve_linear(p, d, 0.0, false, 0.0);
     if (pre.ok) alpha_hat = pre.x[ja];
   }
@@ -603,16 +649,15 @@ double rms(double rss, std::int64_t n) { return n > 0 ? std::sqrt(rss / static_c
 std::vector<HarmonicResidual> harmonic_breakdown(const Prepared& p, const std::vector<double>& r, int max_order,
                                                  bool electrical = false) {
   const int k = 1 + 2 * max_order;
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(k), x(k);
+  Gram g(k);
+  Eigen::VectorXd x(k);
   for (std::size_t i = 0; i < r.size(); ++i) {
     if (electrical && !p.rows[i].cur) continue;
     saturated_basis(p.rows[i], max_order, false, x, electrical);
-    m.selfadjointView<Eigen::Lower>().rankUpdate(x);
-    b += x * r[i];
+    g.add(x, r[i]);
   }
-  m = m.selfadjointView<Eigen::Lower>();
-  const Eigen::VectorXd c = m.completeOrthogonalDecomposition().solve(b);
+  g.flush();
+  const Eigen::VectorXd c = g.m().completeOrthogonalDecomposition().solve(g.b());
   std::vector<HarmonicResidual> out;
   out.push_back({0, std::abs(c[0]), c[0] >= 0.0 ? 0.0 : kPi});
   for (int n = 1; n <= max_order; ++n) {
@@ -677,6 +722,20 @@ std::vector<TimeBinResidual> time_breakdown(const Prepared& p, const std::vector
   }
   std::erase_if(out, [](const TimeBinResidual& x) { return x.samples < 16; });
   return out;
+}
+
+/// Whether the log spans speeds far enough apart for the tracking loop's filtering
+/// to change visibly: the fastest 5 % of samples at least 1.5x the slowest 5 %.
+bool two_speeds(const Prepared& p) {
+  std::vector<double> w;
+  w.reserve(p.rows.size());
+  for (const auto& r : p.rows) w.push_back(std::abs(r.omega));
+  if (w.size() < 20) return false;
+  const std::size_t lo = w.size() / 20, hi = w.size() - 1 - w.size() / 20;
+  std::nth_element(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(lo), w.end());
+  const double slow = w[lo];
+  std::nth_element(w.begin(), w.begin() + static_cast<std::ptrdiff_t>(hi), w.end());
+  return w[hi] >= 1.5 * slow;
 }
 
 bool signals_explained(const Prepared& p, const Solved& s, double ratio) {
@@ -871,6 +930,10 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
   Solved base;
   ex.fit = fit_prepared(p, effects, options, d, base);
   const double base_bic = ex.fit.bic;
+  // Candidates linearise at the model's alpha (SignatureContext::alpha_hat): the
+  // added effect moves alpha by far less than the O(alpha^3) the linearisation drops.
+  const int ja = alpha_column(d);
+  const double alpha_hint = ja >= 0 ? base.x[ja] : kNaN;
   const auto sigs = effect_signatures();
   std::vector<double> weighted_rss_after;  // per candidate, for the excess rule below
   std::size_t done = 0;
@@ -887,10 +950,16 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
       ex.not_evaluated.push_back(name + ": needs the phase currents");
       continue;
     }
+    if (sig.nonlinear && !two_speeds(p)) {
+      // H(j k omega) at one speed is a fixed gain and phase per harmonic: it cannot be
+      // told from the other effects' amplitudes, and the omega_n search is the costly part.
+      ex.not_evaluated.push_back(name + ": one speed in this log; the loop's filtering shows only over a speed change");
+      continue;
+    }
     std::vector<std::string> with(ex.fit.effects.begin(), ex.fit.effects.end());
     with.push_back(name);
     const Design dc = make_design(p, with);
-    const Solved sc = solve(p, dc, false);
+    const Solved sc = solve(p, dc, false, alpha_hint);
     if (!sc.ok) {
       ex.not_evaluated.push_back(name + ": not separable from the model with the signals in this log" +
                                  (p.env ? std::string() : std::string(" (needs sin/cos with a reference)")));

@@ -1,0 +1,135 @@
+#include "daemon/app/live_model_fit.h"
+
+#include <chrono>
+#include <limits>
+#include <stdexcept>
+#include <utility>
+
+namespace resolver {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Samples between checks whether the running fit is done (a future's status
+/// check takes a lock; once per 64 samples is ~30 ms at 2 kHz).
+constexpr std::uint32_t kPollEvery = 64;
+/// The fit needs two revolutions (model_discovery.h); a shorter tail is not fitted.
+constexpr double kMinTailRevolutions = 2.0;
+
+}  // namespace
+
+model_fit_t make_model_fit_message(const Explanation* ex, bool candidates, const std::vector<std::string>& effects) {
+  model_fit_t m{};
+  m.effects = effects;
+  m.num_effects = static_cast<std::int32_t>(m.effects.size());
+  if (ex == nullptr) {
+    m.residual_rms_rad = kNaN;
+    m.noise_floor_rad = kNaN;
+    m.verdict = "insufficient_data";
+    return m;
+  }
+  m.residual_rms_rad = ex->fit.residual_rms_rad;
+  m.noise_floor_rad = ex->fit.noise_floor_rad;
+  for (const auto& h : ex->fit.harmonics) {
+    m.harmonic_order.push_back(static_cast<std::int16_t>(h.order));
+    m.residual_by_harmonic_rad.push_back(h.amplitude);
+  }
+  m.num_harmonics = static_cast<std::int32_t>(m.harmonic_order.size());
+  for (const auto& c : ex->candidates) {
+    m.candidate_effect.push_back(c.effect);
+    m.candidate_residual_rad.push_back(c.residual_after_rad);
+    m.candidate_reason.push_back(c.reason);
+  }
+  m.num_candidates = static_cast<std::int32_t>(m.candidate_effect.size());
+  if (candidates) m.verdict = std::string(to_string(ex->verdict));
+  else m.verdict = ex->fit.explained ? "explained" : "unexplained";  // no candidates ranked: nothing is named
+  return m;
+}
+
+LiveModelFit::LiveModelFit(const ModelFitOptions& options, OutputSink& sink, std::ostream& diagnostics, bool realtime)
+    : options_(options),
+      sink_(sink),
+      diagnostics_(diagnostics),
+      realtime_(realtime),
+      window_(ModelWindowConfig{options.window_revolutions}) {}
+
+LiveModelFit::~LiveModelFit() {
+  // A running fit holds no reference to this object, but its thread must end
+  // before the process does; the result is dropped (finish() publishes it).
+  if (running_.valid()) running_.wait();
+}
+
+void LiveModelFit::add(const DiscoverySample& sample, int p_r, int p, const Stamp& stamp) {
+  last_stamp_ = stamp;
+  if (window_.add(sample, p_r, p)) {
+    DiscoveryInput w = window_.take();
+    if (running_.valid()) {
+      if (realtime_ && running_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+        ++counters_.windows_skipped;
+        return;
+      }
+      publish_ready(true);
+    }
+    start(std::move(w), stamp);
+    return;
+  }
+  if (++since_poll_ >= kPollEvery) {
+    since_poll_ = 0;
+    publish_ready(false);
+  }
+}
+
+void LiveModelFit::finish() {
+  publish_ready(true);
+  if (window_.revolutions() >= kMinTailRevolutions) {
+    start(window_.take(), last_stamp_);
+    publish_ready(true);
+  }
+}
+
+void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
+  const ModelFitOptions opt = options_;
+  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window)]() {
+    Result r;
+    model_fit_t& m = r.message;
+    try {
+      if (opt.candidates) {
+        const Explanation ex = explain_model(w, opt.effects);
+        m = make_model_fit_message(&ex, true, opt.effects);
+      } else {
+        Explanation ex;
+        ex.fit = fit_model(w, opt.effects);
+        m = make_model_fit_message(&ex, false, opt.effects);
+      }
+    } catch (const std::exception& e) {
+      // Too few revolutions, no R/D angle, no currents for a current-side effect:
+      // the window says so in its verdict instead of disappearing.
+      m = make_model_fit_message(nullptr, opt.candidates, opt.effects);
+      r.error = e.what();
+    }
+    m.utime = stamp.utime;
+    m.sample_index = stamp.sample_index;
+    m.counter = stamp.counter;
+    return r;
+  });
+}
+
+void LiveModelFit::publish_ready(bool wait) {
+  if (!running_.valid()) return;
+  if (!wait && running_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+  Result r = running_.get();
+  if (r.error.empty()) {
+    ++counters_.windows_fitted;
+  } else {
+    ++counters_.windows_insufficient;
+    if (r.error != last_error_) {
+      diagnostics_ << "resolverd: model fit: window ending at sample " << r.message.sample_index
+                   << " not fitted (model_fit_t verdict insufficient_data): " << r.error << "\n";
+    }
+  }
+  last_error_ = r.error;
+  sink_.publish(r.message);
+  last_ = std::move(r.message);
+}
+
+}  // namespace resolver

@@ -1,0 +1,82 @@
+// Live model discovery in resolverd (issue 4 "Live", DESIGN 7): every window of
+// `[model] window_revolutions` resolver revolutions the active model
+// (`[model] effects`) is fitted to the window's samples and a model_fit_t is
+// published, so an engineer watching the residual adds an effect (edit the
+// config, SIGHUP) and sees it fall.
+//
+// The fit (model_discovery.h) takes tens of milliseconds, so it runs on a second
+// thread while the pipeline keeps reading; its result is published from the
+// pipeline's thread (the sink is not thread-safe), one window late.
+//  - Replay (`realtime = false`): a finished window waits for the previous fit,
+//    so every window is fitted and the output is the same on every run.
+//  - Live (`realtime = true`): the reader never waits; a window that completes
+//    while the previous fit still runs is dropped and counted (windows_skipped).
+#pragma once
+
+#include <cstdint>
+#include <future>
+#include <ostream>
+#include <string>
+
+#include "daemon/app/daemon_config.h"
+#include "daemon/app/output_sink.h"
+#include "daemon/core/discovery/model_window.h"
+
+namespace resolver {
+
+/// Builds the message for one window. `error` set: the fit could not run (too few
+/// revolutions, no R/D angle...): verdict "insufficient_data" and NaN residuals.
+[[nodiscard]] model_fit_t make_model_fit_message(const Explanation* ex, bool candidates,
+                                                 const std::vector<std::string>& effects);
+
+class LiveModelFit {
+ public:
+  struct Stamp {
+    std::int64_t utime = 0;  ///< [us] of the window's last sample
+    std::int64_t sample_index = 0;
+    std::int16_t counter = 0;
+  };
+  struct Counters {
+    std::int64_t windows_fitted = 0;
+    std::int64_t windows_insufficient = 0;  ///< published with verdict insufficient_data
+    std::int64_t windows_skipped = 0;       ///< live only: the previous fit was still running
+  };
+
+  /// `diagnostics` gets one line each time the reason a window cannot be fitted changes.
+  LiveModelFit(const ModelFitOptions& options, OutputSink& sink, std::ostream& diagnostics, bool realtime);
+  ~LiveModelFit();
+  LiveModelFit(const LiveModelFit&) = delete;
+  LiveModelFit& operator=(const LiveModelFit&) = delete;
+
+  /// One joined sample (pole pairs as currently known). May publish the previous
+  /// window's model_fit_t.
+  void add(const DiscoverySample& sample, int p_r, int p, const Stamp& stamp);
+  /// End of input: waits for the running fit and publishes it. The open, partial
+  /// window is fitted too when it covers at least two revolutions.
+  void finish();
+  [[nodiscard]] const Counters& counters() const { return counters_; }
+  /// The last published message (verdict empty before the first window).
+  [[nodiscard]] const model_fit_t& last() const { return last_; }
+
+ private:
+  struct Result {
+    model_fit_t message;
+    std::string error;  ///< why the window could not be fitted ("" = fitted)
+  };
+  void start(DiscoveryInput window, const Stamp& stamp);
+  void publish_ready(bool wait);
+
+  ModelFitOptions options_;
+  OutputSink& sink_;
+  std::ostream& diagnostics_;
+  bool realtime_;
+  ModelWindow window_;
+  Stamp last_stamp_;
+  std::future<Result> running_;
+  std::string last_error_;
+  model_fit_t last_{};
+  std::uint32_t since_poll_ = 0;
+  Counters counters_;
+};
+
+}  // namespace resolver
