@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
 # The main job on the bundled default, no CAN bus needed:
 #   1. install packages, build
-#   2. simulate the bundled demo bench log (Hwang's setup: alpha = 0.003, 200 r/min,
-#      16-bit R/D, p_r = p = 3) -> build/demo/demo.log (candump -l format)
+#   2. simulate the bundled demo bench log (tools/demo/demo_bench.toml: Hwang's setup,
+#      alpha = 0.003, 200 r/min, 16-bit R/D, p_r = p = 3, plus one effect the seed
+#      model lacks) -> build/demo/demo.log (candump -l format)
 #   3. replay it through resolverd, publishing on LCM (default udpm multicast) and
 #      into build/demo/demo.lcmlog, while resolver-echo listens on the bus
-#   4. print the report: estimated alpha, position error and dq ripple before/after
+#   4. print the report: estimated alpha, position error and dq ripple before/after,
+#      and the live model fit's verdict (README: "find the missing effect in 4 commands")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install-deps.sh
@@ -15,9 +17,7 @@ DEMO=build/demo
 mkdir -p "$DEMO"
 
 echo "== simulating the demo bench log"
-"$BIN/resolver-sim" --out "$DEMO/demo.log" --truth "$DEMO/demo.truth.json" \
-  --rpm 200 --duration 10 --p-r 3 --p 3 --rd-bits 16 --iq 10 --seed 1 \
-  --effect amplitude_imbalance:alpha=0.003
+"$BIN/resolver-sim" --config tools/demo/demo_bench.toml --out "$DEMO/demo.log" --truth "$DEMO/demo.truth.json"
 echo "   $(wc -l < "$DEMO/demo.log") frames in $DEMO/demo.log (truth in $DEMO/demo.truth.json)"
 
 echo "== listening on LCM: resolver-echo prints the first estimates seen on the bus"
@@ -36,3 +36,5 @@ cat "$DEMO/live_estimates.jsonl" || true
 echo "== recorded: $DEMO/demo.lcmlog ($("$BIN/resolver-echo" --log "$DEMO/demo.lcmlog" | wc -l) messages);"
 echo "   look at it with: $BIN/resolver-echo --log $DEMO/demo.lcmlog --channel RESOLVER_DQ --limit 5"
 echo "   JSON report: $DEMO/report.json"
+echo "== next: find the effect the seed model misses (README, 'find the missing effect in 4 commands'):"
+echo "   $BIN/resolver-model explain $DEMO/demo.log"

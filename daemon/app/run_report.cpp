@@ -96,11 +96,11 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     out << fmt::format("  model fit  {} windows fitted, {} insufficient, {} skipped; last window: verdict {}", c.windows_fitted,
                        c.windows_insufficient, c.windows_skipped, last.verdict.empty() ? "(none)" : last.verdict);
     if (!last.verdict.empty() && std::isfinite(last.residual_rms_rad)) {
-      out << fmt::format(", residual {:.3g} rad ({:.2f}x floor)", last.residual_rms_rad,
-                         last.residual_rms_rad / last.noise_floor_rad);
       if (last.verdict == "missing_effect" && !last.candidate_effect.empty()) {
-        out << ", add " << last.candidate_effect.front();
+        out << " (add " << last.candidate_effect.front() << ")";
       }
+      out << fmt::format("; position-error residual {:.3g} rad = {:.2f}x floor", last.residual_rms_rad,
+                         last.residual_rms_rad / last.noise_floor_rad);
     }
     out << "\n";
   }

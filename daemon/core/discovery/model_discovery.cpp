@@ -853,8 +853,11 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
     hs += (hs.empty() ? "" : ", ") + (x.order == 0 ? std::string("constant") : std::to_string(x.order) + " theta") +
           " " + fmt_num(x.amplitude) + " rad" + phase;
   }
-  if (!hs.empty()) out.push_back("position-error residual by harmonic: " + hs);
-  else if (f.signals[0].rms > ratio * f.signals[0].floor)
+  // Only when the position error itself fails: below the floor its harmonics are
+  // the quantization pattern, not a lead.
+  const bool position_fails = f.signals[0].rms > ratio * f.signals[0].floor;
+  if (position_fails && !hs.empty()) out.push_back("position-error residual by harmonic: " + hs);
+  else if (position_fails)
     out.push_back("position-error residual is not locked to the angle (no harmonic of theta above a fifth of the floor): it changes over time");
   // The dq currents, by order of theta_e: which ripple the current sensors or the inverter leave.
   for (const auto& s : f.signals) {
@@ -1017,16 +1020,23 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
   }
   if (named) {
     ex.verdict = Verdict::kMissingEffect;
-    const EffectSignature* bs = find_signature(best->effect);
-    if (bs != nullptr && bs->current_side()) {
-      const SignalResidual& dq = ex.fit.signals.back();  // "i_dq" is last when currents are fitted
-      ex.summary = "missing_effect: adding " + best->effect + " brings the i_dq residual from " + fmt_num(dq.rms) +
-                   " to " + fmt_num(best->dq_residual_after) + " A (floor " + fmt_num(p.floor_i) + "); " + best->reason;
-    } else {
-      ex.summary = "missing_effect: adding " + best->effect + " brings the position-error residual from " +
-                   fmt_num(ex.fit.residual_rms_rad) + " to " + fmt_num(best->residual_after_rad) + " rad (floor " +
-                   fmt_num(p.floor_rd) + "); " + best->reason;
+    // Say it on the signal the effect changes most (in units of its floor).
+    struct Change {
+      const char* what;
+      double before, after, floor;
+      const char* unit;
+    };
+    std::vector<Change> changes{{"position-error", ex.fit.residual_rms_rad, best->residual_after_rad, p.floor_rd, " rad"}};
+    for (const auto& sr : ex.fit.signals) {
+      if (sr.signal == "sin_cos") changes.push_back({"sin/cos", sr.rms, best->sincos_residual_after, sr.floor, " of the amplitude"});
+      if (sr.signal == "i_dq") changes.push_back({"i_dq", sr.rms, best->dq_residual_after, sr.floor, " A"});
     }
+    const Change& c = *std::max_element(changes.begin(), changes.end(), [](const Change& x, const Change& y) {
+      return (x.before - x.after) / x.floor < (y.before - y.after) / y.floor;
+    });
+    ex.summary = "missing_effect: adding " + best->effect + " brings the " + c.what + " residual from " +
+                 fmt_num(c.before) + " to " + fmt_num(c.after) + c.unit + " (floor " + fmt_num(c.floor) + "); " +
+                 best->reason;
   } else {
     ex.verdict = Verdict::kUnexplained;
     ex.summary = "unexplained: no catalog effect brings the residual near the noise floor; the residual is described "
