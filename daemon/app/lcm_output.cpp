@@ -1,13 +1,30 @@
 #include "daemon/app/lcm_output.h"
 
+#include <time.h>
+
 namespace resolver {
 
-LcmOutput::LcmOutput(const std::string& url, LcmChannels channels) : lcm_(url), channels_(std::move(channels)) {
-  if (!lcm_.good()) {
+LcmOutput::LcmOutput(const std::string& url, LcmChannels channels) : channels_(std::move(channels)) {
+  if (const auto file = LcmLogWriter::parse_url(url)) {
+    writer_ = std::make_unique<LcmLogWriter>(*file);  // throws "cannot open <path> for the LCM log: ..."
+    return;
+  }
+  lcm_ = std::make_unique<lcm::LCM>(url);
+  if (!lcm_->good()) {
     throw std::runtime_error("cannot initialise LCM with URL '" + (url.empty() ? std::string("(default)") : url) +
                              "': check the URL (udpm://239.255.76.67:7667?ttl=0, file:///path?mode=w, memq://) "
                              "and, for udpm, that a multicast route exists (ip route add 224.0.0.0/4 dev lo)");
   }
+}
+
+bool LcmOutput::flush() { return writer_ ? writer_->flush() : true; }
+
+std::int64_t LcmOutput::now_us() {
+  // The log's event time is when the event was written, as lcm-logger and
+  // liblcm's file provider stamp it (wall clock, us since the epoch).
+  timespec ts{};
+  ::clock_gettime(CLOCK_REALTIME, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
 }
 
 }  // namespace resolver

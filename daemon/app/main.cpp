@@ -158,8 +158,11 @@ static int run(int argc, char** argv) {
       std::cerr << "resolverd: calibration saved to " << calibration_path(state_dir) << "\n";
     }
   }
+  (void)output->flush();
   if (output->publish_failures() > 0) {
-    std::cerr << "resolverd: " << output->publish_failures() << " LCM publish calls failed\n";
+    std::cerr << "resolverd: " << output->publish_failures() << " LCM publish calls failed";
+    if (!output->write_error().empty()) std::cerr << " (" << output->write_error() << ")";
+    std::cerr << "\n";
   }
   if (!report_path.empty()) {
     std::ofstream out(report_path);
