@@ -94,7 +94,9 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
     model_fit_t& m = r.message;
     try {
       if (opt.candidates) {
-        const Explanation ex = explain_model(w, opt.effects);
+        DiscoveryOptions dopt;
+        dopt.rank_when_explained = false;  // see DiscoveryOptions: the costly part, moot while explained
+        const Explanation ex = explain_model(w, opt.effects, dopt);
         m = make_model_fit_message(&ex, true, opt.effects);
       } else {
         Explanation ex;

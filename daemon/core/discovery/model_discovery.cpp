@@ -154,16 +154,19 @@ void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x, boo
   }
 }
 
-/// Noise floor of one signal: residual of the saturated angle model per speed bin,
-/// then second differences of consecutive samples, which remove whatever smooth
-/// structure is left (a drift in time, a slow speed change): for white noise of
-/// standard deviation sigma, var(r[i+1] - 2 r[i] + r[i-1]) = 6 sigma^2.
-/// `electrical`: the signal's harmonics are of theta_e (currents), not theta.
-double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all, double (*value)(const Row&),
-                   bool electrical = false) {
+/// Noise floors of several signals on the same rows: residual of the saturated
+/// angle model per speed bin, then second differences of consecutive samples,
+/// which remove whatever smooth structure is left (a drift in time, a slow speed
+/// change): for white noise of standard deviation sigma,
+/// var(r[i+1] - 2 r[i] + r[i-1]) = 6 sigma^2. The signals share one basis matrix
+/// per bin, so its Gram matrix is formed once for all of them.
+/// `electrical`: the signals' harmonics are of theta_e (currents), not theta.
+std::vector<double> noise_floors(const Prepared& prep, const std::vector<std::size_t>& idx_all,
+                                 const std::vector<double (*)(const Row&)>& values, bool electrical = false) {
   const double speed_ratio = electrical ? static_cast<double>(prep.p) / static_cast<double>(prep.p_r) : 1.0;
   const int bins = static_cast<int>(prep.bin_edges.size()) - 1;
-  double sum = 0.0;
+  const auto m = static_cast<Eigen::Index>(values.size());
+  std::vector<double> sum(values.size(), 0.0);
   std::int64_t count = 0;
   for (int b = 0; b < bins; ++b) {
     std::vector<std::size_t> idx;
@@ -177,20 +180,33 @@ double noise_floor(const Prepared& prep, const std::vector<std::size_t>& idx_all
     const int order = nyquist_order(wmax, prep.sample_period);
     const int k = 1 + 2 * order + (prep.reference ? 4 : 0);
     if (idx.size() < static_cast<std::size_t>(4 * k)) continue;
-    std::vector<double> y(idx.size());
-    for (std::size_t i = 0; i < idx.size(); ++i) y[i] = value(prep.rows[idx[i]]);
-    const auto r = ls_residual(
-        idx.size(), k,
-        [&](std::size_t i, Eigen::VectorXd& x) { saturated_basis(prep.rows[idx[i]], order, prep.reference, x, electrical); },
-        y);
-    for (std::size_t i = 1; i + 1 < idx.size(); ++i) {
-      if (idx[i + 1] - idx[i - 1] != 2) continue;  // consecutive samples only
-      const double d = r[i + 1] - 2.0 * r[i] + r[i - 1];
-      sum += d * d;
+    const auto n = static_cast<Eigen::Index>(idx.size());
+    Eigen::MatrixXd x(n, k), y(n, m);
+    Eigen::VectorXd row(k);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Row& r = prep.rows[idx[static_cast<std::size_t>(i)]];
+      saturated_basis(r, order, prep.reference, row, electrical);
+      x.row(i) = row.transpose();
+      for (Eigen::Index j = 0; j < m; ++j) y(i, j) = values[static_cast<std::size_t>(j)](r);
+    }
+    const Eigen::MatrixXd gram = x.transpose() * x;
+    const Eigen::MatrixXd coef = gram.completeOrthogonalDecomposition().solve(x.transpose() * y);
+    const Eigen::MatrixXd res = y - x * coef;
+    for (Eigen::Index i = 1; i + 1 < n; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (idx[iu + 1] - idx[iu - 1] != 2) continue;  // consecutive samples only
+      for (Eigen::Index j = 0; j < m; ++j) {
+        const double d = res(i + 1, j) - 2.0 * res(i, j) + res(i - 1, j);
+        sum[static_cast<std::size_t>(j)] += d * d;
+      }
       ++count;
     }
   }
-  return count > 0 ? std::sqrt(sum / (6.0 * static_cast<double>(count))) : kNaN;
+  std::vector<double> out(values.size(), kNaN);
+  if (count > 0) {
+    for (std::size_t j = 0; j < out.size(); ++j) out[j] = std::sqrt(sum[j] / (6.0 * static_cast<double>(count)));
+  }
+  return out;
 }
 
 /// Without a reference: the ideal angle as a quadratic in time per window of at
@@ -367,19 +383,26 @@ Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
   if (p.cur) {
     p.i_d0 /= static_cast<double>(cur_idx.size());
     p.i_q0 /= static_cast<double>(cur_idx.size());
-    const double fd = noise_floor(p, cur_idx, [](const Row& r) { return r.id; }, true);
-    const double fq = noise_floor(p, cur_idx, [](const Row& r) { return r.iq; }, true);
+    const auto f = noise_floors(p, cur_idx, {[](const Row& r) { return r.id; }, [](const Row& r) { return r.iq; }}, true);
+    const double fd = f[0], fq = f[1];
     p.floor_i = std::sqrt(0.5 * (fd * fd + fq * fq));
     if (!(p.floor_i > 0.0)) {
       p.cur = false;
       p.notes.push_back("phase currents present but their noise floor could not be estimated: not fitted");
     }
   }
-  p.floor_rd = noise_floor(p, all, [](const Row& r) { return r.eps; });
-  if (p.env) {
-    const double fs = noise_floor(p, env_idx, [](const Row& r) { return r.ys; });
-    const double fc = noise_floor(p, env_idx, [](const Row& r) { return r.yc; });
-    p.floor_env = std::sqrt(0.5 * (fs * fs + fc * fc));
+  // The envelopes are present on (nearly) every row: one basis for the three signals then.
+  if (p.env && env_idx.size() == all.size()) {
+    const auto f = noise_floors(p, all, {[](const Row& r) { return r.eps; }, [](const Row& r) { return r.ys; },
+                                         [](const Row& r) { return r.yc; }});
+    p.floor_rd = f[0];
+    p.floor_env = std::sqrt(0.5 * (f[1] * f[1] + f[2] * f[2]));
+  } else {
+    p.floor_rd = noise_floors(p, all, {[](const Row& r) { return r.eps; }})[0];
+    if (p.env) {
+      const auto f = noise_floors(p, env_idx, {[](const Row& r) { return r.ys; }, [](const Row& r) { return r.yc; }});
+      p.floor_env = std::sqrt(0.5 * (f[0] * f[0] + f[1] * f[1]));
+    }
   }
   if (!(p.floor_rd > 0.0)) throw std::invalid_argument("could not estimate the noise floor (too few samples per speed)");
   if (p.env && !(p.floor_env > 0.0)) p.env = false;
@@ -932,6 +955,12 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
   Design d;
   Solved base;
   ex.fit = fit_prepared(p, effects, options, d, base);
+  if (ex.fit.explained && !options.rank_when_explained) {
+    ex.verdict = Verdict::kExplained;
+    ex.summary = "explained: every signal's residual is within " + fmt_num(options.explained_ratio) +
+                 "x its noise floor; no effect is needed (candidates not ranked).";
+    return ex;
+  }
   const double base_bic = ex.fit.bic;
   // Candidates linearise at the model's alpha (SignatureContext::alpha_hat): the
   // added effect moves alpha by far less than the O(alpha^3) the linearisation drops.

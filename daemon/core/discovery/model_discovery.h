@@ -66,6 +66,10 @@ struct DiscoveryOptions {
   /// Points of the per-sample series kept in ModelFit::series for plots (evenly
   /// decimated); 0 = none.
   int series_points = 0;
+  /// Rank the candidates even when the model already explains the log (they are
+  /// never proposed then). resolverd's live windows turn this off: ranking is
+  /// ~90 % of a window's cost and says nothing new while the model holds.
+  bool rank_when_explained = true;
 };
 
 /// A value with its standard error (NaN: not identifiable / not computed).
