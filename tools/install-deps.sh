@@ -11,6 +11,7 @@ PACKAGES=(
   can-utils python3 python3-can
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
+  chromium  # headless, screenshots the resolver-model HTML report (tests/model)
 )
 
 missing=()

@@ -1,32 +1,45 @@
 // resolver-model: offline model discovery on a candump log (issue 4, DESIGN 7).
 //   resolver-model fit LOG [--effects a,b] [--json]
 //   resolver-model explain LOG [--effects a,b] [--json]
+//   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
 // Reads the log (default bench layout), fits the named catalog effects
 // (default amplitude_imbalance), prints residuals against the noise floor and,
-// for explain, the ranked missing effects and a verdict.
+// for explain, the ranked missing effects and a verdict; report runs the
+// discovery loop to its verdict and writes one self-contained HTML page of it.
 #include <CLI/CLI.hpp>
 
+#include <unistd.h>
+
 #include <chrono>
+#include <cstdlib>
+#include <string_view>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "daemon/core/discovery/model_discovery.h"
+#include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
 
 namespace {
 
 /// A one-line progress bar on stderr, shown only once a run has taken longer
-/// than kShowAfter (short logs stay quiet) and only when stderr is a terminal
-/// or RESOLVER_PROGRESS is set.
+/// than 1.5 s (short logs stay quiet) and only when stderr is a terminal.
+/// RESOLVER_PROGRESS=1 shows it on a pipe or file too, =0 never;
+/// RESOLVER_PROGRESS_AFTER_MS changes the delay (tests use 0).
 class ProgressBar {
  public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)), start_(Clock::now()) {}
+  explicit ProgressBar(std::string label) : label_(std::move(label)), start_(Clock::now()) {
+    const char* mode = std::getenv("RESOLVER_PROGRESS");
+    enabled_ = mode != nullptr ? std::string_view(mode) != "0" : ::isatty(STDERR_FILENO) == 1;
+    if (const char* ms = std::getenv("RESOLVER_PROGRESS_AFTER_MS")) show_after_ = std::chrono::milliseconds(std::atol(ms));
+  }
   void operator()(double fraction) {
-    if (Clock::now() - start_ < kShowAfter) return;
+    if (!enabled_ || Clock::now() - start_ < show_after_) return;
     const int width = 30;
     const int filled = static_cast<int>(fraction * width + 0.5);
     std::fprintf(stderr, "\r%s [%.*s%*s] %3.0f%%", label_.c_str(), filled, "##############################",
@@ -42,7 +55,8 @@ class ProgressBar {
 
  private:
   using Clock = std::chrono::steady_clock;
-  static constexpr std::chrono::milliseconds kShowAfter{1500};
+  std::chrono::milliseconds show_after_{1500};
+  bool enabled_ = false;
   std::string label_;
   Clock::time_point start_;
   bool shown_ = false;
@@ -63,6 +77,26 @@ std::vector<std::string> split_effects(const std::vector<std::string>& args) {
   return out;
 }
 
+/// `report`: the discovery steps, the HTML page, one summary line and where it went.
+int write_report(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
+                 resolver::DiscoveryOptions options, int max_steps, const std::string& html_out) {
+  options.series_points = 2000;  // per-sample plots: enough to show the ripple, ~100 kB per dotted plot
+  resolver::DiscoveryRun run;
+  {
+    std::optional<ProgressBar> bar;  // one per step: the number of steps is not known ahead
+    options.progress = [&](double f) { (*bar)(f); };
+    run = resolver::run_discovery(samples.input, effects, options, max_steps, [&](int step) {
+      bar.reset();
+      bar.emplace("step " + std::to_string(step) + ": explaining");
+    });
+  }
+  const std::string page = resolver::format_model_html(run, samples, log, options.explained_ratio);
+  resolver::write_text_file(html_out, page);
+  std::cout << resolver::summarize_discovery(run) << "\n"
+            << "wrote " << html_out << " (" << (page.size() + 512) / 1024 << " KiB)\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -70,7 +104,8 @@ int main(int argc, char** argv) {
                "Examples:\n"
                "  resolver-model fit build/demo/demo.log\n"
                "  resolver-model explain build/demo/demo.log\n"
-               "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json"};
+               "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json\n"
+               "  resolver-model report build/demo/demo.log --html demo.html"};
   app.require_subcommand(1);
   std::string log;
   std::vector<std::string> effects_args;
@@ -88,6 +123,14 @@ int main(int argc, char** argv) {
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
   add_common(fit);
   add_common(explain);
+  CLI::App* report = app.add_subcommand(
+      "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
+  std::string html_out;
+  int max_steps = 6;
+  report->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+  report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)")->delimiter(',');
+  report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
+  report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
   CLI11_PARSE(app, argc, argv);
 
   std::vector<std::string> effects = split_effects(effects_args);
@@ -100,6 +143,7 @@ int main(int argc, char** argv) {
       samples = resolver::read_log_samples(log, [&](double f) { bar(f); });
     }
     resolver::DiscoveryOptions options;
+    if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
     resolver::Explanation ex;
     {
       ProgressBar bar("fitting");
