@@ -149,6 +149,8 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
     }
     o += "],\"where_it_fails\":[";
     for (std::size_t i = 0; i < ex.where_it_fails.size(); ++i) o += (i ? "," : "") + json_str(ex.where_it_fails[i]);
+    o += "],\"missing_pair\":[";
+    for (std::size_t i = 0; i < ex.missing_pair.size(); ++i) o += (i ? "," : "") + json_str(ex.missing_pair[i]);
     o += "],\"verdict\":" + json_str(to_string(ex.verdict)) + ",\"summary\":" + json_str(ex.summary);
   } else {
     o += std::string(",\"verdict\":") + (f.explained ? "\"explained\"" : "null");

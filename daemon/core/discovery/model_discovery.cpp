@@ -1047,7 +1047,33 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
       named = excess > 0.0 && (excess - after) >= kExcessExplainedShare * excess;
     }
   }
-  if (named) {
+  // Two effects missing at once: neither alone removes most of the excess, but a
+  // pair of the proposed ones may reach the floor together (forward selection, one
+  // step deeper; only the three best proposed candidates, so at most three fits).
+  if (!named && best != nullptr) {
+    std::vector<const Candidate*> top;
+    for (const auto& c : ex.candidates) {
+      if (c.proposed && top.size() < 3) top.push_back(&c);
+    }
+    for (std::size_t i = 0; i < top.size() && ex.missing_pair.empty(); ++i) {
+      for (std::size_t j = i + 1; j < top.size() && ex.missing_pair.empty(); ++j) {
+        std::vector<std::string> with(ex.fit.effects.begin(), ex.fit.effects.end());
+        with.push_back(top[i]->effect);
+        with.push_back(top[j]->effect);
+        const Design dp = make_design(p, with);
+        const Solved sp = solve(p, dp, false, alpha_hint);
+        if (sp.ok && signals_explained(p, sp, options.explained_ratio)) {
+          ex.missing_pair = {top[i]->effect, top[j]->effect};
+        }
+      }
+    }
+  }
+  if (!ex.missing_pair.empty()) {
+    ex.verdict = Verdict::kMissingEffect;
+    ex.summary = "missing_effect: two effects are missing: " + ex.missing_pair[0] + " and " + ex.missing_pair[1] +
+                 " together bring every signal to within " + fmt_num(options.explained_ratio) +
+                 "x its noise floor (neither does alone); add " + best->effect + " first. " + best->reason;
+  } else if (named) {
     ex.verdict = Verdict::kMissingEffect;
     // Say it on the signal the effect changes most (in units of its floor).
     struct Change {

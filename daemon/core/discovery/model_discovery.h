@@ -167,6 +167,9 @@ struct Explanation {
   std::vector<std::string> where_it_fails;  ///< sentences; empty when explained
   std::string summary;                      ///< one or two sentences
   std::vector<std::string> not_evaluated;   ///< catalog effects skipped, with why
+  /// When no single effect explains the residual but two proposed ones do together:
+  /// both, best single first (verdict missing_effect). Empty otherwise.
+  std::vector<std::string> missing_pair;
 };
 
 /// Effects this version can fit (catalog names).

@@ -6,6 +6,7 @@
 // Tolerances come from the floor the library estimates from the same data.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -174,6 +175,21 @@ TEST(ModelDiscovery, HiddenDeadTimeIsNamedFirst) {
 
 TEST(ModelDiscovery, HiddenCurrentOffsetsAreNamedFirst) {
   expect_current_effect_found("current_offsets:off_a=0.05,off_b=-0.03", "current_offsets", "off_a", 0.05);
+}
+
+TEST(ModelDiscovery, TwoHiddenEffectsAreNamedAsAPair) {
+  // Neither quadrature nor offsets alone removes most of the excess; together they
+  // reach the floor. The verdict names both, best single first, and adding both explains.
+  const auto in = simulate({"amplitude_imbalance:alpha=0.003", "quadrature:beta=0.002", "offsets:o_s=0.001,o_c=-0.0015"});
+  const Explanation ex = explain_model(in, kDefault);
+  EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
+  ASSERT_EQ(ex.missing_pair.size(), 2U) << ex.summary;
+  EXPECT_EQ(ex.missing_pair[0], ex.candidates.front().effect);
+  std::vector<std::string> pair = ex.missing_pair;
+  std::sort(pair.begin(), pair.end());
+  EXPECT_EQ(pair, (std::vector<std::string>{"offsets", "quadrature"}));
+  const std::vector<std::string> with{"amplitude_imbalance", "quadrature", "offsets"};
+  expect_within_floor(fit_model(in, with));
 }
 
 TEST(ModelDiscovery, AlphaDriftingInTimeIsNotExplainedByACatalogEffect) {
