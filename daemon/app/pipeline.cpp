@@ -9,12 +9,7 @@
 
 namespace resolver {
 
-namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // DESIGN 5: health_t at 1 Hz
-
-std::shared_ptr<const FrameDecoder> make_decoder(const DaemonConfig& config) {
+std::shared_ptr<const FrameDecoder> make_frame_decoder(const DaemonConfig& config) {
   const std::string path = config.dbc_path.empty() ? default_dbc_path() : config.dbc_path;
   auto loaded = config.dbc_path.empty() ? dbc::parse_dbc(embedded_bench_dbc(), path) : dbc::load_dbc_file(path);
   if (auto* err = std::get_if<dbc::DbcError>(&loaded)) throw ConfigError(err->what());
@@ -26,6 +21,11 @@ std::shared_ptr<const FrameDecoder> make_decoder(const DaemonConfig& config) {
                       ": " + e.what());
   }
 }
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // DESIGN 5: health_t at 1 Hz
 
 ProcessorConfig processor_config(const DaemonConfig& c) {
   ProcessorConfig p;
@@ -68,7 +68,7 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
     : config_(config),
       sink_(sink),
       problems_(diagnostics, "resolverd: "),
-      intake_(make_decoder(config), config.max_counter_delta,
+      intake_(make_frame_decoder(config), config.max_counter_delta,
               FrameIntake::Callbacks{
                   [this](const BenchSample& s) { on_sample(s); },
                   [this](const BenchInfo& i) { on_bench_info(i); },

@@ -36,6 +36,10 @@
 
 namespace resolver {
 
+/// The config's DBC (or the built-in one) with its signal map. Throws ConfigError
+/// naming the DBC and config at fault. Also used by resolver-model --config.
+[[nodiscard]] std::shared_ptr<const FrameDecoder> make_frame_decoder(const DaemonConfig& config);
+
 class Pipeline {
  public:
   using Clock = std::chrono::steady_clock;

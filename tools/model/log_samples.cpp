@@ -1,36 +1,22 @@
 #include "tools/model/log_samples.h"
 
-#include <memory>
 #include <stdexcept>
-#include <variant>
 
-#include "daemon/app/embedded_dbc.h"
-#include "daemon/dbc/dbc_parser.h"
+#include "daemon/app/pipeline.h"
 #include "daemon/decode/frame_intake.h"
 #include "daemon/decode/signal_map.h"
 #include "drivers/candump/candump_reader.h"
 
 namespace resolver {
 
-namespace {
-
-/// Counter jumps up to this many samples are accepted as lost frames (as resolverd's default).
-constexpr int kMaxCounterDelta = 16;
-
-std::shared_ptr<const FrameDecoder> bench_decoder() {
-  auto loaded = dbc::parse_dbc(embedded_bench_dbc(), "built-in resolver_bench.dbc");
-  if (auto* err = std::get_if<dbc::DbcError>(&loaded)) throw std::runtime_error(err->what());
-  auto db = std::make_shared<const dbc::Database>(std::move(std::get<dbc::Database>(loaded)));
-  return std::make_shared<const FrameDecoder>(db, SignalMap::bench_default());
-}
-
-}  // namespace
-
-LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress) {
+LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
+                            const DaemonConfig& config) {
   LogSamples out;
+  out.input.p_r = config.bench.p_r;
+  out.input.p = config.bench.p;
   CandumpReader reader(path);  // throws "cannot open <path>: <strerror>"
   std::int64_t first_us = -1;
-  FrameIntake intake(bench_decoder(), kMaxCounterDelta,
+  FrameIntake intake(make_frame_decoder(config), config.max_counter_delta,
                      FrameIntake::Callbacks{
                          [&](const BenchSample& s) {
                            if (first_us < 0) first_us = s.timestamp_us;
@@ -50,7 +36,7 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
                            out.input.samples.push_back(d);
                          },
                          [&](const BenchInfo& i) {
-                           if (i.p_r >= 1 && i.p >= 1) {
+                           if (config.bench.use_bench_info && i.p_r >= 1 && i.p >= 1) {
                              out.input.p_r = i.p_r;
                              out.input.p = i.p;
                              out.bench_info = true;
@@ -80,7 +66,11 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
                              std::to_string(out.bad_lines) +
                              " bad lines, none decoded as the default bench layout (RESOLVER_SAMPLE 0x100 ...)");
   }
-  if (!out.bench_info) out.notes.push_back("no BENCH_INFO frame: assuming p_r = 3, p = 3");
+  if (!out.bench_info) {
+    out.notes.push_back("p_r = " + std::to_string(out.input.p_r) + ", p = " + std::to_string(out.input.p) + " from " +
+                        (config.source.empty() ? std::string("the defaults") : config.source) +
+                        (config.bench.use_bench_info ? " (no BENCH_INFO frame in the log)" : " (use_bench_info = false)"));
+  }
   return out;
 }
 

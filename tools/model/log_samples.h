@@ -1,7 +1,8 @@
-// A candump log of the default bench layout as model-discovery samples:
-// CandumpReader -> FrameIntake (built-in DBC, SignalMap::bench_default) ->
-// DiscoverySample per joined sample. p_r, p come from BENCH_INFO when the log
-// has it (else the bench defaults, p_r = p = 3, and a note says so).
+// A candump log as model-discovery samples: CandumpReader -> FrameIntake (the
+// resolverd config's DBC and signal map: by default the built-in DBC and the
+// default bench layout) -> DiscoverySample per joined sample. p_r, p come from
+// BENCH_INFO when the log has it (unless the config says use_bench_info = false),
+// else the config's [bench] values, and a note says so.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/app/daemon_config.h"
 #include "daemon/core/discovery/model_discovery.h"
 
 namespace resolver {
@@ -24,7 +26,9 @@ struct LogSamples {
 
 /// Reads `path`. progress(fraction of the file's bytes) is called now and then
 /// (may be empty). Throws std::runtime_error "cannot open <path>: ..." when the
-/// file cannot be read, and "<path>: no samples ..." when nothing decodes.
-[[nodiscard]] LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress);
+/// file cannot be read, "<path>: no samples ..." when nothing decodes, and
+/// ConfigError when the config's DBC or signal map is bad.
+[[nodiscard]] LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
+                                          const DaemonConfig& config = DaemonConfig{});
 
 }  // namespace resolver

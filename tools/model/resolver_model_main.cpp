@@ -2,6 +2,8 @@
 //   resolver-model fit LOG [--effects a,b] [--json]
 //   resolver-model explain LOG [--effects a,b] [--json]
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
+// All take --config FILE: a resolverd config whose [layout] (DBC, signal map),
+// [bench] pole pairs and [model] effects apply (logs of a user's own layout).
 // Reads the log (default bench layout), fits the named catalog effects
 // (default amplitude_imbalance), prints residuals against the noise floor and,
 // for explain, the ranked missing effects and a verdict; report runs the
@@ -109,6 +111,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string log;
   std::vector<std::string> effects_args;
+  std::string config_path;
   bool json = false;
   std::string fittable;
   for (auto e : resolver::fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(e);
@@ -118,6 +121,12 @@ int main(int argc, char** argv) {
                     "comma-separated catalog effects of the model (default amplitude_imbalance); fittable: " + fittable)
         ->delimiter(',');
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
+  };
+  auto add_config = [&](CLI::App* sub) {
+    sub->add_option("--config", config_path,
+                    "resolverd config (TOML): its [layout] DBC and signals decode the log, [bench] p_r/p apply "
+                    "without BENCH_INFO, [model] effects is the model when --effects is not given")
+        ->check(CLI::ExistingFile);
   };
   CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
@@ -131,16 +140,21 @@ int main(int argc, char** argv) {
   report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)")->delimiter(',');
   report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
   report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
+  add_config(fit);
+  add_config(explain);
+  add_config(report);
   CLI11_PARSE(app, argc, argv);
 
-  std::vector<std::string> effects = split_effects(effects_args);
-  if (effects.empty()) effects.emplace_back("amplitude_imbalance");
   const bool do_explain = explain->parsed();
   try {
+    resolver::DaemonConfig config;
+    if (!config_path.empty()) config = resolver::load_daemon_config(config_path);  // throws naming file and key
+    std::vector<std::string> effects = split_effects(effects_args);
+    if (effects.empty()) effects = config.model.effects;  // default ["amplitude_imbalance"]
     resolver::LogSamples samples;
     {
       ProgressBar bar("reading " + log);
-      samples = resolver::read_log_samples(log, [&](double f) { bar(f); });
+      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config);
     }
     resolver::DiscoveryOptions options;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
