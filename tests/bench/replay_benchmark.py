@@ -8,8 +8,12 @@ For each log size (default 1 M and 10 M frames) this script
      in the work directory;
   2. runs, side by side and interleaved, R times each (default 3):
        resolverd   --replay LOG --once --fast --quiet --lcm file://OUT.lcmlog
-                   (the full pipeline: parse, decode, join, estimate,
-                   compensate, dq, publish every angle_t / dq_t into an LCM log)
+                   with [model] enabled = false (the full pipeline: parse,
+                   decode, join, estimate, compensate, dq, publish every
+                   angle_t / dq_t into an LCM log)
+       resolverd + model fit: the same with the default config, which also fits
+                   the effect model every 16 revolutions (model_fit_t; on a
+                   second thread that replay waits for, so every window is fitted)
        python-can  can.CanutilsLogReader(LOG), iterating every message
        log2asc     can-utils' converter, log2asc -I LOG -O /dev/null can0
      each under /usr/bin/time -v for the peak RSS, wall time from the parent;
@@ -157,14 +161,27 @@ def run_resolverd(args, log, frames, lcm="file", config=None):
             "lcm_bytes": lcm_bytes}
 
 
+def no_model_config(args, extra=""):
+    config = args.work / ("no_model_fit.toml" if not extra else "no_model_fit_decimation10.toml")
+    config.write_text("# replay_benchmark.py: the pipeline without the live model fit\n"
+                      "[model]\nenabled = false\n" + extra)
+    return config
+
+
+def run_resolverd_pipeline(args, log, frames):
+    return run_resolverd(args, log, frames, config=no_model_config(args))
+
+
+def run_resolverd_model(args, log, frames):
+    return run_resolverd(args, log, frames)  # default config: model fit on
+
+
 def run_resolverd_memq(args, log, frames):
-    return run_resolverd(args, log, frames, lcm="memq://")
+    return run_resolverd(args, log, frames, lcm="memq://", config=no_model_config(args))
 
 
 def run_resolverd_decimated(args, log, frames):
-    config = args.work / "decimation10.toml"
-    config.write_text("# replay_benchmark.py: publish angle_t and dq_t every 10th sample\n"
-                      "[output]\nangle_decimation = 10\ndq_decimation = 10\n")
+    config = no_model_config(args, "[output]\nangle_decimation = 10\ndq_decimation = 10\n")
     return run_resolverd(args, log, frames, config=config)
 
 
@@ -203,7 +220,7 @@ def main():
     args = parse_args()
     check_tools(args)
     args.work.mkdir(parents=True, exist_ok=True)
-    tools = [("resolverd", run_resolverd)]
+    tools = [("resolverd", run_resolverd_pipeline), ("resolverd + model fit", run_resolverd_model)]
     if not args.skip_python_can:
         tools.append(("python-can", run_python_can))
     if not args.skip_log2asc:
