@@ -47,7 +47,7 @@ class LcmLogWriter {
   [[nodiscard]] std::int64_t lost() const { return lost_; }
 
  private:
-  static constexpr std::size_t kFlushAt = 256 * 1024;
+  static constexpr std::size_t kFlushAt = std::size_t{256} * 1024;
   std::string path_;
   int fd_ = -1;
   std::vector<std::uint8_t> buffer_;

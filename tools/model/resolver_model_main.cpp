@@ -12,7 +12,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <string_view>
 #include <cstdio>
@@ -38,12 +40,16 @@ class ProgressBar {
   explicit ProgressBar(std::string label) : label_(std::move(label)), start_(Clock::now()) {
     const char* mode = std::getenv("RESOLVER_PROGRESS");
     enabled_ = mode != nullptr ? std::string_view(mode) != "0" : ::isatty(STDERR_FILENO) == 1;
-    if (const char* ms = std::getenv("RESOLVER_PROGRESS_AFTER_MS")) show_after_ = std::chrono::milliseconds(std::atol(ms));
+    if (const char* ms = std::getenv("RESOLVER_PROGRESS_AFTER_MS")) {
+      char* end = nullptr;
+      const long v = std::strtol(ms, &end, 10);
+      if (end != ms && *end == '\0' && v >= 0) show_after_ = std::chrono::milliseconds(v);  // else keep the default
+    }
   }
   void operator()(double fraction) {
     if (!enabled_ || Clock::now() - start_ < show_after_) return;
     const int width = 30;
-    const int filled = static_cast<int>(fraction * width + 0.5);
+    const int filled = static_cast<int>(std::lround(std::clamp(fraction, 0.0, 1.0) * width));
     std::fprintf(stderr, "\r%s [%.*s%*s] %3.0f%%", label_.c_str(), filled, "##############################",
                  width - filled, "", fraction * 100.0);
     std::fflush(stderr);
@@ -99,9 +105,7 @@ int write_report(const resolver::LogSamples& samples, const std::string& log, co
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"resolver-model: compare the effect model with a log, see where it fails, name the missing effect.\n"
                "Examples:\n"
                "  resolver-model fit build/demo/demo.log\n"
@@ -172,6 +176,17 @@ int main(int argc, char** argv) {
                        : resolver::format_model_text(ex, do_explain, notes));
     return 0;
   } catch (const std::exception& e) {
+    std::cerr << "resolver-model: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {  // e.g. out of memory while building the command line
     std::cerr << "resolver-model: " << e.what() << "\n";
     return 1;
   }

@@ -179,7 +179,7 @@ std::vector<double> noise_floors(const Prepared& prep, const std::vector<std::si
     }
     const int order = nyquist_order(wmax, prep.sample_period);
     const int k = 1 + 2 * order + (prep.reference ? 4 : 0);
-    if (idx.size() < static_cast<std::size_t>(4 * k)) continue;
+    if (idx.size() < 4 * static_cast<std::size_t>(k)) continue;
     const auto n = static_cast<Eigen::Index>(idx.size());
     Eigen::MatrixXd x(n, k), y(n, m);
     Eigen::VectorXd row(k);
@@ -286,14 +286,14 @@ Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
     }
     s.swap(keep);
   } else {
-    p.notes.push_back("no reference angle: fitting against the speed-smoothed ideal angle (constant errors, "
+    p.notes.emplace_back("no reference angle: fitting against the speed-smoothed ideal angle (constant errors, "
                       "mounting offset and eccentricity are not identifiable)");
   }
-  if (!sincos) p.notes.push_back("no sin/cos envelopes: only the R/D angle is fitted (k3 and alpha are not separable)");
-  else if (!p.reference) p.notes.push_back("sin/cos envelopes present but not fitted without a reference angle");
+  if (!sincos) p.notes.emplace_back("no sin/cos envelopes: only the R/D angle is fitted (k3 and alpha are not separable)");
+  else if (!p.reference) p.notes.emplace_back("sin/cos envelopes present but not fitted without a reference angle");
   const bool currents = static_cast<double>(with_i) >= kSignalPresentShare * share;
-  if (!currents) p.notes.push_back("no phase currents in the log: current-side effects are not evaluated");
-  else if (!p.reference) p.notes.push_back("phase currents present but not fitted without a reference angle (dq needs the true theta_e)");
+  if (!currents) p.notes.emplace_back("no phase currents in the log: current-side effects are not evaluated");
+  else if (!p.reference) p.notes.emplace_back("phase currents present but not fitted without a reference angle (dq needs the true theta_e)");
 
   const std::size_t n = s.size();
   std::vector<double> t(n), truth(n), mech(n, 0.0);
@@ -388,7 +388,7 @@ Prepared prepare(const DiscoveryInput& in, const DiscoveryOptions& opt) {
     p.floor_i = std::sqrt(0.5 * (fd * fd + fq * fq));
     if (!(p.floor_i > 0.0)) {
       p.cur = false;
-      p.notes.push_back("phase currents present but their noise floor could not be estimated: not fitted");
+      p.notes.emplace_back("phase currents present but their noise floor could not be estimated: not fitted");
     }
   }
   // The envelopes are present on (nearly) every row: one basis for the three signals then.
@@ -437,10 +437,10 @@ Design make_design(const Prepared& p, std::span<const std::string> effects) {
     if (sig == nullptr) {
       std::string list;
       for (const auto& x : effect_signatures()) list += (list.empty() ? "" : ", ") + std::string(x.effect);
-      throw std::invalid_argument("effect '" + e + "' " +
-                                  (find_effect(e) != nullptr ? "is in the catalog but not fittable in this version"
-                                                             : "is not in the effect catalog") +
-                                  "; fittable: " + list);
+      std::string msg = "effect '" + e + "' ";
+      msg += find_effect(e) != nullptr ? "is in the catalog but not fittable in this version" : "is not in the effect catalog";
+      msg += "; fittable: " + list;
+      throw std::invalid_argument(msg);
     }
     if (sig->needs_reference && !p.reference) {
       throw std::invalid_argument("effect '" + e + "' needs the reference angle, which this log does not have");
@@ -684,7 +684,7 @@ std::vector<HarmonicResidual> harmonic_breakdown(const Prepared& p, const std::v
   std::vector<HarmonicResidual> out;
   out.push_back({0, std::abs(c[0]), c[0] >= 0.0 ? 0.0 : kPi});
   for (int n = 1; n <= max_order; ++n) {
-    const double a = c[2 * n - 1], bb = c[2 * n];
+    const double a = c[2 * Eigen::Index{n} - 1], bb = c[2 * Eigen::Index{n}];
     out.push_back({n, std::hypot(a, bb), std::atan2(bb, a)});
   }
   return out;
@@ -840,7 +840,7 @@ ModelFit fit_prepared(const Prepared& p, std::span<const std::string> effects, c
   f.currents_used = p.cur;
   f.explained = signals_explained(p, s, opt.explained_ratio);
   f.notes = p.notes;
-  if (d.tracking) f.notes.push_back("tracking_loop: zeta assumed 0.7, omega_n searched on [100, 1e5] rad/s");
+  if (d.tracking) f.notes.emplace_back("tracking_loop: zeta assumed 0.7, omega_n searched on [100, 1e5] rad/s");
   return f;
 }
 
@@ -857,7 +857,7 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
     const std::string unit = s.signal == "position_error" ? " rad (" + fmt_num(rad_to_arcmin(s.rms)) + " arcmin)"
                              : s.signal == "i_dq"         ? " A"
                                                           : " of the amplitude";
-    out.push_back(s.signal + ": residual " + fmt_num(s.rms) + unit +
+    out.emplace_back(s.signal + ": residual " + fmt_num(s.rms) + unit +
                   " is " + fmt_num(s.rms / s.floor, "%.1f") + "x the noise floor " + fmt_num(s.floor));
   }
   if (out.empty()) return out;
@@ -879,9 +879,9 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
   // Only when the position error itself fails: below the floor its harmonics are
   // the quantization pattern, not a lead.
   const bool position_fails = f.signals[0].rms > ratio * f.signals[0].floor;
-  if (position_fails && !hs.empty()) out.push_back("position-error residual by harmonic: " + hs);
+  if (position_fails && !hs.empty()) out.emplace_back("position-error residual by harmonic: " + hs);
   else if (position_fails)
-    out.push_back("position-error residual is not locked to the angle (no harmonic of theta above a fifth of the floor): it changes over time");
+    out.emplace_back("position-error residual is not locked to the angle (no harmonic of theta above a fifth of the floor): it changes over time");
   // The dq currents, by order of theta_e: which ripple the current sensors or the inverter leave.
   for (const auto& s : f.signals) {
     if (s.signal != "i_dq" || s.rms <= ratio * s.floor) continue;
@@ -891,7 +891,7 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
       if (std::max(ad, aq) < 0.2 * p.floor_i) continue;
       cs += (cs.empty() ? "" : ", ") + std::to_string(n) + " theta_e: i_d " + fmt_num(ad) + " A, i_q " + fmt_num(aq) + " A";
     }
-    out.push_back(cs.empty() ? "i_dq residual is not locked to theta_e (no harmonic above a fifth of the floor)"
+    out.emplace_back(cs.empty() ? "i_dq residual is not locked to theta_e (no harmonic above a fifth of the floor)"
                              : "i_dq residual by harmonic of theta_e: " + cs);
   }
   // Over time: the catalog's effects are fixed in time, so a residual that grows or
@@ -906,7 +906,7 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
             fmt_num(b.rms / p.floor_rd, "%.1f") + "x floor (2 theta " + fmt_num(b.order2_amplitude) + " rad)";
     }
     if (hi > ratio * p.floor_rd && hi > 2.0 * lo) {
-      out.push_back("the position-error residual changes over time (" + ts +
+      out.emplace_back("the position-error residual changes over time (" + ts +
                     "): no catalog effect depends on time (a drift, e.g. with temperature, is outside the catalog)");
     }
   }
@@ -915,7 +915,7 @@ std::vector<std::string> describe_failure(const Prepared& p, const ModelFit& f, 
     for (const auto& b : f.speed_bins) {
       bs += (bs.empty() ? "" : ", ") + fmt_num(b.rpm_mid, "%.0f") + " r/min: " + fmt_num(b.rms / p.floor_rd, "%.1f") + "x floor";
     }
-    out.push_back("by speed: " + bs);
+    out.emplace_back("by speed: " + bs);
   }
   return out;
 }
@@ -975,17 +975,17 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
     const std::string name(sig.effect);
     if (std::find(ex.fit.effects.begin(), ex.fit.effects.end(), name) != ex.fit.effects.end()) continue;
     if (sig.needs_reference && !p.reference) {
-      ex.not_evaluated.push_back(name + ": needs the reference angle");
+      ex.not_evaluated.emplace_back(name + ": needs the reference angle");
       continue;
     }
     if (sig.current_side() && !p.cur) {
-      ex.not_evaluated.push_back(name + ": needs the phase currents");
+      ex.not_evaluated.emplace_back(name + ": needs the phase currents");
       continue;
     }
     if (sig.nonlinear && !two_speeds(p)) {
       // H(j k omega) at one speed is a fixed gain and phase per harmonic: it cannot be
       // told from the other effects' amplitudes, and the omega_n search is the costly part.
-      ex.not_evaluated.push_back(name + ": one speed in this log; the loop's filtering shows only over a speed change");
+      ex.not_evaluated.emplace_back(name + ": one speed in this log; the loop's filtering shows only over a speed change");
       continue;
     }
     std::vector<std::string> with(ex.fit.effects.begin(), ex.fit.effects.end());
@@ -993,7 +993,7 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
     const Design dc = make_design(p, with);
     const Solved sc = solve(p, dc, false, alpha_hint);
     if (!sc.ok) {
-      ex.not_evaluated.push_back(name + ": not separable from the model with the signals in this log" +
+      ex.not_evaluated.emplace_back(name + ": not separable from the model with the signals in this log" +
                                  (p.env ? std::string() : std::string(" (needs sin/cos with a reference)")));
       continue;
     }
@@ -1018,8 +1018,8 @@ Explanation explain_model(const DiscoveryInput& input, std::span<const std::stri
   for (const auto& e : effect_catalog()) {
     if (find_signature(e.name) != nullptr) continue;
     const std::string n(e.name);
-    if (n == "quantization" || n == "noise") ex.not_evaluated.push_back(n + ": sets the noise floor, not a candidate");
-    else ex.not_evaluated.push_back(n + ": no signature in this version");
+    if (n == "quantization" || n == "noise") ex.not_evaluated.emplace_back(n + ": sets the noise floor, not a candidate");
+    else ex.not_evaluated.emplace_back(n + ": no signature in this version");
   }
   std::sort(ex.candidates.begin(), ex.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
 

@@ -41,7 +41,7 @@ TEST(LcmLogWriter, LiblcmReadsBackEveryEvent) {
     for (int i = 0; i < kEvents; ++i) {
       angle_t a{};
       a.utime = i;
-      a.sample_index = 3 * i;
+      a.sample_index = 3 * static_cast<std::int64_t>(i);
       a.theta_rd = 0.001 * i;
       out.publish(a);
     }
