@@ -60,9 +60,9 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.2e} (std. error; spread {:.2e} over {} revolutions) {}\n",
                        est.alpha(), est.alpha_stderr(), est.alpha_spread(), est.revolutions(),
                        est.converged() ? "converged" : "NOT converged");
-    out << fmt::format("             revolutions rejected: speed not constant {}, too few samples {}, too slow {}\n",
+    out << fmt::format("             revolutions rejected: speed not constant {}, too few samples {}, too slow {}, samples lost {}\n",
                        est.rejected(HwangRejection::kSpeedNotConstant), est.rejected(HwangRejection::kTooFewSamples),
-                       est.rejected(HwangRejection::kTooSlow));
+                       est.rejected(HwangRejection::kTooSlow), est.rejected(HwangRejection::kGap));
   } else {
     out << fmt::format("  estimate   {}: {} over {:.0f} revolutions{}\n", model.method,
                        model.converged ? "converged" : "NOT converged", model.revolutions,

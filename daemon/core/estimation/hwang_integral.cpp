@@ -1,5 +1,6 @@
 #include "daemon/core/estimation/hwang_integral.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -64,6 +65,12 @@ std::optional<HwangRevolution> HwangIntegralEstimator::close_revolution(double t
   }
   if (previous && std::abs(period - *previous) > config_.max_speed_change * *previous) {
     ++s.rejected[static_cast<int>(HwangRejection::kSpeedNotConstant)];
+    return std::nullopt;
+  }
+  double max_step = std::max(s.t.front() - s.start_time, t_cross - s.t.back());
+  for (std::size_t i = 1; i < s.t.size(); ++i) max_step = std::max(max_step, s.t[i] - s.t[i - 1]);
+  if (max_step > config_.max_gap_intervals * period / static_cast<double>(n)) {
+    ++s.rejected[static_cast<int>(HwangRejection::kGap)];
     return std::nullopt;
   }
   // Ideal angle: straight line through the two crossings of the same R/D level.

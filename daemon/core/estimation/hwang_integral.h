@@ -49,6 +49,11 @@ struct HwangIntegralConfig {
   int min_samples_per_revolution = 16;
   /// A revolution taking longer than this is a stop, not a revolution [s].
   double max_revolution_time_s = 10.0;
+  /// Largest time step between consecutive samples (and from the crossings to the
+  /// first and last sample) in units of the revolution's mean sample interval; a
+  /// longer step means lost samples. 2.5: at constant speed and a fixed rate the
+  /// steps are 1 interval (2 at most next to a crossing); one lost sample makes 2.
+  double max_gap_intervals = 2.5;
 };
 
 /// Result of one completed resolver electrical revolution.
@@ -58,7 +63,10 @@ struct HwangRevolution {
   int samples = 0;             ///< samples in the revolution
 };
 
-enum class HwangRejection : std::uint8_t { kSpeedNotConstant, kTooFewSamples, kTooSlow };
+/// kGap: samples missing inside the revolution (lost frames): the quarter sums
+/// no longer balance and alpha_k can be off by any amount. Seen in the vcan soak
+/// with kernel drops: one such revolution took the mean to -3.9e9.
+enum class HwangRejection : std::uint8_t { kSpeedNotConstant, kTooFewSamples, kTooSlow, kGap };
 
 struct HwangIntegralState {
   AngleUnwrapper unwrap;
@@ -77,7 +85,7 @@ struct HwangIntegralState {
   double mean = 0.0;
   double m2 = 0.0;
   std::int64_t samples_used = 0;
-  std::int64_t rejected[3] = {0, 0, 0};
+  std::int64_t rejected[4] = {0, 0, 0, 0};
 };
 
 class HwangIntegralEstimator {

@@ -116,6 +116,31 @@ TEST(HwangIntegral, RejectsRevolutionsWhenSpeedChanges) {
   EXPECT_NEAR(est.alpha(), s.alpha, s.alpha * s.alpha / 2.0 + 5.0 * quantization_sigma(s));
 }
 
+TEST(HwangIntegral, RevolutionsWithLostSamplesAreRejected) {
+  // Frames lost on the bus (kernel drops): every 7th revolution loses a block of
+  // 40 of its ~200 samples. Those revolutions must be rejected, not averaged in;
+  // the estimate stays within the quantization bound of the clean ones.
+  HwangIntegralEstimator est(HwangIntegralConfig{});
+  RotationCase s;
+  const double rate = 2000.0;
+  int dropped_blocks = 0;
+  for (int i = 0; i < 40000; ++i) {
+    const double t = i / rate;
+    const double theta = s.omega * t;
+    const auto rev = static_cast<int>(theta / kTwoPi);
+    const double in_rev = theta / kTwoPi - rev;
+    if (rev % 7 == 3 && in_rev > 0.3 && in_rev < 0.5) {
+      if (in_rev + s.omega / rate / kTwoPi >= 0.5) ++dropped_blocks;
+      continue;
+    }
+    est.update(t, rd_angle(s, theta));
+  }
+  ASSERT_GT(dropped_blocks, 5);
+  EXPECT_GE(est.rejected(HwangRejection::kGap), dropped_blocks - 1);
+  EXPECT_TRUE(est.converged());
+  EXPECT_NEAR(est.alpha(), s.alpha, s.alpha * s.alpha / 2.0 + 5.0 * quantization_sigma(s));
+}
+
 TEST(HwangIntegral, TooFewSamplesPerRevolutionAreRejected) {
   RotationCase s;
   s.omega = kTwoPi * 200.0;  // 10 samples per revolution at 2 kHz
