@@ -25,6 +25,8 @@
 // published something (the one completing a sample: angle_t + dq_t, plus
 // health_t once a second) have a publish latency; "all frames" is arrival to
 // the end of Pipeline::feed for every frame.
+#include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
 #include <time.h>
@@ -65,6 +67,9 @@ struct Options {
   std::string lcm = "memq://";
   std::string iface;  // empty: socket pair on the host
   std::string json;
+  std::string config;    // resolverd config file; "" = the built-in defaults
+  int sender_fifo = 50;  // SCHED_FIFO priority of the sending thread; 0 = normal
+  int reader_fifo = 0;   // of the reading thread (resolverd's unit sets none)
 };
 
 std::int64_t realtime_ns() {
@@ -135,13 +140,13 @@ Endpoints open_endpoints(const Options& o) {
 }
 
 RunResult run_once(const Options& o) {
-  resolver::DaemonConfig config;
+  resolver::DaemonConfig config = o.config.empty() ? resolver::DaemonConfig{} : resolver::load_daemon_config(o.config);
   config.lcm_url = o.lcm;
   resolver::LcmOutput lcm(o.lcm, config.channels);
   TimingSink sink(lcm);
   resolver::Pipeline pipeline(config, sink, std::cerr);
   Endpoints ends = open_endpoints(o);
-  FrameFeed feed(o.rate, o.seconds);
+  FrameFeed feed(o.rate);
 
   RunResult r;
   const auto expected = static_cast<std::size_t>(o.rate * o.seconds * 1.05) + 64;
@@ -152,11 +157,22 @@ RunResult run_once(const Options& o) {
   std::atomic<bool> stop{false};
   std::atomic<bool> writer_done{false};
   SendCounts sent;
-  PaceConfig pace{o.rate, o.burst, o.seconds, 0.0};
+  PaceConfig pace{o.rate, o.burst, o.seconds, 0.0, o.sender_fifo};
   std::thread writer([&] {
     sent = resolver::bench_live::send_paced(ends.writer_fd(), feed, pace, stop);
-    // Socket pair: end of stream for the reader (0-byte read + POLLHUP).
-    if (!ends.writer_can) ::shutdown(ends.writer_owned.get(), SHUT_WR);
+    if (ends.writer_can) {
+      // The kernel reports receive-queue drops (SO_RXQ_OVFL) only with a
+      // delivered frame: one end marker (ID 0x7FF, an unknown_id reject)
+      // carries the final count.
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      resolver::CanFrame marker;
+      marker.id = 0x7FF;
+      marker.len = 1;
+      resolver::bench_live::send_one(ends.writer_fd(), marker, sent);
+    }
+    // Socket pair: closing the writing end is the end of stream for the reader
+    // (0-byte read + POLLHUP -> kDeviceGone); shutdown(SHUT_WR) would give no POLLHUP.
+    ends.writer_owned.reset();
     writer_done.store(true);
   });
 
@@ -178,7 +194,7 @@ RunResult run_once(const Options& o) {
       pipeline.feed(frame, 0, t_read);
       const std::int64_t done_ns = realtime_ns();
       ++r.frames_read;
-      last_frame = Clock::now();
+      last_frame = t_read;
       if (!first_frame) first_frame = t_read;
       if (!window_start && t_read - *first_frame >= std::chrono::duration<double>(warmup)) {
         window_start = t_read;
@@ -195,10 +211,9 @@ RunResult run_once(const Options& o) {
           r.publish_read_us.push_back(static_cast<float>(static_cast<double>(sink.last_return_ns() - read_ns) * 1e-3));
         }
       }
-    } else if (status == resolver::ReadStatus::kDeviceGone) {
-      break;  // socket pair closed by the writer
-    } else if (status == resolver::ReadStatus::kTimeout && writer_done.load()) {
-      break;  // vcan: nothing for read_timeout after the writer finished
+    } else if (status == resolver::ReadStatus::kDeviceGone ||  // socket pair closed by the writer
+               (status == resolver::ReadStatus::kTimeout && writer_done.load())) {  // vcan: quiet after the end
+      break;
     }
     pipeline.set_kernel_drops(static_cast<std::int64_t>(ends.reader.stats().kernel_drops));
     pipeline.tick(realtime_ns() / 1000);
@@ -220,12 +235,11 @@ RunResult run_once(const Options& o) {
   r.rejects = pipeline.intake().rejects().total();
   r.lcm_failures = lcm.publish_failures();
   r.sample_rate_hz = feed.sample_rate_hz();
+  r.rpm = feed.rpm();
   return r;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"Live latency of resolverd's SocketCAN read path: frame arrival -> LCM publish return, and CPU share.\n"
                "Host (no PF_CAN): frames go through socketpair(AF_UNIX, SOCK_SEQPACKET) into SocketCanSource::adopt.\n"
                "With --iface vcan0 (vcan guest): a real CAN_RAW socket. See docs/PERFORMANCE.md, 'Live latency'."};
@@ -239,7 +253,20 @@ int main(int argc, char** argv) {
   app.add_option("--lcm", o.lcm, "LCM URL of the output (memq://, or udpm://239.255.76.67:7667?ttl=0)");
   app.add_option("--iface", o.iface, "read a real SocketCAN interface (vcan0) instead of a socket pair");
   app.add_option("--json", o.json, "also write the results as JSON to this file");
+  app.add_option("--config", o.config, "resolverd config (TOML) for the pipeline, e.g. decimation or [model] enabled = false");
+  app.add_option("--sender-fifo", o.sender_fifo,
+                 "SCHED_FIFO priority of the sending thread, so host load does not bunch the frames; 0 = normal");
+  app.add_option("--reader-fifo", o.reader_fifo,
+                 "SCHED_FIFO priority of the reading (daemon) thread; 0 = normal, as resolverd runs by default");
   CLI11_PARSE(app, argc, argv);
+
+  std::string reader_sched = "SCHED_OTHER";
+  if (o.reader_fifo > 0) {
+    sched_param sp{};
+    sp.sched_priority = o.reader_fifo;
+    const bool ok = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp) == 0;
+    reader_sched = ok ? "SCHED_FIFO " + std::to_string(o.reader_fifo) : "SCHED_OTHER (SCHED_FIFO refused)";
+  }
 
   std::vector<RunResult> runs;
   try {
@@ -250,7 +277,8 @@ int main(int argc, char** argv) {
   }
   const resolver::bench_live::Setup setup{o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
                                                           : o.iface + " (CAN_RAW) -> SocketCanSource::open",
-                                          o.lcm, o.rate, o.burst, o.seconds, std::min(o.warmup, o.seconds / 4.0)};
+                                          o.lcm + (o.config.empty() ? "" : ", config " + o.config), o.rate, o.burst, o.seconds, std::min(o.warmup, o.seconds / 4.0),
+                                          reader_sched};
   resolver::bench_live::print_table(std::cout, setup, runs);
   if (!o.json.empty()) {
     std::ofstream out(o.json);
@@ -258,4 +286,17 @@ int main(int argc, char** argv) {
   }
   // Not a timing test: only a lost or mangled frame makes this fail.
   return resolver::bench_live::all_frames_accounted(runs) ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "live_latency_bench: " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "live_latency_bench: unknown exception\n";
+  }
+  return 2;
 }

@@ -2,6 +2,9 @@
 
 #include <linux/can/error.h>
 #include <poll.h>
+#include <pthread.h>
+#include <sched.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <time.h>
 
@@ -14,17 +17,14 @@
 namespace resolver::bench_live {
 namespace {
 
-constexpr double kRpm = 200.0;            // Hwang's test speed [r/min]
 constexpr double kBenchInfoHz = 10.0;     // BENCH_INFO rate (DESIGN 4)
 constexpr double kFramesPerSample = 3.0;  // sample + currents + reference
 constexpr std::int64_t kNsPerS = 1'000'000'000;
 
-SimConfig sim_config(double frames_per_s, double seconds) {
+SimConfig sim_config(double sample_rate_hz, double rpm, int samples) {
   SimConfig c;
-  // Whole Hz (BENCH_INFO carries a u16): 8000 frames/s -> 2663 Hz -> 7999 frames/s.
-  c.sample_rate_hz = std::max(1.0, std::round((frames_per_s - kBenchInfoHz) / kFramesPerSample));
-  // A margin so the feed outlasts the paced run even if the sender catches up.
-  c.profile = {{seconds + 5.0, kRpm, kRpm}};
+  c.sample_rate_hz = sample_rate_hz;
+  c.profile = {{static_cast<double>(samples) / sample_rate_hz, rpm, rpm}};
   c.chain.amplitude_imbalance.alpha = 0.003;
   return c;
 }
@@ -56,20 +56,15 @@ CanFrame error_frame() {
 
 }  // namespace
 
-FrameFeed::FrameFeed(double frames_per_s, double seconds) : sim_(sim_config(frames_per_s, seconds)) {
-  pending_.reserve(8);
-}
-
-bool FrameFeed::next(CanFrame& out) {
-  if (at_ == pending_.size()) {
-    pending_.clear();
-    at_ = 0;
-    SimSample s{};
-    if (!sim_.next(s)) return false;
-    sim_.append_frames(s, pending_);
-  }
-  out = pending_[at_++];
-  return true;
+FrameFeed::FrameFeed(double frames_per_s) {
+  // Whole Hz (BENCH_INFO carries a u16): 8000 frames/s -> 2663 Hz -> 7999 frames/s.
+  sample_rate_hz_ = std::max(1.0, std::round((frames_per_s - kBenchInfoHz) / kFramesPerSample));
+  rpm_ = sample_rate_hz_ * 60.0 / kSamplesPerRevolution;
+  const int samples = kSamplesPerRevolution * kLoopRevolutions;
+  BenchSimulator sim(sim_config(sample_rate_hz_, rpm_, samples));
+  frames_.reserve(static_cast<std::size_t>(samples) * 4);
+  SimSample s{};
+  while (sim.next(s)) sim.append_frames(s, frames_);
 }
 
 bool send_one(int fd, const CanFrame& frame, SendCounts& counts) {
@@ -103,27 +98,34 @@ bool send_one(int fd, const CanFrame& frame, SendCounts& counts) {
 
 SendCounts send_paced(int fd, FrameFeed& feed, const PaceConfig& cfg, const std::atomic<bool>& stop) {
   SendCounts counts;
+  // The default timer slack (50 us) would let the kernel defer each wake-up
+  // by up to 40 % of a frame period; ask for exact wake-ups on this thread.
+  ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+  ::pthread_setname_np(::pthread_self(), "llb-sender");  // tells it apart in perf/top
+  if (cfg.fifo_priority > 0) {
+    // A bus is not delayed by host load: with SCHED_FIFO the sender's timing
+    // stays close to the schedule even while other work fills the cores.
+    sched_param sp{};
+    sp.sched_priority = cfg.fifo_priority;
+    counts.fifo = ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp) == 0;
+  }
   const int burst = std::max(1, cfg.burst);
   const double period_ns = 1e9 / cfg.frames_per_s;
   const auto total = static_cast<std::uint64_t>(cfg.seconds * cfg.frames_per_s);
   const auto error_every = static_cast<std::uint64_t>(cfg.error_every_s * cfg.frames_per_s);
   const CanFrame err_frame = error_frame();
-  CanFrame frame;
   const std::int64_t t0 = mono_ns();
   std::uint64_t i = 0;
-  bool more = true;
-  while (more && i < total && !stop.load(std::memory_order_relaxed)) {
+  while (i < total && !stop.load(std::memory_order_relaxed)) {
     // Absolute schedule: a late wake-up is caught up by the next burst rather
     // than shifting every later frame (the bus does not slow down either).
     const std::int64_t due = t0 + static_cast<std::int64_t>(static_cast<double>(i) * period_ns);
     sleep_until_ns(due);
     const double late_ns = static_cast<double>(mono_ns() - due);
-    if (late_ns > period_ns) ++counts.late_wakeups;
+    if (late_ns > period_ns * burst) ++counts.late_wakeups;  // the next wake-up was due already
     counts.max_late_us = std::max(counts.max_late_us, late_ns * 1e-3);
     for (int b = 0; b < burst && i < total; ++b, ++i) {
-      more = feed.next(frame);
-      if (!more) break;
-      send_one(fd, frame, counts);
+      send_one(fd, feed.next(), counts);
       if (error_every > 0 && i % error_every == error_every - 1) send_one(fd, err_frame, counts);
     }
   }

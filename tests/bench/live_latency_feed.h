@@ -18,20 +18,34 @@
 
 namespace resolver::bench_live {
 
-/// Endless stream of default-layout frames (200 r/min, alpha = 0.003).
+/// Endless stream of default-layout frames (alpha = 0.003). The simulator
+/// runs once, for kLoopRevolutions mechanical revolutions of 768 samples each
+/// (the speed is chosen for that: ~208 r/min at 8000 frames/s), and the frames
+/// are then replayed in a loop: 768 is a multiple of 256, so the u8 counters
+/// and the angles run on seamlessly across the seam. Generating on the fly
+/// would cost the sender more CPU than the reader it measures (the simulator's
+/// maths is slow under emulation in the vcan guest).
 class FrameFeed {
  public:
-  /// `frames_per_s` sets the simulated control rate; `seconds` how long the
-  /// stream lasts before it ends (next() then returns false).
-  FrameFeed(double frames_per_s, double seconds);
-  /// The next frame in bus order; false when the simulated run is over.
-  bool next(CanFrame& out);
-  [[nodiscard]] double sample_rate_hz() const { return sim_.config().sample_rate_hz; }
+  static constexpr int kSamplesPerRevolution = 768;
+  static constexpr int kLoopRevolutions = 4;
+
+  explicit FrameFeed(double frames_per_s);
+  /// The next frame in bus order (endless).
+  const CanFrame& next() {
+    const CanFrame& f = frames_[at_];
+    at_ = at_ + 1 == frames_.size() ? 0 : at_ + 1;
+    return f;
+  }
+  [[nodiscard]] double sample_rate_hz() const { return sample_rate_hz_; }
+  [[nodiscard]] double rpm() const { return rpm_; }
+  [[nodiscard]] std::size_t loop_frames() const { return frames_.size(); }
 
  private:
-  BenchSimulator sim_;
-  std::vector<CanFrame> pending_;
+  std::vector<CanFrame> frames_;
   std::size_t at_ = 0;
+  double sample_rate_hz_ = 0.0;
+  double rpm_ = 0.0;
 };
 
 struct PaceConfig {
@@ -39,6 +53,7 @@ struct PaceConfig {
   int burst = 1;                ///< frames sent back to back per wake-up
   double seconds = 10.0;        ///< how long to send
   double error_every_s = 0.0;   ///< inject one CAN error frame this often; 0 = never
+  int fifo_priority = 0;        ///< > 0: run the sending thread SCHED_FIFO at this priority
 };
 
 /// What the sender did; every frame it tried to send is in exactly one of
@@ -49,14 +64,14 @@ struct SendCounts {
   std::uint64_t error_sent = 0;     ///< of `sent`, error frames
   std::uint64_t failed_down = 0;    ///< ENETDOWN: the link was down (never reached a reader)
   std::uint64_t failed_other = 0;   ///< any other send failure (ENOBUFS after retries, ...)
-  std::uint64_t late_wakeups = 0;   ///< wake-ups more than one frame period after their due time
+  std::uint64_t late_wakeups = 0;   ///< wake-ups so late that the next one was already due
   double max_late_us = 0.0;         ///< [us] worst wake-up lateness
   double seconds = 0.0;             ///< [s] first to last send
+  bool fifo = false;                ///< the sender ran SCHED_FIFO (fifo_priority granted)
 };
 
 /// Sends frames from `feed` on `fd` (a connected datagram socket: CAN_RAW or
-/// AF_UNIX) at cfg.frames_per_s until cfg.seconds pass, the feed ends or
-/// `stop` is set. Blocking sends; ENOBUFS is retried for up to ~100 ms.
+/// AF_UNIX) at cfg.frames_per_s until cfg.seconds pass or `stop` is set. Blocking sends; ENOBUFS is retried for up to ~100 ms.
 SendCounts send_paced(int fd, FrameFeed& feed, const PaceConfig& cfg, const std::atomic<bool>& stop);
 
 /// Sends one frame outside the pacing (end markers); true when accepted.

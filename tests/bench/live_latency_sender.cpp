@@ -23,9 +23,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int /*sig*/) { g_stop.store(true); }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"Sends default-bench frames at a fixed rate on a CAN interface (vcan soak); counts what the link "
                "refused while down. Output: sender_* key=value lines."};
   std::string iface = "vcan0";
@@ -49,7 +47,7 @@ int main(int argc, char** argv) {
     so.iface = iface;
     so.receive_error_frames = false;
     resolver::SocketCanSource sock = resolver::SocketCanSource::open(so);
-    resolver::bench_live::FrameFeed feed(pace.frames_per_s, pace.seconds);
+    resolver::bench_live::FrameFeed feed(pace.frames_per_s);
     resolver::bench_live::SendCounts c = resolver::bench_live::send_paced(sock.fd(), feed, pace, g_stop);
     if (marker) {
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
@@ -67,4 +65,15 @@ int main(int argc, char** argv) {
     return 2;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (...) {
+    std::cerr << "live_latency_sender: unexpected exception\n";
+  }
+  return 2;
 }

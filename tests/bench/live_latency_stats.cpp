@@ -1,6 +1,7 @@
 #include "tests/bench/live_latency_stats.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -10,7 +11,7 @@ namespace {
 /// Nearest-rank percentile of a sorted vector; 0 when empty.
 double pct(const std::vector<float>& sorted, double q) {
   if (sorted.empty()) return 0.0;
-  const auto i = static_cast<std::size_t>(q * static_cast<double>(sorted.size() - 1) + 0.5);
+  const auto i = static_cast<std::size_t>(std::llround(q * static_cast<double>(sorted.size() - 1)));
   return static_cast<double>(sorted[std::min(i, sorted.size() - 1)]);
 }
 
@@ -62,6 +63,7 @@ Row summarize(RunResult& r) {
 Row median_row(const std::vector<Row>& rows) {
   auto col = [&](double Row::*m) {
     std::vector<double> v;
+    v.reserve(rows.size());
     for (const Row& r : rows) v.push_back(r.*m);
     return median(v);
   };
@@ -76,6 +78,7 @@ Row median_row(const std::vector<Row>& rows) {
 
 void print_table(std::ostream& out, const Setup& s, std::vector<RunResult>& runs) {
   std::vector<Row> rows;
+  rows.reserve(runs.size());
   for (RunResult& r : runs) rows.push_back(summarize(r));
   const Row m = median_row(rows);
   out << "live latency: frame arrival -> LCM publish return (resolverd's live read path)\n"
@@ -83,8 +86,11 @@ void print_table(std::ostream& out, const Setup& s, std::vector<RunResult>& runs
       << "  output  LcmOutput " << s.lcm << "\n"
       << "  traffic " << fmt("%.0f", s.rate) << " frames/s, " << s.burst << " per sender wake-up, default bench layout ("
       << fmt("%.0f", runs.empty() ? 0.0 : runs.front().sample_rate_hz)
-      << " Hz x 3 frames + BENCH_INFO 10 Hz), " << fmt("%.1f", s.seconds) << " s per run, first "
-      << fmt("%.1f", s.warmup) << " s not counted\n\n"
+      << " Hz x 3 frames + BENCH_INFO 10 Hz, " << fmt("%.0f", runs.empty() ? 0.0 : runs.front().rpm)
+      << " r/min, " << FrameFeed::kLoopRevolutions << " revolutions looped), " << fmt("%.1f", s.seconds) << " s per run, first "
+      << fmt("%.1f", s.warmup) << " s not counted\n"
+      << "  threads reader (daemon side) " << s.reader_sched << ", sender "
+      << (runs.empty() || !runs.front().sent.fifo ? "SCHED_OTHER" : "SCHED_FIFO") << "\n\n"
       << "| run | frames | publishing frames | arrival->publish p50 [us] | p99 [us] | max [us] | recvmsg->publish p50 [us] "
          "| p99 [us] | max [us] | all frames arrival->done p99 [us] | CPU [% of a core] | reader wake-ups/s | sender "
          "late wake-ups / max [us] |\n"
@@ -110,6 +116,7 @@ void print_table(std::ostream& out, const Setup& s, std::vector<RunResult>& runs
 
 void write_json(std::ostream& out, const Setup& s, std::vector<RunResult>& runs) {
   std::vector<Row> rows;
+  rows.reserve(runs.size());
   for (RunResult& r : runs) rows.push_back(summarize(r));
   auto row_json = [&](const Row& w) {
     return "{\"frames\": " + fmt("%.0f", w.frames) + ", \"published\": " + fmt("%.0f", w.published) +
@@ -122,7 +129,8 @@ void write_json(std::ostream& out, const Setup& s, std::vector<RunResult>& runs)
            ", \"sender_max_late_us\": " + fmt("%.0f", w.max_late_us) + "}";
   };
   out << "{\"source\": \"" << s.source << "\", \"lcm\": \"" << s.lcm << "\", \"rate\": " << s.rate
-      << ", \"burst\": " << s.burst << ", \"seconds\": " << s.seconds << ", \"runs\": [";
+      << ", \"burst\": " << s.burst << ", \"reader_sched\": \"" << s.reader_sched << "\""
+      << ", \"seconds\": " << s.seconds << ", \"runs\": [";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const RunResult& r = runs[i];
     out << (i ? ", " : "") << "{\"row\": " << row_json(rows[i]) << ", \"sent\": " << r.sent.sent

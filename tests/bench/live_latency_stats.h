@@ -30,6 +30,7 @@ struct RunResult {
   std::int64_t rejects = 0;
   std::uint64_t lcm_failures = 0;
   double sample_rate_hz = 0.0;
+  double rpm = 0.0;
 };
 
 struct Setup {
@@ -39,6 +40,7 @@ struct Setup {
   int burst = 1;
   double seconds = 0.0;
   double warmup = 0.0;
+  std::string reader_sched;  ///< scheduling of the daemon-side thread
 };
 
 /// One row of the table; also the median row.
