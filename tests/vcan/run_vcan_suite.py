@@ -32,7 +32,7 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ALL_SCENARIOS = ["replay", "errors", "linkflap", "recreate", "sighup", "fd", "fullspeed", "latency", "soak"]
+ALL_SCENARIOS = ["replay", "errors", "linkflap", "recreate", "sighup", "model", "fd", "fullspeed", "latency", "soak"]
 NEEDS_ROOT_NATIVELY = {"linkflap", "recreate", "soak"}  # they take vcan0 down / delete it
 # Scenarios that run the live benchmark's programs (tests/bench/live_latency_*).
 LIVE_BENCH_PROGS = {"latency": "live_latency_bench", "soak": "live_latency_sender"}
@@ -82,6 +82,20 @@ def make_inputs(bin_dir, in_dir):
     while " 100#" not in lines[cut]:
         cut += 1
     for name, part in (("half1.log", lines[:cut]), ("half2.log", lines[cut:])):
+        with open(os.path.join(in_dir, name), "w") as f:
+            f.writelines(part)
+
+    # model: 6 s with quadrature hidden next to alpha, in two halves (seed model, then
+    # the model with quadrature added by SIGHUP).
+    model = os.path.join(in_dir, "model.log")
+    run([os.path.join(bin_dir, "resolver-sim"), "--out", model, "--rpm", "200", "--duration", "6", "--seed", "3",
+         "--effect", f"amplitude_imbalance:alpha={ALPHA_TRUE}", "--effect", "quadrature:beta=0.002"])
+    with open(model) as f:
+        mlines = [ln for ln in f if ln.strip()]
+    mcut = len(mlines) // 2
+    while " 100#" not in mlines[mcut]:
+        mcut += 1
+    for name, part in (("model1.log", mlines[:mcut]), ("model2.log", mlines[mcut:])):
         with open(os.path.join(in_dir, name), "w") as f:
             f.writelines(part)
 
@@ -360,6 +374,8 @@ def check_scenario(c, s, out, msgs, facts, inputs, summary):
         print(f"  NOTE {s}: canplayer -t with a 4 KiB receive buffer: {drops} of {sent} frames dropped by the kernel")
     elif s == "soak":
         check_soak(c, s, out, facts, last, summary, msgs)
+    elif s == "model":
+        check_model(c, s, facts, msgs, summary)
     elif s == "fd":
         sent = fact_int("frames_sent")
         fd = fact_int("fd_frames_sent")
@@ -399,6 +415,29 @@ def read_rss(path):
                 if len(parts) == 2 and parts[1].isdigit():
                     rows.append((parts[0], int(parts[1])))
     return rows
+
+
+def check_model(c, s, facts, msgs, summary):
+    """Live model discovery: model_fit_t per 8-revolution window; the seed model
+    names the hidden quadrature, the reloaded model explains the log."""
+    c.check(s, facts.get("reload_ok_rc") == "0", "SIGHUP with quadrature added: 'config reloaded'")
+    c.check(s, facts.get("reload_bad_rc") == "0", "SIGHUP with an unknown effect: 'reload failed', model kept")
+    fits = [m for m in msgs if m["type"] == "resolver.model_fit_t"]
+    fitted = [m for m in fits if m["verdict"] != "insufficient_data"]
+    seed = [m for m in fitted if m["effects"] == ["amplitude_imbalance"]]
+    added = [m for m in fitted if m["effects"] == ["amplitude_imbalance", "quadrature"]]
+    summary["model_fit_t"] = {"published": len(fits), "seed_model": [m["verdict"] for m in seed],
+                              "with_quadrature": [m["verdict"] for m in added]}
+    c.check(s, len(seed) >= 2 and all(m["verdict"] == "missing_effect" and m["candidate_effect"][:1] == ["quadrature"]
+                                      for m in seed),
+            f"seed model: {len(seed)} windows, all missing_effect with quadrature first "
+            f"({[(m['verdict'], m['candidate_effect'][:1]) for m in seed]})")
+    c.check(s, len(added) >= 2 and all(m["verdict"] == "explained" for m in added),
+            f"after SIGHUP: {len(added)} windows, all explained ({[m['verdict'] for m in added]})")
+    c.check(s, all(m["effects"] != ["flux_capacitor"] for m in fits), "the refused config never ran")
+    if added:
+        r = [m["residual_rms_rad"] / m["noise_floor_rad"] for m in added]
+        c.check(s, max(r) <= 1.5, f"residual after adding quadrature {min(r):.2f}..{max(r):.2f}x floor (<= 1.5)")
 
 
 def check_soak(c, s, out, facts, last, summary, msgs):
