@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <toml++/toml.h>
 
@@ -55,7 +56,16 @@ void read(const toml::table& table, std::string_view key, T& out, const std::str
     if (auto v = node->value<bool>()) { out = *v; return; }
     throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " must be true or false");
   } else if constexpr (std::is_same_v<T, int>) {
-    if (node->is_integer()) { out = static_cast<int>(*node->value<std::int64_t>()); return; }
+    if (node->is_integer()) {
+      // Out of int range would wrap silently (4294967299 -> 3): refuse it instead.
+      const std::int64_t v = *node->value<std::int64_t>();
+      if (v >= std::numeric_limits<int>::min() && v <= std::numeric_limits<int>::max()) {
+        out = static_cast<int>(v);
+        return;
+      }
+      throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " = " + std::to_string(v) +
+                        " is out of range");
+    }
     throw ConfigError(where(source, *node) + ": [" + section + "] " + std::string(key) + " must be an integer");
   } else {
     if (auto v = node->value<double>()) { out = *v; return; }
@@ -227,7 +237,9 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
       if (arr == nullptr) throw ConfigError(where(s, *h) + ": [estimator] harmonics must be an array of orders, e.g. [3]");
       c.sincos.harmonics.clear();
       for (const auto& el : *arr) {
-        const auto n = el.value<std::int64_t>();
+        // is_integer first: value<int64_t>() of a float like 1e90 converts out of range
+        // (undefined behaviour; fuzz finding F4).
+        const auto n = el.is_integer() ? el.value<std::int64_t>() : std::nullopt;
         if (!n || *n < 2 || *n > 16) {
           throw ConfigError(where(s, *h) + ": [estimator] harmonics: orders must be integers 2..16");
         }

@@ -93,7 +93,7 @@ void apply_toml(const std::string& path, const CLI::App& app, Options& o, std::v
     fail(fmt::format("--config {}: key '{}' must be a string", path, key));
   };
   const auto integer = [&](const std::string& key, const toml::node& node) {
-    if (auto v = node.value<std::int64_t>()) return *v;
+    if (node.is_integer()) return *node.value<std::int64_t>();  // value<int64_t>() of a float may overflow
     fail(fmt::format("--config {}: key '{}' must be an integer", path, key));
   };
   for (const auto& [key_node, node] : table) {
