@@ -68,6 +68,20 @@ def run(cmd, **kw):
 
 # ---- inputs -----------------------------------------------------------------
 
+def split_in_halves(path, first, second):
+    """Writes the log's two halves next to it, split at a sample boundary (before a
+    RESOLVER_SAMPLE frame, ID 0x100). Returns (lines, index of the cut)."""
+    with open(path) as f:
+        lines = [ln for ln in f if ln.strip()]
+    cut = len(lines) // 2
+    while " 100#" not in lines[cut]:
+        cut += 1
+    for name, part in ((first, lines[:cut]), (second, lines[cut:])):
+        with open(os.path.join(os.path.dirname(path), name), "w") as f:
+            f.writelines(part)
+    return lines, cut
+
+
 def make_inputs(bin_dir, in_dir):
     """demo.log (5 s, Hwang's bench, alpha = 0.003) and its two halves, split at a
     sample boundary (before a RESOLVER_SAMPLE frame, ID 0x100)."""
@@ -76,28 +90,14 @@ def make_inputs(bin_dir, in_dir):
     run([os.path.join(bin_dir, "resolver-sim"), "--out", demo, "--rpm", "200", "--duration", "5",
          "--p-r", "3", "--p", "3", "--rd-bits", "16", "--iq", "10", "--seed", "1",
          "--effect", f"amplitude_imbalance:alpha={ALPHA_TRUE}"])
-    with open(demo) as f:
-        lines = [ln for ln in f if ln.strip()]
-    cut = len(lines) // 2
-    while " 100#" not in lines[cut]:
-        cut += 1
-    for name, part in (("half1.log", lines[:cut]), ("half2.log", lines[cut:])):
-        with open(os.path.join(in_dir, name), "w") as f:
-            f.writelines(part)
+    lines, cut = split_in_halves(demo, "half1.log", "half2.log")
 
     # model: 6 s with quadrature hidden next to alpha, in two halves (seed model, then
     # the model with quadrature added by SIGHUP).
     model = os.path.join(in_dir, "model.log")
     run([os.path.join(bin_dir, "resolver-sim"), "--out", model, "--rpm", "200", "--duration", "6", "--seed", "3",
          "--effect", f"amplitude_imbalance:alpha={ALPHA_TRUE}", "--effect", "quadrature:beta=0.002"])
-    with open(model) as f:
-        mlines = [ln for ln in f if ln.strip()]
-    mcut = len(mlines) // 2
-    while " 100#" not in mlines[mcut]:
-        mcut += 1
-    for name, part in (("model1.log", mlines[:mcut]), ("model2.log", mlines[mcut:])):
-        with open(os.path.join(in_dir, name), "w") as f:
-            f.writelines(part)
+    split_in_halves(model, "model1.log", "model2.log")
 
     def samples(ls):
         return sum(1 for ln in ls if " 100#" in ln)

@@ -111,25 +111,6 @@ class Gram {
   std::int64_t n_ = 0;
 };
 
-/// Least squares y ~ X, returns residuals. X given as a row generator.
-template <typename Fill>
-std::vector<double> ls_residual(std::size_t n, int k, Fill&& fill, const std::vector<double>& y) {
-  Gram g(k);
-  Eigen::VectorXd x(k);
-  for (std::size_t i = 0; i < n; ++i) {
-    fill(i, x);
-    g.add(x, y[i]);
-  }
-  g.flush();
-  const Eigen::VectorXd coef = g.m().completeOrthogonalDecomposition().solve(g.b());
-  std::vector<double> r(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    fill(i, x);
-    r[i] = y[i] - x.dot(coef);
-  }
-  return r;
-}
-
 /// The fully flexible angle model of one bin: [1, sin n theta, cos n theta (n <= order)]
 /// plus 1x/2x mechanical with a reference.
 void saturated_basis(const Row& r, int order, bool mech, Eigen::VectorXd& x, bool electrical = false) {
