@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
@@ -13,10 +14,6 @@
 
 namespace resolver {
 namespace {
-
-// [bytes] read(2) chunk. 1 MiB amortises the syscall over ~30 k lines and
-// stays in L2/L3; much larger buys nothing measurable.
-constexpr std::size_t kBufferSize = std::size_t{1} << 20;
 
 bool is_blank_line(std::string_view line) {
   for (const char c : line) {
@@ -31,8 +28,11 @@ std::string format_seconds(std::int64_t us) {
 
 }  // namespace
 
-CandumpReader::CandumpReader(const std::string& path)
-    : path_(path), buffer_(std::make_unique<char[]>(kBufferSize)) {
+CandumpReader::CandumpReader(const std::string& path, std::size_t buffer_bytes)
+    : path_(path),
+      buffer_bytes_(std::max(buffer_bytes, kMinBufferBytes)),
+      // Not zeroed: only bytes read(2) wrote are ever looked at.
+      buffer_(std::make_unique_for_overwrite<char[]>(buffer_bytes_)) {
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) {
     throw std::runtime_error(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
@@ -48,6 +48,7 @@ CandumpReader::~CandumpReader() { close_fd(); }
 CandumpReader::CandumpReader(CandumpReader&& other) noexcept
     : path_(std::move(other.path_)),
       fd_(std::exchange(other.fd_, -1)),
+      buffer_bytes_(other.buffer_bytes_),
       buffer_(std::move(other.buffer_)),
       begin_(other.begin_),
       end_(other.end_),
@@ -67,6 +68,7 @@ CandumpReader& CandumpReader::operator=(CandumpReader&& other) noexcept {
     close_fd();
     path_ = std::move(other.path_);
     fd_ = std::exchange(other.fd_, -1);
+    buffer_bytes_ = other.buffer_bytes_;
     buffer_ = std::move(other.buffer_);
     begin_ = other.begin_;
     end_ = other.end_;
@@ -90,7 +92,7 @@ void CandumpReader::close_fd() noexcept {
 
 void CandumpReader::fill() {
   for (;;) {
-    const ssize_t n = ::read(fd_, buffer_.get() + end_, kBufferSize - end_);
+    const ssize_t n = ::read(fd_, buffer_.get() + end_, buffer_bytes_ - end_);
     if (n > 0) {
       end_ += static_cast<std::size_t>(n);
       return;

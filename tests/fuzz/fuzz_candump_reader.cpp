@@ -23,7 +23,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     written += static_cast<std::size_t>(n);
   }
   if (written == size) {
-    resolver::CandumpReader reader("/proc/self/fd/" + std::to_string(fd));
+    // The smallest buffer: refills and over-long lines happen within -max_len,
+    // and a run does not pay for the daemon's 1 MiB buffer.
+    resolver::CandumpReader reader("/proc/self/fd/" + std::to_string(fd), resolver::CandumpReader::kMinBufferBytes);
     resolver::CanFrame frame;
     std::uint64_t last_line = 0;
     bool have_time = false;

@@ -24,8 +24,9 @@ struct Outcome {
   LogLineError kind = LogLineError::kMissingTimestamp;
 };
 
-std::vector<Outcome> read_all(const std::string& path) {
-  CandumpReader reader(path);
+std::vector<Outcome> read_all(const std::string& path,
+                              std::size_t buffer_bytes = CandumpReader::kDefaultBufferBytes) {
+  CandumpReader reader(path, buffer_bytes);
   std::vector<Outcome> out;
   for (;;) {
     Outcome o{};
@@ -165,6 +166,34 @@ TEST(CandumpReader, OverlongLineIsSkippedToTheNextNewline) {
   EXPECT_EQ(out[4].line, 5U);
   EXPECT_EQ(out[5].kind, LogLineError::kLineTooLong);  // unterminated at end of file
   EXPECT_EQ(out[5].line, 6U);
+}
+
+TEST(CandumpReader, SmallestBufferReadsLikeTheDefaultAtTheLengthLimit) {
+  // Lines of exactly the longest accepted length and one byte more, around
+  // good frames: the smallest buffer (the fuzz target's) must split and drop
+  // them exactly as the 1 MiB buffer does, including at the end of the file.
+  const std::string at_limit(kMaxCandumpLineLength, 'z');
+  const std::string over_limit(kMaxCandumpLineLength + 1, 'z');
+  std::string text;
+  for (int i = 0; i < 6; ++i) {
+    text += "(1.0) can0 001#01\n" + at_limit + "\n(1.5) can0 002#02\n" + over_limit + "\n";
+  }
+  text += at_limit;  // unterminated, at the limit
+  TempPath tmp;
+  write_text(tmp.str(), text);
+  const auto big = read_all(tmp.str());
+  const auto small = read_all(tmp.str(), 1);  // raised to kMinBufferBytes
+  ASSERT_EQ(big.size(), 6U * 4U + 1U);
+  ASSERT_EQ(small.size(), big.size());
+  for (std::size_t i = 0; i < big.size(); ++i) {
+    EXPECT_EQ(small[i].status, big[i].status) << "outcome " << i;
+    EXPECT_EQ(small[i].line, big[i].line) << "outcome " << i;
+    EXPECT_EQ(small[i].kind, big[i].kind) << "outcome " << i;
+  }
+  EXPECT_EQ(big[1].status, CandumpReader::Status::kBadLine);
+  EXPECT_NE(big[1].kind, LogLineError::kLineTooLong);  // at the limit: parsed, and bad for another reason
+  EXPECT_EQ(big[3].kind, LogLineError::kLineTooLong);
+  EXPECT_NE(big.back().kind, LogLineError::kLineTooLong);
 }
 
 TEST(CandumpReader, LinesAcrossChunkBoundariesAreWhole) {
