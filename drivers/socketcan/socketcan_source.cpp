@@ -2,6 +2,7 @@
 // socket lives in socketcan_open.cpp.
 #include "drivers/socketcan/socketcan_source.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <sys/socket.h>
 
@@ -22,9 +23,14 @@ namespace {
 // about 120 bytes; 256 leaves slack for an adopted fd with other options.
 constexpr std::size_t kControlBytes = 256;
 
-int to_poll_timeout_ms(std::chrono::milliseconds timeout) {
-  if (timeout.count() < 0) return -1;  // poll(): wait forever
-  return timeout.count() > INT_MAX ? INT_MAX : static_cast<int>(timeout.count());
+/// SO_RCVTIMEO value for a read timeout: a zero timeval means "wait forever".
+/// A zero timeout never reaches here (read() uses MSG_DONTWAIT instead).
+timeval to_receive_timeout(std::chrono::milliseconds timeout) {
+  timeval tv{};
+  if (timeout.count() <= 0) return tv;
+  tv.tv_sec = static_cast<time_t>(timeout.count() / 1000);
+  tv.tv_usec = static_cast<suseconds_t>((timeout.count() % 1000) * 1000);
+  return tv;
 }
 
 std::int64_t realtime_now_us() {
@@ -42,29 +48,34 @@ SocketCanSource::SocketCanSource(UniqueFd fd, std::string iface,
 
 SocketCanSource SocketCanSource::adopt(int fd, std::string iface_name) {
   if (fd < 0) throw SocketCanError("adopt(fd " + std::to_string(fd) + ")", iface_name, EBADF);
+  // read() waits inside recvmsg (SO_RCVTIMEO), which a non-blocking file
+  // would turn into a busy loop of EAGAIN; socket activation may hand one over.
+  const int status_flags = ::fcntl(fd, F_GETFL);
+  if (status_flags >= 0 && (status_flags & O_NONBLOCK) != 0) ::fcntl(fd, F_SETFL, status_flags & ~O_NONBLOCK);
   return SocketCanSource(UniqueFd(fd), std::move(iface_name), SocketCanOptions{}.read_timeout);
 }
 
-ReadStatus SocketCanSource::read(CanFrame& frame) {
-  pollfd pfd{};
-  pfd.fd = fd_.get();
-  pfd.events = POLLIN;
-  const int ready = ::poll(&pfd, 1, to_poll_timeout_ms(read_timeout_));
-  if (ready < 0) {
-    if (errno == EINTR) return ReadStatus::kInterrupted;
-    throw SocketCanError("poll", iface_, errno);
+void SocketCanSource::apply_receive_timeout() {
+  if (applied_timeout_ && *applied_timeout_ == read_timeout_) return;
+  if (read_timeout_.count() != 0) {
+    const timeval tv = to_receive_timeout(read_timeout_);
+    if (::setsockopt(fd_.get(), SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv) < 0) {
+      throw SocketCanError("setsockopt(SO_RCVTIMEO)", iface_, errno);
+    }
   }
-  if (ready == 0) {
-    ++stats_.timeouts;
-    return ReadStatus::kTimeout;
-  }
-  if ((pfd.revents & POLLNVAL) != 0) throw SocketCanError("poll", iface_, EBADF);
-  // POLLERR is not handled here: recvmsg() returns the pending socket error
-  // (ENETDOWN, ENODEV), which receive() maps to a status.
-  return receive(frame, pfd.revents);
+  applied_timeout_ = read_timeout_;
 }
 
-ReadStatus SocketCanSource::receive(CanFrame& frame, short revents) {
+ReadStatus SocketCanSource::read(CanFrame& frame) {
+  // One blocking recvmsg per frame, bounded by SO_RCVTIMEO: at a saturated
+  // bus every frame wakes the reader, and a poll() before each recvmsg was a
+  // second syscall per frame (docs/PERFORMANCE.md, live latency). A pending
+  // socket error (ENETDOWN, ENODEV) wakes a blocked recvmsg and is returned
+  // by it; a signal interrupts it with EINTR even under SA_RESTART, because
+  // calls with a receive timeout are never restarted (signal(7)).
+  apply_receive_timeout();
+  const int flags = read_timeout_.count() == 0 ? MSG_DONTWAIT : 0;
+
   CanWireImage image{};
   iovec iov{};
   iov.iov_base = image.data();
@@ -76,13 +87,11 @@ ReadStatus SocketCanSource::receive(CanFrame& frame, short revents) {
   msg.msg_control = control.data();
   msg.msg_controllen = control.size();
 
-  // MSG_DONTWAIT: poll() said readable, but a pending error may already have
-  // been consumed; never block past read_timeout.
-  const ssize_t received = ::recvmsg(fd_.get(), &msg, MSG_DONTWAIT);
+  const ssize_t received = ::recvmsg(fd_.get(), &msg, flags);
   if (received < 0) {
     const int err = errno;
     switch (err) {
-      case EAGAIN:
+      case EAGAIN:  // SO_RCVTIMEO expired, or nothing queued under MSG_DONTWAIT
         ++stats_.timeouts;
         return ReadStatus::kTimeout;
       case EINTR:
@@ -97,9 +106,9 @@ ReadStatus SocketCanSource::receive(CanFrame& frame, short revents) {
         throw SocketCanError("recvmsg", iface_, err);
     }
   }
-  // CAN_RAW never returns an empty read; a 0-byte read with POLLHUP is a
-  // stream/seqpacket peer that closed (adopted fds).
-  if (received == 0 && (revents & POLLHUP) != 0) return ReadStatus::kDeviceGone;
+  // CAN_RAW never returns an empty read; a 0-byte read on a hung-up socket is
+  // a stream/seqpacket peer that closed (adopted fds). Rare: poll only here.
+  if (received == 0 && peer_hung_up()) return ReadStatus::kDeviceGone;
 
   // Drops are counted even when this read turns out to be malformed.
   const ReceiveMetadata meta = parse_receive_cmsgs(msg);
@@ -121,6 +130,13 @@ ReadStatus SocketCanSource::receive(CanFrame& frame, short revents) {
   if (frame.fd) ++stats_.fd_frames;
   if (frame.error) ++stats_.error_frames;
   return ReadStatus::kFrame;
+}
+
+bool SocketCanSource::peer_hung_up() const {
+  pollfd pfd{};
+  pfd.fd = fd_.get();
+  pfd.events = POLLIN;
+  return ::poll(&pfd, 1, 0) == 1 && (pfd.revents & POLLHUP) != 0;
 }
 
 void SocketCanSource::write(const CanFrame& frame) {

@@ -18,6 +18,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,7 +72,8 @@ class SocketCanSource {
   /// Takes ownership of an already-open datagram socket (tests, socket
   /// activation). Socket options are left as they are: enable SO_TIMESTAMPNS
   /// and SO_RXQ_OVFL on the fd beforehand to get kernel timestamps and drop
-  /// counts. Throws SocketCanError (EBADF) if fd < 0.
+  /// counts. read() sets SO_RCVTIMEO on it, and O_NONBLOCK is cleared here so
+  /// that read() can wait in recvmsg. Throws SocketCanError (EBADF) if fd < 0.
   static SocketCanSource adopt(int fd, std::string iface_name);
 
   SocketCanSource(SocketCanSource&&) noexcept = default;
@@ -80,7 +82,9 @@ class SocketCanSource {
   SocketCanSource& operator=(const SocketCanSource&) = delete;
   ~SocketCanSource() = default;
 
-  /// Waits up to read_timeout (poll) and then reads one frame (recvmsg).
+  /// Reads one frame, waiting up to read_timeout: one recvmsg bounded by
+  /// SO_RCVTIMEO (set on the socket, also on an adopted one); a zero timeout
+  /// does not wait, a negative one waits until a frame, error or signal.
   /// On kFrame: timestamp_us comes from the kernel stamp (SO_TIMESTAMPING
   /// hardware, SO_TIMESTAMPNS, SO_TIMESTAMP; else CLOCK_REALTIME at read
   /// time), iface is this source's name, fd from the read size. The frame is
@@ -102,11 +106,15 @@ class SocketCanSource {
 
  private:
   SocketCanSource(UniqueFd fd, std::string iface, std::chrono::milliseconds read_timeout);
-  ReadStatus receive(CanFrame& frame, short revents);
+  /// Sets SO_RCVTIMEO when read_timeout changed since the last read.
+  void apply_receive_timeout();
+  /// True when the socket reports POLLHUP (adopted stream/seqpacket fds).
+  [[nodiscard]] bool peer_hung_up() const;
 
   UniqueFd fd_;
   std::string iface_;
   std::chrono::milliseconds read_timeout_;
+  std::optional<std::chrono::milliseconds> applied_timeout_;  ///< SO_RCVTIMEO now on the socket
   SocketCanStats stats_;
   std::uint32_t last_drop_counter_ = 0;  ///< last SO_RXQ_OVFL value seen (cumulative)
 };

@@ -282,6 +282,54 @@ TEST(SocketCanSource, SignalDuringWaitIsInterrupted) {
   EXPECT_LT(waited, 4s);
 }
 
+TEST(SocketCanSource, SignalInterruptsTheWaitEvenWithSaRestart) {
+  // read() waits in recvmsg with SO_RCVTIMEO, and such calls are never
+  // restarted after a handler (signal(7)): the daemon's loop sees its flags
+  // whatever flags another library installed its handlers with.
+  Pair pair = make_pair(SOCK_DGRAM);
+  pair.source.set_read_timeout(5s);
+  struct sigaction action{};
+  struct sigaction previous{};
+  action.sa_handler = on_alarm;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESTART;
+  ASSERT_EQ(::sigaction(SIGALRM, &action, &previous), 0);
+  itimerval timer{};
+  timer.it_value.tv_usec = 20'000;
+  ASSERT_EQ(::setitimer(ITIMER_REAL, &timer, nullptr), 0);
+  CanFrame frame;
+  const ReadStatus status = pair.source.read(frame);
+  ::sigaction(SIGALRM, &previous, nullptr);
+  ::close(pair.peer);
+  EXPECT_EQ(status, ReadStatus::kInterrupted);
+}
+
+TEST(SocketCanSource, ZeroTimeoutDoesNotWaitAndLaterTimeoutsApply) {
+  Pair pair = make_pair(SOCK_DGRAM);
+  CanFrame frame;
+  pair.source.set_read_timeout(0ms);  // the daemon's drain at SIGTERM
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(pair.source.read(frame), ReadStatus::kTimeout);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 20ms);
+  pair.source.set_read_timeout(30ms);
+  start = std::chrono::steady_clock::now();
+  EXPECT_EQ(pair.source.read(frame), ReadStatus::kTimeout);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 25ms);
+  ::close(pair.peer);
+}
+
+TEST(SocketCanSource, AdoptedNonBlockingSocketStillWaitsForItsTimeout) {
+  int fds[2] = {-1, -1};
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0, fds), 0);
+  SocketCanSource source = SocketCanSource::adopt(fds[0], "vcan0");
+  source.set_read_timeout(30ms);
+  CanFrame frame;
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_EQ(source.read(frame), ReadStatus::kTimeout);
+  EXPECT_GE(std::chrono::steady_clock::now() - start, 25ms) << "a non-blocking fd made read() spin";
+  ::close(fds[1]);
+}
+
 TEST(SocketCanSource, UnexpectedErrnoThrowsWithOperationAndIface) {
   // A pipe is readable but not a socket: recvmsg() fails with ENOTSOCK.
   int fds[2] = {-1, -1};
@@ -296,7 +344,8 @@ TEST(SocketCanSource, UnexpectedErrnoThrowsWithOperationAndIface) {
   } catch (const SocketCanError& e) {
     EXPECT_EQ(e.error_code(), ENOTSOCK);
     const std::string text = e.what();
-    EXPECT_NE(text.find("recvmsg on can7"), std::string::npos) << text;
+    // The first call on the socket is the one setting the receive timeout.
+    EXPECT_NE(text.find("setsockopt(SO_RCVTIMEO) on can7"), std::string::npos) << text;
     EXPECT_NE(text.find("not an open socket"), std::string::npos) << text;
   }
   ::close(fds[1]);
