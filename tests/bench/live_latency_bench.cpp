@@ -39,6 +39,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <thread>
@@ -70,6 +71,7 @@ struct Options {
   std::string config;    // resolverd config file; "" = the built-in defaults
   int sender_fifo = 50;  // SCHED_FIFO priority of the sending thread; 0 = normal
   int reader_fifo = 0;   // of the reading thread (resolverd's unit sets none)
+  bool read_only = false;  // the floor: read every frame, no pipeline, no publish
 };
 
 std::int64_t realtime_ns() {
@@ -78,10 +80,18 @@ std::int64_t realtime_ns() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
-double thread_cpu_s() {
+double cpu_clock_s(clockid_t clock) {
   timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  if (clock_gettime(clock, &ts) != 0) return std::numeric_limits<double>::quiet_NaN();
   return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+double thread_cpu_s() { return cpu_clock_s(CLOCK_THREAD_CPUTIME_ID); }
+
+/// [s] CPU of every thread of this process except the sender: the reader and
+/// the threads the pipeline starts (the live model fit).
+double daemon_cpu_s(clockid_t sender_clock) {
+  return cpu_clock_s(CLOCK_PROCESS_CPUTIME_ID) - cpu_clock_s(sender_clock);
 }
 
 /// Forwards to LCM and remembers when the last publish returned, so the
@@ -174,6 +184,9 @@ RunResult run_once(const Options& o) {
     // (0-byte read + POLLHUP -> kDeviceGone); shutdown(SHUT_WR) would give no POLLHUP.
     ends.writer_owned.reset();
     writer_done.store(true);
+    // Stay alive until the reader has read this thread's CPU clock, which is
+    // invalid once the thread has exited.
+    while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   });
 
   using Clock = resolver::Pipeline::Clock;
@@ -181,7 +194,10 @@ RunResult run_once(const Options& o) {
   std::optional<Clock::time_point> first_frame;
   std::optional<Clock::time_point> window_start;
   Clock::time_point last_frame{};
+  clockid_t sender_clock{};
+  if (::pthread_getcpuclockid(writer.native_handle(), &sender_clock) != 0) sender_clock = CLOCK_THREAD_CPUTIME_ID;
   double cpu_start = thread_cpu_s();
+  double daemon_cpu_start = daemon_cpu_s(sender_clock);
   rusage ru_start{};
   getrusage(RUSAGE_THREAD, &ru_start);
   resolver::CanFrame frame;
@@ -191,7 +207,11 @@ RunResult run_once(const Options& o) {
       const Clock::time_point t_read = Clock::now();
       const std::int64_t read_ns = realtime_ns();
       const std::uint64_t before = sink.count();
-      pipeline.feed(frame, 0, t_read);
+      if (o.read_only) {
+        ++r.frames_seen_read_only;
+      } else {
+        pipeline.feed(frame, 0, t_read);
+      }
       const std::int64_t done_ns = realtime_ns();
       ++r.frames_read;
       last_frame = t_read;
@@ -199,6 +219,7 @@ RunResult run_once(const Options& o) {
       if (!window_start && t_read - *first_frame >= std::chrono::duration<double>(warmup)) {
         window_start = t_read;
         cpu_start = thread_cpu_s();
+        daemon_cpu_start = daemon_cpu_s(sender_clock);
         getrusage(RUSAGE_THREAD, &ru_start);
       }
       if (window_start) {
@@ -219,6 +240,9 @@ RunResult run_once(const Options& o) {
     pipeline.tick(realtime_ns() / 1000);
   }
   const double cpu_end = thread_cpu_s();
+  // Before the join: the sender's clock is valid only while it runs, and it
+  // runs until the reader has seen the end of the stream.
+  const double daemon_cpu_end = daemon_cpu_s(sender_clock);
   rusage ru_end{};
   getrusage(RUSAGE_THREAD, &ru_end);
   stop.store(true);
@@ -228,9 +252,10 @@ RunResult run_once(const Options& o) {
   r.sent = sent;
   r.wall_s = window_start ? std::chrono::duration<double>(last_frame - *window_start).count() : 0.0;
   r.cpu_s = cpu_end - cpu_start;
+  r.daemon_cpu_s = daemon_cpu_end - daemon_cpu_start;
   r.ctx_switches = (ru_end.ru_nvcsw - ru_start.ru_nvcsw) + (ru_end.ru_nivcsw - ru_start.ru_nivcsw);
   r.kernel_drops = ends.reader.stats().kernel_drops;
-  r.frames_seen = pipeline.intake().stats().frames_seen;
+  r.frames_seen = o.read_only ? r.frames_seen_read_only : pipeline.intake().stats().frames_seen;
   r.frames_decoded = pipeline.intake().stats().frames_decoded;
   r.rejects = pipeline.intake().rejects().total();
   r.lcm_failures = lcm.publish_failures();
@@ -258,6 +283,9 @@ int run(int argc, char** argv) {
                  "SCHED_FIFO priority of the sending thread, so host load does not bunch the frames; 0 = normal");
   app.add_option("--reader-fifo", o.reader_fifo,
                  "SCHED_FIFO priority of the reading (daemon) thread; 0 = normal, as resolverd runs by default");
+  app.add_flag("--read-only", o.read_only,
+               "the floor: only SocketCanSource::read each frame (no pipeline, no publish), i.e. what waking once "
+               "per frame costs on this machine");
   CLI11_PARSE(app, argc, argv);
 
   std::string reader_sched = "SCHED_OTHER";
@@ -277,7 +305,8 @@ int run(int argc, char** argv) {
   }
   const resolver::bench_live::Setup setup{o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
                                                           : o.iface + " (CAN_RAW) -> SocketCanSource::open",
-                                          o.lcm + (o.config.empty() ? "" : ", config " + o.config), o.rate, o.burst, o.seconds, std::min(o.warmup, o.seconds / 4.0),
+                                          o.read_only ? std::string("none (--read-only: read path only)")
+                                                      : o.lcm + (o.config.empty() ? "" : ", config " + o.config), o.rate, o.burst, o.seconds, std::min(o.warmup, o.seconds / 4.0),
                                           reader_sched};
   resolver::bench_live::print_table(std::cout, setup, runs);
   if (!o.json.empty()) {

@@ -23,9 +23,13 @@ struct RunResult {
   std::vector<float> all_kernel_us;      ///< [us] kernel stamp -> Pipeline::feed return, every frame
   double wall_s = 0.0;                   ///< [s] measured window (after warm-up)
   double cpu_s = 0.0;                    ///< [s] reader thread CPU (user + sys) over the window
+  /// [s] every thread but the sender's (reader + the live model fit's thread)
+  /// over the window: what resolverd itself would use.
+  double daemon_cpu_s = 0.0;
   long ctx_switches = 0;                 ///< reader thread, voluntary + involuntary, over the window
   std::uint64_t kernel_drops = 0;
   std::int64_t frames_seen = 0;
+  std::int64_t frames_seen_read_only = 0;  ///< --read-only: frames read and dropped on purpose
   std::int64_t frames_decoded = 0;
   std::int64_t rejects = 0;
   std::uint64_t lcm_failures = 0;
@@ -49,7 +53,7 @@ struct Row {
   double pub_p50 = 0, pub_p99 = 0, pub_max = 0;
   double read_p50 = 0, read_p99 = 0, read_max = 0;
   double all_p99 = 0, all_max = 0;
-  double cpu_percent = 0, wakeups_per_s = 0;
+  double cpu_percent = 0, daemon_cpu_percent = 0, wakeups_per_s = 0;
   double late_wakeups = 0, max_late_us = 0;
 };
 
