@@ -114,11 +114,15 @@ void Pipeline::count_problem(std::string_view reason, const std::string& message
   intake_.count_problem(reason, message);
 }
 
-void Pipeline::feed(const CanFrame& frame, std::uint64_t line, Clock::time_point arrival) {
+void Pipeline::feed_untimed(const CanFrame& frame, std::uint64_t line) {
   last_frame_us_ = frame.timestamp_us;
   if (health_window_start_us_ < 0) health_window_start_us_ = frame.timestamp_us;
   intake_.feed(frame, line);
   if (frame.timestamp_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(frame.timestamp_us);
+}
+
+void Pipeline::feed(const CanFrame& frame, std::uint64_t line, Clock::time_point arrival) {
+  feed_untimed(frame, line);
   const double us = std::chrono::duration<double, std::micro>(Clock::now() - arrival).count();
   latency_window_.add(us);
   latency_total_.add(us);

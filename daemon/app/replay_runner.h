@@ -12,6 +12,9 @@
 
 namespace resolver {
 
+/// Fast replay measures the read -> publish latency of one frame in this many.
+inline constexpr std::uint64_t kReplayLatencyEvery = 16;
+
 struct ReplayOptions {
   std::string path;
   bool fast = false;   ///< ignore log timing

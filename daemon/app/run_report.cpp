@@ -105,8 +105,8 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     out << "\n";
   }
   const LatencyHistogram& lat = p.latency_total();
-  out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us\n",
-                     lat.percentile(0.5), lat.percentile(0.99), lat.max());
+  out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us ({} frames timed)\n",
+                     lat.percentile(0.5), lat.percentile(0.99), lat.max(), lat.count());
 }
 
 std::string run_report_json(const Pipeline& p, const RunInfo& info) {
