@@ -12,7 +12,7 @@
 namespace resolver {
 namespace {
 
-constexpr std::int64_t kUsPerSecond = 1'000'000;
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
 constexpr std::int64_t kNsPerUs = 1'000;
 
 template <typename T>
@@ -23,14 +23,17 @@ bool copy_payload(const cmsghdr& cmsg, T& out) {
   return true;
 }
 
-std::int64_t from_seconds_nanos(std::int64_t sec, std::int64_t nsec) {
-  return sec * kUsPerSecond + nsec / kNsPerUs;
+/// [ns] since the epoch.
+std::int64_t from_seconds_nanos(std::int64_t sec, std::int64_t nsec) { return sec * kNsPerSecond + nsec; }
+std::int64_t from_seconds_micros(std::int64_t sec, std::int64_t usec) {
+  return sec * kNsPerSecond + usec * kNsPerUs;
 }
 
-void offer(ReceiveMetadata& meta, TimestampKind kind, std::int64_t us) {
+void offer(ReceiveMetadata& meta, TimestampKind kind, std::int64_t ns) {
   if (static_cast<int>(kind) > static_cast<int>(meta.timestamp_kind)) {
     meta.timestamp_kind = kind;
-    meta.timestamp_us = us;
+    meta.timestamp_ns = ns;
+    meta.timestamp_us = ns / kNsPerUs;
   }
 }
 
@@ -57,7 +60,7 @@ void parse_one(const cmsghdr& cmsg, ReceiveMetadata& meta) {
     }
     case SO_TIMESTAMP_OLD: {
       timeval tv{};
-      if (copy_payload(cmsg, tv)) offer(meta, TimestampKind::kSoftwareMicro, tv.tv_sec * kUsPerSecond + tv.tv_usec);
+      if (copy_payload(cmsg, tv)) offer(meta, TimestampKind::kSoftwareMicro, from_seconds_micros(tv.tv_sec, tv.tv_usec));
       break;
     }
     case SO_TIMESTAMPING_OLD: {
@@ -73,7 +76,7 @@ void parse_one(const cmsghdr& cmsg, ReceiveMetadata& meta) {
     }
     case SO_TIMESTAMP_NEW: {
       __kernel_sock_timeval tv{};
-      if (copy_payload(cmsg, tv)) offer(meta, TimestampKind::kSoftwareMicro, tv.tv_sec * kUsPerSecond + tv.tv_usec);
+      if (copy_payload(cmsg, tv)) offer(meta, TimestampKind::kSoftwareMicro, from_seconds_micros(tv.tv_sec, tv.tv_usec));
       break;
     }
     case SO_TIMESTAMPING_NEW: {

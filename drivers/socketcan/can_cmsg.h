@@ -23,6 +23,9 @@ struct ReceiveMetadata {
   /// [us] since the epoch (CLOCK_REALTIME for software stamps; the adapter's
   /// clock for hardware stamps). Empty when no usable timestamp came.
   std::optional<std::int64_t> timestamp_us;
+  /// The same stamp in [ns] (microsecond stamps x 1000): orders frames of
+  /// two sockets that arrived within one microsecond (split_wake_source.h).
+  std::optional<std::int64_t> timestamp_ns;
   TimestampKind timestamp_kind = TimestampKind::kNone;
   /// Cumulative frames dropped by this socket since it was created (wraps at
   /// 2^32). The kernel omits the cmsg while the count is still zero.

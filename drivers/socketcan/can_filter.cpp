@@ -15,7 +15,7 @@ KernelCanFilter to_kernel_filter(const CanIdFilter& filter) {
         (filter.extended ? "29 bits" : "11 bits; set extended = true for 29-bit IDs"));
   }
   KernelCanFilter out{};
-  out.can_id = filter.id | (filter.extended ? CAN_EFF_FLAG : 0U);
+  out.can_id = filter.id | (filter.extended ? CAN_EFF_FLAG : 0U) | (filter.inverted ? CAN_INV_FILTER : 0U);
   out.can_mask = (filter.mask & width_mask) | CAN_EFF_FLAG;
   return out;
 }

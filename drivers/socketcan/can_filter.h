@@ -1,7 +1,8 @@
 // Receive filters for a CAN_RAW socket (CAN_RAW_FILTER).
 //
-// A frame passes a filter when (received_id & mask) == (id & mask). The
-// kernel ORs all filters; an empty list means "receive everything".
+// A frame passes a filter when (received_id & mask) == (id & mask), or, for an
+// inverted filter, when it does not. The kernel ORs all filters (ANDs them
+// with SocketCanOptions::join_filters); an empty list means "receive everything".
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,7 @@ struct CanIdFilter {
   std::uint32_t id;        ///< ID to match (11 or 29 bits, no flag bits)
   std::uint32_t mask;      ///< 1 bits must match; 0x7FF = exact standard ID
   bool extended = false;   ///< match 29-bit frames (true) or 11-bit frames (false)
+  bool inverted = false;   ///< pass the frames that do NOT match (CAN_INV_FILTER)
 };
 
 /// The kernel's `struct can_filter`, without pulling <linux/can.h> into callers.

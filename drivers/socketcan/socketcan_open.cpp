@@ -76,6 +76,9 @@ SocketCanSource SocketCanSource::open(const SocketCanOptions& options) {
                static_cast<socklen_t>(filters.size() * sizeof(can_filter)), "CAN_RAW_FILTER",
                iface);
   }
+  if (options.join_filters && filters.size() > 1) {
+    set_flag(fd.get(), SOL_CAN_RAW, CAN_RAW_JOIN_FILTERS, "CAN_RAW_JOIN_FILTERS", iface);
+  }
   const can_err_mask_t error_mask = options.receive_error_frames ? CAN_ERR_MASK : 0U;
   set_option(fd.get(), SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &error_mask, sizeof error_mask,
              "CAN_RAW_ERR_FILTER", iface);

@@ -33,10 +33,9 @@ timeval to_receive_timeout(std::chrono::milliseconds timeout) {
   return tv;
 }
 
-std::int64_t realtime_now_us() {
+std::int64_t realtime_now_ns() {
   // system_clock is CLOCK_REALTIME on Linux, the clock SO_TIMESTAMP uses.
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
 }
 
@@ -124,7 +123,8 @@ ReadStatus SocketCanSource::read(CanFrame& frame) {
     ++stats_.truncated;
     return ReadStatus::kTruncated;
   }
-  frame.timestamp_us = meta.timestamp_us ? *meta.timestamp_us : realtime_now_us();
+  last_stamp_ns_ = meta.timestamp_ns ? *meta.timestamp_ns : realtime_now_ns();
+  frame.timestamp_us = last_stamp_ns_ / 1000;
   frame.set_iface(iface_);
   ++stats_.frames;
   if (frame.fd) ++stats_.fd_frames;

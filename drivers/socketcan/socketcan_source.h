@@ -34,6 +34,9 @@ struct SocketCanOptions {
   bool enable_fd = true;                        ///< CAN_RAW_FD_FRAMES: also receive CAN FD frames
   bool receive_error_frames = true;             ///< CAN_RAW_ERR_FILTER = CAN_ERR_MASK
   std::vector<CanIdFilter> filters;             ///< CAN_RAW_FILTER; empty = receive all
+  /// CAN_RAW_JOIN_FILTERS: a frame must pass every filter, not just one
+  /// (how "every ID but these" is said with inverted filters). Linux >= 4.1.
+  bool join_filters = false;
   /// [ms] longest a read() waits, so the caller's loop can check signals/watchdog.
   /// Negative = wait forever.
   std::chrono::milliseconds read_timeout{100};
@@ -99,6 +102,9 @@ class SocketCanSource {
   void write(const CanFrame& frame);
 
   [[nodiscard]] const SocketCanStats& stats() const { return stats_; }
+  /// [ns] receive stamp of the frame the last kFrame read returned (its
+  /// timestamp_us at full resolution).
+  [[nodiscard]] std::int64_t last_stamp_ns() const { return last_stamp_ns_; }
   [[nodiscard]] int fd() const { return fd_.get(); }
   [[nodiscard]] const std::string& iface() const { return iface_; }
   [[nodiscard]] std::chrono::milliseconds read_timeout() const { return read_timeout_; }
@@ -117,6 +123,7 @@ class SocketCanSource {
   std::optional<std::chrono::milliseconds> applied_timeout_;  ///< SO_RCVTIMEO now on the socket
   SocketCanStats stats_;
   std::uint32_t last_drop_counter_ = 0;  ///< last SO_RXQ_OVFL value seen (cumulative)
+  std::int64_t last_stamp_ns_ = 0;
 };
 
 }  // namespace resolver

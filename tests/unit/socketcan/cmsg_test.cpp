@@ -66,6 +66,7 @@ TEST(SocketCanCmsg, NanosecondTimestamp) {
   const ReceiveMetadata meta = parse_receive_cmsgs(msg);
   ASSERT_TRUE(meta.timestamp_us.has_value());
   EXPECT_EQ(*meta.timestamp_us, kSec * 1'000'000 + 123'456);
+  EXPECT_EQ(meta.timestamp_ns, kSec * 1'000'000'000 + 123'456'789);  // full resolution kept
   EXPECT_EQ(meta.timestamp_kind, TimestampKind::kSoftwareNano);
 }
 
@@ -79,6 +80,7 @@ TEST(SocketCanCmsg, MicrosecondTimestamp) {
   const ReceiveMetadata meta = parse_receive_cmsgs(msg);
   ASSERT_TRUE(meta.timestamp_us.has_value());
   EXPECT_EQ(*meta.timestamp_us, kSec * 1'000'000 + 654'321);
+  EXPECT_EQ(meta.timestamp_ns, kSec * 1'000'000'000 + 654'321'000);
   EXPECT_EQ(meta.timestamp_kind, TimestampKind::kSoftwareMicro);
 }
 
