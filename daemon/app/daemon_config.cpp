@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <toml++/toml.h>
 
@@ -16,6 +17,8 @@ namespace resolver {
 std::string default_dbc_path() { return "proto/resolver_bench.dbc (built into resolverd)"; }
 
 namespace {
+
+constexpr std::int64_t kMaxExtendedCanId = 0x1FFFFFFF;
 
 std::string where(const std::string& source, const toml::node& node) {
   const auto& src = node.source();
@@ -77,6 +80,23 @@ void require_positive(int value, const char* name, const std::string& source) {
   if (value < 1) throw ConfigError(source + ": " + name + " must be >= 1, got " + std::to_string(value));
 }
 
+void read_wake_ids(const toml::table& t, std::vector<std::uint32_t>& ids, const std::string& s) {
+  const toml::node* node = t.get("wake_ids");
+  if (node == nullptr) return;
+  const toml::array* arr = node->as_array();
+  if (arr == nullptr) {
+    throw ConfigError(where(s, *node) + ": [can] wake_ids must be an array of CAN IDs, e.g. [0x102]");
+  }
+  ids.clear();
+  for (const auto& item : *arr) {
+    const std::optional<std::int64_t> id = item.is_integer() ? item.value<std::int64_t>() : std::nullopt;
+    if (!id || *id < 0 || *id > kMaxExtendedCanId) {
+      throw ConfigError(where(s, item) + ": [can] wake_ids: each entry must be a CAN ID from 0 to 0x1FFFFFFF");
+    }
+    ids.push_back(static_cast<std::uint32_t>(*id));
+  }
+}
+
 void read_model_section(const toml::table& t, ModelFitOptions& m, const std::string& s) {
   check_keys(t, "model", {"enabled", "effects", "window_revolutions", "candidates"}, s);
   read(t, "enabled", m.enabled, s, "model");
@@ -134,9 +154,10 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     read(*t, "url", c.lcm_url, s, "lcm");
   }
   if (const auto* t = section("can")) {
-    check_keys(*t, "can", {"receive_buffer_bytes"}, s);
+    check_keys(*t, "can", {"receive_buffer_bytes", "wake_ids"}, s);
     read(*t, "receive_buffer_bytes", c.can.receive_buffer_bytes, s, "can");
     if (c.can.receive_buffer_bytes < 0) throw ConfigError(s + ": [can] receive_buffer_bytes must be >= 0");
+    read_wake_ids(*t, c.can.wake_ids, s);
   }
   if (const auto* t = section("channels")) {
     check_keys(*t, "channels", {"angle", "dq", "estimate", "model_fit", "health"}, s);

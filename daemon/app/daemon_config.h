@@ -6,6 +6,9 @@
 //
 //   [lcm]
 //   url = "udpm://239.255.76.67:7667?ttl=0"
+//   [can]
+//   receive_buffer_bytes = 4194304
+//   wake_ids = [0x102]         # wake once per sample, on the frame that completes it; [] = every frame
 //   [channels]
 //   angle = "RESOLVER_ANGLE"   # also dq, estimate, model_fit, health
 //   [output]
@@ -60,6 +63,12 @@ struct CanOptions {
   /// SO_RCVBUF for the CAN socket [bytes]; the kernel default (~200 kB)
   /// overflowed at full bus rate in the vcan guest. Capped by net.core.rmem_max.
   int receive_buffer_bytes = 4 << 20;
+  /// IDs of the frames that wake the reader (IDs above 0x7FF are 29-bit).
+  /// Empty: every frame does. Name the frame that completes a sample (the
+  /// run report says which one does) and the other frames of the sample wait
+  /// in a second socket until it comes: one wake-up per sample instead of one
+  /// per frame (drivers/socketcan/split_wake_source.h).
+  std::vector<std::uint32_t> wake_ids;
 };
 
 struct LcmChannels {

@@ -6,12 +6,22 @@
 #include <thread>
 
 #include "daemon/service/sd_notify.h"
-#include "drivers/socketcan/socketcan_source.h"
+#include "drivers/socketcan/split_wake_source.h"
 
 namespace resolver {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+
+std::vector<CanIdFilter> wake_filters(const std::vector<std::uint32_t>& ids) {
+  std::vector<CanIdFilter> out;
+  out.reserve(ids.size());
+  for (const std::uint32_t id : ids) {
+    const bool extended = id > 0x7FF;
+    out.push_back(CanIdFilter{id, extended ? 0x1FFFFFFFU : 0x7FFU, extended});
+  }
+  return out;
+}
 
 std::int64_t wall_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -24,7 +34,8 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
   SocketCanOptions so;
   so.iface = options.iface;
   so.receive_buffer_bytes = options.receive_buffer_bytes;
-  std::optional<SocketCanSource> source;
+  const std::vector<CanIdFilter> wake = wake_filters(options.wake_ids);
+  std::optional<SplitWakeSource> source;
   auto backoff = std::chrono::milliseconds(250);
   constexpr auto kMaxBackoff = std::chrono::milliseconds(5000);
   bool reported_down = false;
@@ -67,8 +78,9 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
     service_tick(pipeline);
     if (!source) {
       try {
-        source.emplace(SocketCanSource::open(so));
-        err << "resolverd: reading " << options.iface << "\n";
+        source.emplace(SplitWakeSource::open(so, wake));
+        err << "resolverd: reading " << options.iface
+            << (wake.empty() ? "" : " (two sockets: woken only by the [can] wake_ids frames)") << "\n";
         backoff = std::chrono::milliseconds(250);
         reported_down = false;
         waiting_for.clear();

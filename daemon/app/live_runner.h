@@ -2,11 +2,15 @@
 // end the daemon: a downed link (ENETDOWN) keeps the socket and goes on
 // reading; a vanished interface (ENODEV) closes it and re-opens with backoff.
 // Every such event is counted in health_t and printed once per episode.
+// With wake_ids the interface is read through two sockets, so that only the
+// named frames wake the daemon (drivers/socketcan/split_wake_source.h).
 #pragma once
 
 #include <functional>
 #include <ostream>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "daemon/app/pipeline.h"
 #include "daemon/app/stop_flag.h"
@@ -20,6 +24,9 @@ struct LiveOptions {
   /// systemd notifications (READY, WATCHDOG, STATUS, STOPPING); null = none.
   SdNotifier* notifier = nullptr;
   int receive_buffer_bytes = 0;  ///< SO_RCVBUF; 0 = kernel default
+  /// [can] wake_ids: frames that wake the reader (IDs above 0x7FF are 29-bit);
+  /// empty = every frame. Fixed at start (a SIGHUP does not change it).
+  std::vector<std::uint32_t> wake_ids;
 };
 
 /// `current` returns the pipeline to feed (it may be rebuilt on SIGHUP by

@@ -1,8 +1,11 @@
 #include "daemon/app/pipeline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <variant>
+
+#include <fmt/format.h>
 
 #include "daemon/app/embedded_dbc.h"
 #include "daemon/dbc/dbc_parser.h"
@@ -117,7 +120,14 @@ void Pipeline::count_problem(std::string_view reason, const std::string& message
 void Pipeline::feed_untimed(const CanFrame& frame, std::uint64_t line) {
   last_frame_us_ = frame.timestamp_us;
   if (health_window_start_us_ < 0) health_window_start_us_ = frame.timestamp_us;
+  const std::int64_t complete_before = intake_.stats().samples_complete;
   intake_.feed(frame, line);
+  // Only a sample completed by one of its own frames says which frame
+  // completes samples; one emitted because a newer counter began (while the
+  // joiner learns the layout, or with a frame missing) does not.
+  if (intake_.stats().samples_complete != complete_before && intake_.last_frame_counter() == last_counter_) {
+    note_completing_frame(frame);
+  }
   if (frame.timestamp_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(frame.timestamp_us);
 }
 
@@ -126,6 +136,19 @@ void Pipeline::feed(const CanFrame& frame, std::uint64_t line, Clock::time_point
   const double us = std::chrono::duration<double, std::micro>(Clock::now() - arrival).count();
   latency_window_.add(us);
   latency_total_.add(us);
+}
+
+void Pipeline::note_completing_frame(const CanFrame& frame) {
+  completing_frames_.add(frame.id);
+  const auto& wake = config_.can.wake_ids;
+  if (wake.empty() || std::find(wake.begin(), wake.end(), frame.id) != wake.end()) return;
+  // The frame came through the quiet socket, so the sample waited for the
+  // next waking frame: the latency is a sample period or the read timeout.
+  intake_.count_problem("completed_by_quiet_frame",
+                        fmt::format("a sample was completed by frame 0x{:X}, which is not in [can] wake_ids, so it "
+                                    "waited for the next waking frame; name the frame that completes samples "
+                                    "(see the run report) in wake_ids",
+                                    frame.id));
 }
 
 void Pipeline::tick(std::int64_t now_us) {

@@ -25,6 +25,7 @@
 #include <memory>
 #include <ostream>
 
+#include "daemon/app/completing_frames.h"
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/latency_histogram.h"
 #include "daemon/app/live_model_fit.h"
@@ -77,6 +78,8 @@ class Pipeline {
   [[nodiscard]] const RunSummary& summary() const { return summary_; }
   [[nodiscard]] const LatencyHistogram& latency_total() const { return latency_total_; }
   [[nodiscard]] std::int64_t samples() const { return samples_; }
+  /// Which frame IDs completed the samples (the ones [can] wake_ids should name).
+  [[nodiscard]] const CompletingFrames& completing_frames() const { return completing_frames_; }
   /// nullptr when [model] enabled = false.
   [[nodiscard]] const LiveModelFit* model_fit() const { return model_fit_.get(); }
 
@@ -86,6 +89,7 @@ class Pipeline {
   void publish_estimate(std::int64_t utime, const BenchSample& sample);
   void feed_model_fit(const SampleInput& in, const BenchSample& sample);
   void publish_health(std::int64_t utime);
+  void note_completing_frame(const CanFrame& frame);
 
   DaemonConfig config_;
   OutputSink& sink_;
@@ -96,6 +100,7 @@ class Pipeline {
   LatencyHistogram latency_window_;
   LatencyHistogram latency_total_;
   std::int64_t samples_ = 0;
+  CompletingFrames completing_frames_;
   std::int64_t last_frame_us_ = 0;
   std::int64_t health_window_start_us_ = -1;
   std::int64_t frames_at_window_start_ = 0;

@@ -35,6 +35,22 @@ std::string json_string(const std::string& text) {
   return out + "\"";
 }
 
+/// "completed by 0x102 (100.0 %)": the frame a live reader must wake up for.
+void print_completing_frames(std::ostream& out, const CompletingFrames& c) {
+  const std::int64_t total = c.total();
+  if (total == 0) return;
+  std::size_t top = 0;
+  out << "  completed  by";
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const auto& [id, n] = c.at(i);
+    out << fmt::format("{} 0x{:X}: {} ({:.1f} %)", i == 0 ? "" : ",", id, n,
+                       100.0 * static_cast<double>(n) / static_cast<double>(total));
+    if (n > c.at(top).second) top = i;
+  }
+  if (c.other() > 0) out << fmt::format(", other IDs: {}", c.other());
+  out << fmt::format("; live, [can] wake_ids = [0x{:X}] wakes the daemon once per sample\n", c.at(top).first);
+}
+
 }  // namespace
 
 void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info) {
@@ -46,6 +62,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
                      st.frames_seen, st.frames_decoded, st.bus_errors,
                      info.wall_seconds > 0 ? static_cast<double>(st.frames_seen) / info.wall_seconds : 0.0);
   out << fmt::format("  samples    {} complete, {} incomplete\n", st.samples_complete, st.samples_incomplete);
+  print_completing_frames(out, p.completing_frames());
   if (p.intake().rejects().all().empty()) {
     out << "  rejected   none\n";
   } else {

@@ -57,6 +57,8 @@ class FrameIntake {
   [[nodiscard]] const IntakeStats& stats() const { return stats_; }
   [[nodiscard]] const RejectCounters& rejects() const { return rejects_; }
   [[nodiscard]] const FrameDecoder& decoder() const { return *decoder_; }
+  /// Counter of the last frame decoded (valid once one was).
+  [[nodiscard]] std::uint8_t last_frame_counter() const { return part_.counter; }
 
  private:
   void reject(std::string_view reason, const CanFrame& frame, std::uint64_t line, const std::string& detail);

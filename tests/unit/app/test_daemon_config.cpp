@@ -84,6 +84,16 @@ TEST(DaemonConfig, BadValuesAreRejectedWithTheRule) {
             std::string::npos);
 }
 
+TEST(DaemonConfig, WakeIdsAreCanIdsAndDefaultToEveryFrame) {
+  EXPECT_TRUE(parse_daemon_config("", "t.toml").can.wake_ids.empty());
+  const DaemonConfig c = parse_daemon_config("[can]\nwake_ids = [0x102, 0x18FF0001]\n", "t.toml");
+  EXPECT_EQ(c.can.wake_ids, (std::vector<std::uint32_t>{0x102, 0x18FF0001}));
+  EXPECT_NE(error_of("[can]\nwake_ids = 0x102\n").find("test.toml:2: [can] wake_ids must be an array"), std::string::npos);
+  EXPECT_NE(error_of("[can]\nwake_ids = [0x20000000]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);
+  EXPECT_NE(error_of("[can]\nwake_ids = [-1]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);
+  EXPECT_NE(error_of("[can]\nwake_ids = [\"0x102\"]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);
+}
+
 TEST(DaemonConfig, MissingFileSaysSo) {
   try {
     load_daemon_config("/nonexistent/resolverd.toml");

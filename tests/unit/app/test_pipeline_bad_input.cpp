@@ -105,6 +105,41 @@ TEST(PipelineBadInput, EveryProblemCountedNoGoodSampleLost) {
   EXPECT_NE(d.find("[bad_hex]"), std::string::npos) << d;
 }
 
+TEST(PipelineWakeIds, CountsSamplesCompletedByAFrameOutsideWakeIds) {
+  // Samples of RESOLVER_SAMPLE (0x100) + PHASE_CURRENTS (0x101), no reference:
+  // 0x101 completes each one. Naming 0x102 in wake_ids is a mistake the
+  // daemon must report (those samples waited for a wake-up); naming 0x101 is right.
+  for (const std::uint32_t wake : {0x102U, 0x101U}) {
+    RecordingSink sink;
+    std::ostringstream diag;
+    DaemonConfig config;
+    config.can.wake_ids = {wake};
+    Pipeline pipeline(config, sink, diag);
+    CanFrame info = bench::encode_bench_info(1'000'000, 3, 3, 16, 2000);
+    pipeline.feed_untimed(info, 0);
+    for (int k = 0; k < 12; ++k) {
+      const auto c = static_cast<std::uint8_t>(k);
+      const std::int64_t t = 1'000'100 + 500LL * k;
+      pipeline.feed_untimed(bench::encode_resolver_sample(t, c, 0, 26000, static_cast<std::uint16_t>(100 * k)), 0);
+      pipeline.feed_untimed(bench::encode_phase_currents(t + 1, c, 100, -50, -50), 0);
+    }
+    const CompletingFrames& done = pipeline.completing_frames();
+    // The joiner learns the layout on the first samples and emits them when
+    // the next counter begins: those are not counted as completed by a frame.
+    ASSERT_EQ(done.size(), 1U);
+    EXPECT_EQ(done.at(0).first, 0x101U);
+    EXPECT_EQ(done.at(0).second, pipeline.intake().stats().samples_complete - 2);
+    const std::int64_t quiet = pipeline.intake().rejects().get("completed_by_quiet_frame");
+    if (wake == 0x102U) {
+      EXPECT_EQ(quiet, done.at(0).second);
+      EXPECT_NE(diag.str().find("completed by frame 0x101, which is not in [can] wake_ids"), std::string::npos)
+          << diag.str();
+    } else {
+      EXPECT_EQ(quiet, 0) << diag.str();
+    }
+  }
+}
+
 TEST(PipelineBadInput, MissingLogIsAClearError) {
   RecordingSink sink;
   std::ostringstream diag;
