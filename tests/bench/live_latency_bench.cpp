@@ -32,6 +32,7 @@
 #include <time.h>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <atomic>
@@ -49,6 +50,7 @@
 #include "daemon/app/lcm_output.h"
 #include "daemon/app/pipeline.h"
 #include "drivers/socketcan/socketcan_source.h"
+#include "drivers/socketcan/split_wake_source.h"
 #include "tests/bench/live_latency_feed.h"
 #include "tests/bench/live_latency_stats.h"
 
@@ -72,6 +74,7 @@ struct Options {
   int sender_fifo = 50;  // SCHED_FIFO priority of the sending thread; 0 = normal
   int reader_fifo = 0;   // of the reading thread (resolverd's unit sets none)
   bool read_only = false;  // the floor: read every frame, no pipeline, no publish
+  std::vector<std::uint32_t> wake_ids;  // resolverd's [can] wake_ids
 };
 
 std::int64_t realtime_ns() {
@@ -121,11 +124,33 @@ class TimingSink final : public resolver::OutputSink {
 
 /// The reading end and the writing end of one run.
 struct Endpoints {
-  resolver::SocketCanSource reader;
+  resolver::SplitWakeSource reader;
   resolver::UniqueFd writer_owned;  // socket pair: the other end
+  resolver::UniqueFd quiet_writer;  // socket pair, --wake-ids: the quiet socket's other end
   std::optional<resolver::SocketCanSource> writer_can;  // vcan: a second CAN_RAW socket
   [[nodiscard]] int writer_fd() const { return writer_can ? writer_can->fd() : writer_owned.get(); }
 };
+
+std::vector<resolver::CanIdFilter> wake_filters(const std::vector<std::uint32_t>& ids) {
+  std::vector<resolver::CanIdFilter> out;
+  out.reserve(ids.size());
+  for (const std::uint32_t id : ids) out.push_back(resolver::CanIdFilter{id, id > 0x7FF ? 0x1FFFFFFFU : 0x7FFU, id > 0x7FF});
+  return out;
+}
+
+/// A socket pair whose reading end gets what open() enables on a CAN_RAW
+/// socket; AF_UNIX stamps each datagram when it is sent (there is no receive
+/// interrupt to stamp at).
+std::pair<resolver::SocketCanSource, resolver::UniqueFd> stamped_pair(const char* name) {
+  int fds[2] = {-1, -1};
+  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds) < 0) {
+    throw resolver::SocketCanError("socketpair(AF_UNIX, SOCK_SEQPACKET)", name, errno);
+  }
+  const int on = 1;
+  ::setsockopt(fds[0], SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
+  ::setsockopt(fds[0], SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
+  return {resolver::SocketCanSource::adopt(fds[0], name), resolver::UniqueFd(fds[1])};
+}
 
 Endpoints open_endpoints(const Options& o) {
   if (!o.iface.empty()) {
@@ -135,18 +160,18 @@ Endpoints open_endpoints(const Options& o) {
     resolver::SocketCanOptions wo;
     wo.iface = o.iface;
     wo.receive_error_frames = false;
-    return Endpoints{resolver::SocketCanSource::open(ro), resolver::UniqueFd(), resolver::SocketCanSource::open(wo)};
+    return Endpoints{resolver::SplitWakeSource::open(ro, wake_filters(o.wake_ids)), resolver::UniqueFd(),
+                     resolver::UniqueFd(), resolver::SocketCanSource::open(wo)};
   }
-  int fds[2] = {-1, -1};
-  if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds) < 0) {
-    throw resolver::SocketCanError("socketpair(AF_UNIX, SOCK_SEQPACKET)", "sockpair", errno);
+  auto [reader, writer] = stamped_pair("sockpair0");
+  if (o.wake_ids.empty()) {
+    return Endpoints{resolver::SplitWakeSource(std::move(reader), std::nullopt), std::move(writer),
+                     resolver::UniqueFd(), std::nullopt};
   }
-  // What open() enables on a CAN_RAW socket; AF_UNIX stamps each datagram
-  // when it is sent (there is no receive interrupt to stamp at).
-  const int on = 1;
-  ::setsockopt(fds[0], SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
-  ::setsockopt(fds[0], SOL_SOCKET, SO_RXQ_OVFL, &on, sizeof on);
-  return Endpoints{resolver::SocketCanSource::adopt(fds[0], "sockpair0"), resolver::UniqueFd(fds[1]), std::nullopt};
+  // The sender routes by ID what the kernel's filters would (PaceConfig::quiet_fd).
+  auto [quiet_reader, quiet_writer] = stamped_pair("sockpair0");
+  return Endpoints{resolver::SplitWakeSource(std::move(reader), std::move(quiet_reader)), std::move(writer),
+                   std::move(quiet_writer), std::nullopt};
 }
 
 RunResult run_once(const Options& o) {
@@ -167,7 +192,15 @@ RunResult run_once(const Options& o) {
   std::atomic<bool> stop{false};
   std::atomic<bool> writer_done{false};
   SendCounts sent;
-  PaceConfig pace{o.rate, o.burst, o.seconds, 0.0, o.sender_fifo};
+  PaceConfig pace;
+  pace.frames_per_s = o.rate;
+  pace.burst = o.burst;
+  pace.seconds = o.seconds;
+  pace.fifo_priority = o.sender_fifo;
+  if (ends.quiet_writer.valid()) {
+    pace.quiet_fd = ends.quiet_writer.get();
+    pace.wake_ids = o.wake_ids;
+  }
   std::thread writer([&] {
     sent = resolver::bench_live::send_paced(ends.writer_fd(), feed, pace, stop);
     if (ends.writer_can) {
@@ -182,6 +215,7 @@ RunResult run_once(const Options& o) {
     }
     // Socket pair: closing the writing end is the end of stream for the reader
     // (0-byte read + POLLHUP -> kDeviceGone); shutdown(SHUT_WR) would give no POLLHUP.
+    ends.quiet_writer.reset();
     ends.writer_owned.reset();
     writer_done.store(true);
     // Stay alive until the reader has read this thread's CPU clock, which is
@@ -286,6 +320,11 @@ int run(int argc, char** argv) {
   app.add_flag("--read-only", o.read_only,
                "the floor: only SocketCanSource::read each frame (no pipeline, no publish), i.e. what waking once "
                "per frame costs on this machine");
+  app.add_option("--wake-ids", o.wake_ids,
+                 "resolverd's [can] wake_ids: only these frame IDs wake the reader, the others wait in a second "
+                 "socket (host: a second socket pair, the sender routes by ID as the kernel's filters would), "
+                 "e.g. 0x102")
+      ->expected(1, 16);
   CLI11_PARSE(app, argc, argv);
 
   std::string reader_sched = "SCHED_OTHER";
@@ -303,8 +342,11 @@ int run(int argc, char** argv) {
     std::cerr << "live_latency_bench: " << e.what() << "\n";
     return 2;
   }
-  const resolver::bench_live::Setup setup{o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
-                                                          : o.iface + " (CAN_RAW) -> SocketCanSource::open",
+  std::string wake;
+  for (const std::uint32_t id : o.wake_ids) wake += fmt::format("{}0x{:X}", wake.empty() ? "" : ", ", id);
+  const std::string split = wake.empty() ? "" : "; split: only " + wake + " wake the reader";
+  const resolver::bench_live::Setup setup{(o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
+                                                           : o.iface + " (CAN_RAW) -> SocketCanSource::open") + split,
                                           o.read_only ? std::string("none (--read-only: read path only)")
                                                       : o.lcm + (o.config.empty() ? "" : ", config " + o.config), o.rate, o.burst, o.seconds, std::min(o.warmup, o.seconds / 4.0),
                                           reader_sched};

@@ -125,7 +125,9 @@ SendCounts send_paced(int fd, FrameFeed& feed, const PaceConfig& cfg, const std:
     if (late_ns > period_ns * burst) ++counts.late_wakeups;  // the next wake-up was due already
     counts.max_late_us = std::max(counts.max_late_us, late_ns * 1e-3);
     for (int b = 0; b < burst && i < total; ++b, ++i) {
-      send_one(fd, feed.next(), counts);
+      const CanFrame& frame = feed.next();
+      const bool quiet = cfg.quiet_fd >= 0 && std::find(cfg.wake_ids.begin(), cfg.wake_ids.end(), frame.id) == cfg.wake_ids.end();
+      send_one(quiet ? cfg.quiet_fd : fd, frame, counts);
       if (error_every > 0 && i % error_every == error_every - 1) send_one(fd, err_frame, counts);
     }
   }

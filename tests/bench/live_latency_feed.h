@@ -54,6 +54,11 @@ struct PaceConfig {
   double seconds = 10.0;        ///< how long to send
   double error_every_s = 0.0;   ///< inject one CAN error frame this often; 0 = never
   int fifo_priority = 0;        ///< > 0: run the sending thread SCHED_FIFO at this priority
+  /// Host stand-in for the kernel's CAN_RAW filters of a split reader
+  /// (split_wake_source.h): frames whose ID is not in wake_ids go to
+  /// quiet_fd instead of the main fd. -1 = everything to the main fd.
+  int quiet_fd = -1;
+  std::vector<std::uint32_t> wake_ids;
 };
 
 /// What the sender did; every frame it tried to send is in exactly one of
