@@ -32,7 +32,8 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ALL_SCENARIOS = ["replay", "errors", "linkflap", "recreate", "sighup", "model", "fd", "fullspeed", "latency", "soak"]
+ALL_SCENARIOS = ["replay", "errors", "linkflap", "recreate", "sighup", "split", "model", "fd", "fullspeed", "latency",
+                 "soak"]
 NEEDS_ROOT_NATIVELY = {"linkflap", "recreate", "soak"}  # they take vcan0 down / delete it
 # Scenarios that run the live benchmark's programs (tests/bench/live_latency_*).
 LIVE_BENCH_PROGS = {"latency": "live_latency_bench", "soak": "live_latency_sender"}
@@ -116,7 +117,8 @@ def scenario_params(args):
             "resolver_vcan_latency_lcm": args.latency_lcm,
             "resolver_vcan_soak_s": str(args.soak_seconds),
             "resolver_vcan_soak_flap_s": str(args.soak_flap_seconds),
-            "resolver_vcan_burst": str(args.live_burst)}
+            "resolver_vcan_burst": str(args.live_burst),
+            "resolver_vcan_wake_ids": args.wake_ids or "none"}
 
 
 def run_native(args, scenarios, share):
@@ -344,6 +346,21 @@ def check_scenario(c, s, out, msgs, facts, inputs, summary):
         c.check(s, r.get("network_down", 0) >= 1, f"network_down counted in health ({r})")
         c.check(s, last["frames_seen"] == sent, f"frames_seen {last['frames_seen']} == sent {sent} across the flap")
         c.check(s, len(angles) == inputs["samples"], f"angle_t {len(angles)} == samples {inputs['samples']}")
+    elif s == "split":
+        sent = fact_int("frames_sent")
+        err_bus = fact_int("error_frames_seen_by_candump")
+        r = reasons(last)
+        c.check(s, "two sockets" in stderr, "resolverd read vcan0 through two sockets ([can] wake_ids = [0x102])")
+        c.check(s, facts.get("link_down_rc") == "0" and facts.get("link_up_rc") == "0", "ip link set down/up succeeded")
+        c.check(s, last["frames_decoded"] == sent, f"frames_decoded {last['frames_decoded']} == sent {sent} (both sockets)")
+        c.check(s, last["frames_seen"] == sent + err_bus,
+                f"frames_seen {last['frames_seen']} == {sent} data + {err_bus} error frames")
+        c.check(s, last["bus_errors"] == err_bus, f"bus_errors {last['bus_errors']} == error frames candump received {err_bus}")
+        c.check(s, r.get("network_down", 0) >= 1, f"network_down counted across the split sockets ({r})")
+        # sample_clock_reanchored: the 1.5 s pause of the flap, as in linkflap.
+        c.check(s, set(r) <= {"network_down", "sample_clock_reanchored"},
+                f"no other rejects: frames in order, none completed a sample from the quiet socket ({r})")
+        c.check(s, len(angles) == inputs["samples"], f"angle_t {len(angles)} == samples {inputs['samples']}")
     elif s == "recreate":
         sent = fact_int("frames_sent")
         r = reasons(last)
@@ -524,6 +541,9 @@ def main():
     ap.add_argument("--soak-flap-seconds", type=int, default=30, help="soak scenario: link flap period")
     ap.add_argument("--live-burst", type=int, default=8,
                     help="latency and soak scenarios: frames per sender wake-up (8 = a burst per ms at 8000 frames/s)")
+    ap.add_argument("--wake-ids", default="",
+                    help="latency and soak scenarios: resolverd's [can] wake_ids, comma-separated (e.g. 0x102): "
+                         "read through two sockets, woken only by these frames; default: every frame wakes")
     ap.add_argument("--canplayer-gap-ms", type=int, default=int(os.environ.get("RESOLVER_VCAN_CANPLAYER_GAP_MS", "1")),
                     help="canplayer -g: its sleep between clock checks [ms]; 1 is canplayer's default, "
                          "0 busy-loops for the log's exact timing")

@@ -10,6 +10,7 @@
 #   resolver_vcan_latency_lcm  LCM URL of the output (memq://)
 #   resolver_vcan_burst        frames per sender wake-up (8 = one burst per ms;
 #                              1 = evenly spaced, more than the emulated guest keeps up with)
+#   resolver_vcan_wake_ids     resolverd's [can] wake_ids, comma-separated (none)
 # The sender runs SCHED_OTHER here: on the guest's single vCPU a real-time
 # sender that falls behind would starve the reader it is measuring.
 . "$(dirname "$0")/lib.sh"
@@ -23,9 +24,13 @@ secs=$(param resolver_vcan_latency_s 5)
 runs=$(param resolver_vcan_latency_runs 1)
 lcm=$(param resolver_vcan_latency_lcm memq://)
 burst=$(param resolver_vcan_burst 8)
+wake=$(param resolver_vcan_wake_ids none)
 fact latency_seconds "$secs"
 fact latency_burst "$burst"
+fact wake_ids "$wake"
+set --
+[ "$wake" = none ] || set -- --wake-ids $(echo "$wake" | tr ',' ' ')
 live_latency_bench --iface "$IFACE" --seconds "$secs" --runs "$runs" --lcm "$lcm" --burst "$burst" --sender-fifo 0 \
-  --json "$OUT/latency.json" > "$OUT/latency.txt" 2>&1
+  --json "$OUT/latency.json" "$@" > "$OUT/latency.txt" 2>&1
 fact latency_rc $?
 cat "$OUT/latency.txt"

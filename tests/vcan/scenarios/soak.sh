@@ -9,7 +9,8 @@
 #   frames attempted = frames_seen + kernel_drops + frames refused while down
 # and that the RSS stayed flat. Parameters (environment natively, kernel
 # command line in the guest): resolver_vcan_soak_s (30: the suite's short
-# variant; 600 for the full soak), resolver_vcan_soak_flap_s (30).
+# variant; 600 for the full soak), resolver_vcan_soak_flap_s (30),
+# resolver_vcan_wake_ids (none; e.g. 0x102: resolverd's [can] wake_ids).
 . "$(dirname "$0")/lib.sh"
 param() {
   eval "_v=\${$1:-}"
@@ -19,6 +20,9 @@ param() {
 secs=$(param resolver_vcan_soak_s 30)
 flap=$(param resolver_vcan_soak_flap_s 30)
 burst=$(param resolver_vcan_burst 8)
+wake=$(param resolver_vcan_wake_ids none)
+fact wake_ids "$wake"
+if [ "$wake" = none ]; then printf '' > "$OUT/resolverd.toml"; else printf '[can]\nwake_ids = [%s]\n' "$wake" > "$OUT/resolverd.toml"; fi
 # A short soak still flaps: at least twice per run, at least 4 s apart.
 [ "$secs" -ge $((2 * flap)) ] || flap=$((secs / 3))
 [ "$flap" -ge 4 ] || flap=4
@@ -28,7 +32,7 @@ fact burst "$burst"
 url='udpm://239.255.76.67:7667?ttl=0'
 rm -f "$OUT/out.lcmlog"
 lcm-logger -q -f --lcm-url="$url" -c 'RESOLVER_HEALTH|RESOLVER_ESTIMATE' "$OUT/out.lcmlog" > "$OUT/lcm-logger.txt" 2>&1 & LOGGER_PID=$!
-resolverd --can "$IFACE" --lcm "$url" --report "$OUT/report.json" \
+resolverd --can "$IFACE" --lcm "$url" --report "$OUT/report.json" --config "$OUT/resolverd.toml" \
   < /dev/null > "$OUT/resolverd.stdout" 2> "$OUT/resolverd.stderr" &
 RESOLVERD_PID=$!
 wait_for "$OUT/resolverd.stderr" "reading $IFACE" 1 20 || exit 1
