@@ -15,6 +15,7 @@ class CompletingFrames {
   static constexpr std::size_t kMaxIds = 8;  ///< distinct IDs tallied; more go to other()
 
   void add(std::uint32_t id) {
+    ++total_;
     for (std::size_t i = 0; i < used_; ++i) {
       if (ids_[i].first == id) {
         ++ids_[i].second;
@@ -31,16 +32,13 @@ class CompletingFrames {
   [[nodiscard]] std::size_t size() const { return used_; }
   [[nodiscard]] const std::pair<std::uint32_t, std::int64_t>& at(std::size_t i) const { return ids_[i]; }
   [[nodiscard]] std::int64_t other() const { return other_; }
-  [[nodiscard]] std::int64_t total() const {
-    std::int64_t n = other_;
-    for (std::size_t i = 0; i < used_; ++i) n += ids_[i].second;
-    return n;
-  }
+  [[nodiscard]] std::int64_t total() const { return total_; }
 
  private:
   std::array<std::pair<std::uint32_t, std::int64_t>, kMaxIds> ids_{};
   std::size_t used_ = 0;
   std::int64_t other_ = 0;
+  std::int64_t total_ = 0;
 };
 
 }  // namespace resolver

@@ -80,13 +80,20 @@ void require_positive(int value, const char* name, const std::string& source) {
   if (value < 1) throw ConfigError(source + ": " + name + " must be >= 1, got " + std::to_string(value));
 }
 
-void read_wake_ids(const toml::table& t, std::vector<std::uint32_t>& ids, const std::string& s) {
+void read_wake_ids(const toml::table& t, bool& wake_auto, std::vector<std::uint32_t>& ids, const std::string& s) {
   const toml::node* node = t.get("wake_ids");
   if (node == nullptr) return;
+  if (const auto text = node->value<std::string>(); text && *text == "auto") {
+    wake_auto = true;
+    ids.clear();
+    return;
+  }
   const toml::array* arr = node->as_array();
   if (arr == nullptr) {
-    throw ConfigError(where(s, *node) + ": [can] wake_ids must be an array of CAN IDs, e.g. [0x102]");
+    throw ConfigError(where(s, *node) +
+                      ": [can] wake_ids must be \"auto\" or an array of CAN IDs, e.g. [0x102] ([] = every frame)");
   }
+  wake_auto = false;
   ids.clear();
   for (const auto& item : *arr) {
     const std::optional<std::int64_t> id = item.is_integer() ? item.value<std::int64_t>() : std::nullopt;
@@ -157,7 +164,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     check_keys(*t, "can", {"receive_buffer_bytes", "wake_ids"}, s);
     read(*t, "receive_buffer_bytes", c.can.receive_buffer_bytes, s, "can");
     if (c.can.receive_buffer_bytes < 0) throw ConfigError(s + ": [can] receive_buffer_bytes must be >= 0");
-    read_wake_ids(*t, c.can.wake_ids, s);
+    read_wake_ids(*t, c.can.wake_auto, c.can.wake_ids, s);
   }
   if (const auto* t = section("channels")) {
     check_keys(*t, "channels", {"angle", "dq", "estimate", "model_fit", "health"}, s);

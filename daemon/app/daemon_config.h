@@ -8,7 +8,8 @@
 //   url = "udpm://239.255.76.67:7667?ttl=0"
 //   [can]
 //   receive_buffer_bytes = 4194304
-//   wake_ids = [0x102]         # wake once per sample, on the frame that completes it; [] = every frame
+//   wake_ids = "auto"          # wake once per sample, on the frame that completes it (learnt);
+//                              # or fixed: [0x102]; [] = every frame
 //   [channels]
 //   angle = "RESOLVER_ANGLE"   # also dq, estimate, model_fit, health
 //   [output]
@@ -63,11 +64,13 @@ struct CanOptions {
   /// SO_RCVBUF for the CAN socket [bytes]; the kernel default (~200 kB)
   /// overflowed at full bus rate in the vcan guest. Capped by net.core.rmem_max.
   int receive_buffer_bytes = 4 << 20;
-  /// IDs of the frames that wake the reader (IDs above 0x7FF are 29-bit).
-  /// Empty: every frame does. Name the frame that completes a sample (the
-  /// run report says which one does) and the other frames of the sample wait
-  /// in a second socket until it comes: one wake-up per sample instead of one
-  /// per frame (drivers/socketcan/split_wake_source.h).
+  /// Which frames wake the live reader: "auto" (default, wake_auto) learns
+  /// the frame that completes the samples (daemon/app/wake_planner.h); a
+  /// list fixes the IDs (above 0x7FF: 29-bit), [] = every frame. Only the
+  /// named frames wake the daemon, the others of a sample wait in a second
+  /// socket until it comes: one wake-up per sample instead of one per frame
+  /// (drivers/socketcan/split_wake_source.h).
+  bool wake_auto = true;
   std::vector<std::uint32_t> wake_ids;
 };
 

@@ -5,6 +5,7 @@
 #include <optional>
 #include <thread>
 
+#include "daemon/app/wake_planner.h"
 #include "daemon/service/sd_notify.h"
 #include "drivers/socketcan/split_wake_source.h"
 
@@ -34,8 +35,14 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
   SocketCanOptions so;
   so.iface = options.iface;
   so.receive_buffer_bytes = options.receive_buffer_bytes;
-  const std::vector<CanIdFilter> wake = wake_filters(options.wake_ids);
+  WakePlanner planner(options.wake_auto, options.wake_ids);
   std::optional<SplitWakeSource> source;
+  std::uint64_t drops_before = 0;  // kernel drops counted by sources already closed
+  const Pipeline* wired = nullptr; // the pipeline that was told the wake IDs
+  std::uint64_t silences_seen = 0; // SplitWakeSource::waking_silences() acted on
+  // SO_MEMINFO once per this many reads (~1 s at a saturated bus) and at every timeout.
+  constexpr int kReadsPerDropRefresh = 8192;
+  int reads_since_refresh = 0;
   auto backoff = std::chrono::milliseconds(250);
   constexpr auto kMaxBackoff = std::chrono::milliseconds(5000);
   bool reported_down = false;
@@ -72,15 +79,39 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
     notify->status(format_service_status(options.iface, rate, p.intake().rejects().total(), detail, extra));
   };
 
+  // Changes which frames wake the reader (WakePlanner), on the live sockets:
+  // nothing queued is lost, a frame both sockets got in the switch is handed
+  // out once (SplitWakeSource::set_wake).
+  auto switch_wake = [&](Pipeline& pipeline, std::vector<std::uint32_t> ids) {
+    const std::string before = WakePlanner::describe(planner.wake_ids());
+    try {
+      source->set_wake(wake_filters(ids));
+    } catch (const SocketCanError& e) {
+      pipeline.count_problem("wake_switch_failed", std::string(e.what()) + "; still woken by " + before);
+      planner.switched(planner.wake_ids());  // count again rather than retry at once
+      return;
+    }
+    err << "resolverd: " << options.iface << ": "
+        << (ids.empty() ? before + " no longer completes the samples; every frame wakes the reader again"
+                        : "samples are completed by " + WakePlanner::describe(ids) +
+                              "; only it wakes the reader now, the other frames wait in a second socket")
+        << "\n";
+    planner.switched(ids);
+    pipeline.set_wake_ids(std::move(ids));
+  };
+
   while (!flags.stop.load()) {
     if (flags.reload.exchange(false)) on_reload();
     Pipeline& pipeline = current();
     service_tick(pipeline);
     if (!source) {
       try {
-        source.emplace(SplitWakeSource::open(so, wake));
-        err << "resolverd: reading " << options.iface
-            << (wake.empty() ? "" : " (two sockets: woken only by the [can] wake_ids frames)") << "\n";
+        source.emplace(SplitWakeSource::open(so, wake_filters(planner.wake_ids())));
+        err << "resolverd: reading " << options.iface;
+        if (!planner.wake_ids().empty()) {
+          err << " (two sockets: woken only by " << WakePlanner::describe(planner.wake_ids()) << ")";
+        }
+        err << "\n";
         backoff = std::chrono::milliseconds(250);
         reported_down = false;
         waiting_for.clear();
@@ -103,12 +134,26 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
         continue;
       }
     }
+    if (wired != &pipeline) {  // first pass, or a SIGHUP rebuilt it
+      pipeline.set_wake_ids(planner.wake_ids());
+      wired = &pipeline;
+    }
     const ReadStatus status = source->read(frame);
     switch (status) {
-      case ReadStatus::kFrame:
+      case ReadStatus::kFrame: {
         reported_down = false;
+        const std::int64_t completed = pipeline.completing_frames().total();
         pipeline.feed(frame, 0, Clock::now());
+        if (!planner.auto_mode()) break;
+        if (pipeline.completing_frames().total() != completed) {
+          if (auto ids = planner.on_sample_completed_by(frame.id)) switch_wake(pipeline, std::move(*ids));
+        }
+        if (source->waking_silences() != silences_seen) {
+          silences_seen = source->waking_silences();
+          if (auto ids = planner.on_waking_silence()) switch_wake(pipeline, std::move(*ids));
+        }
         break;
+      }
       case ReadStatus::kTimeout:
       case ReadStatus::kInterrupted:
         break;
@@ -125,12 +170,19 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
         break;
       case ReadStatus::kDeviceGone:
         pipeline.count_problem("device_gone", options.iface + " disappeared (ENODEV); re-opening with backoff");
+        drops_before += source->stats().kernel_drops;
         source.reset();
+        silences_seen = 0;
         pipeline.restart_sequence();
         break;
     }
     if (source) {
-      const std::uint64_t drops = source->stats().kernel_drops;
+      if (status == ReadStatus::kTimeout || ++reads_since_refresh >= kReadsPerDropRefresh) {
+        // Drops after the last frame a socket queued show only this way.
+        source->refresh_kernel_drops();
+        reads_since_refresh = 0;
+      }
+      const std::uint64_t drops = drops_before + source->stats().kernel_drops;
       pipeline.set_kernel_drops(static_cast<std::int64_t>(drops));
       if (drops > drops_reported) {
         pipeline.count_problem("kernel_drop", options.iface + ": kernel dropped " + std::to_string(drops - drops_reported) +
@@ -149,7 +201,8 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
     for (int i = 0; i < 1'000'000 && source->read(frame) == ReadStatus::kFrame; ++i) {
       pipeline.feed(frame, 0, Clock::now());
     }
-    pipeline.set_kernel_drops(static_cast<std::int64_t>(source->stats().kernel_drops));
+    source->refresh_kernel_drops();
+    pipeline.set_kernel_drops(static_cast<std::int64_t>(drops_before + source->stats().kernel_drops));
   }
   current().finish();
 }

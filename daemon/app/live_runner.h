@@ -2,8 +2,9 @@
 // end the daemon: a downed link (ENETDOWN) keeps the socket and goes on
 // reading; a vanished interface (ENODEV) closes it and re-opens with backoff.
 // Every such event is counted in health_t and printed once per episode.
-// With wake_ids the interface is read through two sockets, so that only the
-// named frames wake the daemon (drivers/socketcan/split_wake_source.h).
+// Once the frame that completes the samples is known ([can] wake_ids, learnt
+// by default) the interface is read through two sockets, so that only that
+// frame wakes the daemon (split_wake_source.h, wake_planner.h).
 #pragma once
 
 #include <functional>
@@ -24,8 +25,10 @@ struct LiveOptions {
   /// systemd notifications (READY, WATCHDOG, STATUS, STOPPING); null = none.
   SdNotifier* notifier = nullptr;
   int receive_buffer_bytes = 0;  ///< SO_RCVBUF; 0 = kernel default
-  /// [can] wake_ids: frames that wake the reader (IDs above 0x7FF are 29-bit);
-  /// empty = every frame. Fixed at start (a SIGHUP does not change it).
+  /// [can] wake_ids: learn the frame that completes samples and wake only
+  /// for it (wake_auto, wake_planner.h), or these IDs (above 0x7FF: 29-bit;
+  /// empty = every frame). Fixed at start (a SIGHUP does not change it).
+  bool wake_auto = false;
   std::vector<std::uint32_t> wake_ids;
 };
 

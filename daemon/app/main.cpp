@@ -134,7 +134,7 @@ static int run(int argc, char** argv) {
         notifier.ready();
       };
       const auto live_start = std::chrono::steady_clock::now();
-      run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes, config.can.wake_ids}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
+      run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes, config.can.wake_auto, config.can.wake_ids}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
       info.source = can_iface;
       info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }

@@ -140,8 +140,7 @@ void Pipeline::feed(const CanFrame& frame, std::uint64_t line, Clock::time_point
 
 void Pipeline::note_completing_frame(const CanFrame& frame) {
   completing_frames_.add(frame.id);
-  const auto& wake = config_.can.wake_ids;
-  if (wake.empty() || std::find(wake.begin(), wake.end(), frame.id) != wake.end()) return;
+  if (wake_ids_.empty() || std::find(wake_ids_.begin(), wake_ids_.end(), frame.id) != wake_ids_.end()) return;
   // The frame came through the quiet socket, so the sample waited for the
   // next waking frame: the latency is a sample period or the read timeout.
   intake_.count_problem("completed_by_quiet_frame",

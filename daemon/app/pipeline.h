@@ -24,6 +24,8 @@
 #include <cstdint>
 #include <memory>
 #include <ostream>
+#include <utility>
+#include <vector>
 
 #include "daemon/app/completing_frames.h"
 #include "daemon/app/daemon_config.h"
@@ -80,6 +82,9 @@ class Pipeline {
   [[nodiscard]] std::int64_t samples() const { return samples_; }
   /// Which frame IDs completed the samples (the ones [can] wake_ids should name).
   [[nodiscard]] const CompletingFrames& completing_frames() const { return completing_frames_; }
+  /// The frames that wake the live reader now (empty = every frame): a sample
+  /// completed by another frame waited for a wake-up and is counted.
+  void set_wake_ids(std::vector<std::uint32_t> ids) { wake_ids_ = std::move(ids); }
   /// nullptr when [model] enabled = false.
   [[nodiscard]] const LiveModelFit* model_fit() const { return model_fit_.get(); }
 
@@ -101,6 +106,7 @@ class Pipeline {
   LatencyHistogram latency_total_;
   std::int64_t samples_ = 0;
   CompletingFrames completing_frames_;
+  std::vector<std::uint32_t> wake_ids_;
   std::int64_t last_frame_us_ = 0;
   std::int64_t health_window_start_us_ = -1;
   std::int64_t frames_at_window_start_ = 0;

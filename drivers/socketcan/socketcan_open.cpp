@@ -60,6 +60,24 @@ std::vector<can_filter> kernel_filters(const SocketCanOptions& options) {
 
 }  // namespace
 
+void SocketCanSource::set_filters(const std::vector<CanIdFilter>& filters, bool join) {
+  SocketCanOptions options;
+  options.iface = iface_;
+  options.filters = filters;
+  std::vector<can_filter> kernel = kernel_filters(options);
+  if (kernel.empty()) kernel.push_back(can_filter{0, 0});  // every frame, as a new socket
+  if (join && kernel.size() > 1) set_flag(fd_.get(), SOL_CAN_RAW, CAN_RAW_JOIN_FILTERS, "CAN_RAW_JOIN_FILTERS", iface_);
+  set_option(fd_.get(), SOL_CAN_RAW, CAN_RAW_FILTER, kernel.data(),
+             static_cast<socklen_t>(kernel.size() * sizeof(can_filter)), "CAN_RAW_FILTER", iface_);
+}
+
+void SocketCanSource::receive_nothing() {
+  // No filter at all: the socket matches no frame (can.rst, "RAW socket option CAN_RAW_FILTER").
+  set_option(fd_.get(), SOL_CAN_RAW, CAN_RAW_FILTER, nullptr, 0, "CAN_RAW_FILTER", iface_);
+  const can_err_mask_t none = 0;
+  set_option(fd_.get(), SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &none, sizeof none, "CAN_RAW_ERR_FILTER", iface_);
+}
+
 SocketCanSource SocketCanSource::open(const SocketCanOptions& options) {
   const std::string& iface = options.iface;
   check_iface_name(iface);

@@ -96,12 +96,24 @@ class SocketCanSource {
   /// not listed in ReadStatus.
   ReadStatus read(CanFrame& frame);
 
+  /// Replaces the receive filters of a CAN_RAW socket while it is in use
+  /// (frames already queued stay): `filters` as SocketCanOptions::filters,
+  /// empty = every frame; `join` = CAN_RAW_JOIN_FILTERS. Throws SocketCanError.
+  void set_filters(const std::vector<CanIdFilter>& filters, bool join = false);
+  /// From now on the socket receives no frame, error frames included (what
+  /// is queued can still be read). Throws SocketCanError.
+  void receive_nothing();
+
   /// Sends one frame (tools and tests). Waits up to read_timeout while the
   /// transmit queue is full (ENOBUFS), then throws SocketCanError; throws
   /// std::invalid_argument for a frame that cannot be encoded (see can_wire.h).
   void write(const CanFrame& frame);
 
   [[nodiscard]] const SocketCanStats& stats() const { return stats_; }
+  /// Brings stats().kernel_drops up to date without waiting for a frame to
+  /// carry the count (SO_MEMINFO; a no-op where the kernel lacks it). Cheap
+  /// enough for once a second; at the end of a run it counts the last drops.
+  void refresh_kernel_drops();
   /// [ns] receive stamp of the frame the last kFrame read returned (its
   /// timestamp_us at full resolution).
   [[nodiscard]] std::int64_t last_stamp_ns() const { return last_stamp_ns_; }
@@ -114,6 +126,8 @@ class SocketCanSource {
   SocketCanSource(UniqueFd fd, std::string iface, std::chrono::milliseconds read_timeout);
   /// Sets SO_RCVTIMEO when read_timeout changed since the last read.
   void apply_receive_timeout();
+  /// Adds the drops the cumulative kernel counter shows beyond the last one.
+  void note_drop_counter(std::uint32_t counter);
   /// True when the socket reports POLLHUP (adopted stream/seqpacket fds).
   [[nodiscard]] bool peer_hung_up() const;
 

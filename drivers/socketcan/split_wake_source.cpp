@@ -1,63 +1,121 @@
 #include "drivers/socketcan/split_wake_source.h"
 
 #include <cerrno>
+#include <cstring>
+#include <stdexcept>
 #include <utility>
 
 namespace resolver {
+
+SocketCanOptions SplitWakeSource::quiet_options(const SocketCanOptions& base, const std::vector<CanIdFilter>& wake) {
+  SocketCanOptions q = base;
+  q.receive_error_frames = false;  // error frames must wake the reader
+  q.join_filters = true;           // "not A and not B", not "not A or not B"
+  q.filters.clear();
+  for (CanIdFilter f : wake) {
+    f.inverted = true;
+    q.filters.push_back(f);
+  }
+  q.read_timeout = std::chrono::milliseconds(0);  // never waited on
+  return q;
+}
 
 SplitWakeSource SplitWakeSource::open(const SocketCanOptions& options, const std::vector<CanIdFilter>& wake) {
   if (!options.filters.empty()) {
     throw SocketCanError("open (split wake-up sockets)", options.iface, EINVAL,
                          "receive filters and wake IDs cannot be combined");
   }
-  if (wake.empty()) return SplitWakeSource(SocketCanSource::open(options), std::nullopt);
-  // The quiet socket first: from its bind on it receives every non-waking
-  // frame, so none can slip between the two binds unseen. (A waking frame in
-  // that instant reaches neither; the waking socket is bound microseconds
-  // later, before the caller reads anything, and the bus is idle at start-up.)
-  SocketCanOptions quiet_options = options;
-  quiet_options.receive_error_frames = false;  // error frames must wake the reader
-  quiet_options.join_filters = true;           // "not A and not B", not "not A or not B"
-  for (CanIdFilter f : wake) {
-    f.inverted = true;
-    quiet_options.filters.push_back(f);
-  }
-  SocketCanSource quiet = SocketCanSource::open(quiet_options);
-  SocketCanOptions waking_options = options;
-  waking_options.filters = wake;
-  return SplitWakeSource(SocketCanSource::open(waking_options), std::move(quiet));
+  SplitWakeSource source(SocketCanSource::open(options), std::nullopt);
+  source.options_ = options;
+  if (!wake.empty()) source.set_wake(wake);
+  return source;
 }
 
 SplitWakeSource::SplitWakeSource(SocketCanSource waking, std::optional<SocketCanSource> quiet)
-    : waking_(std::move(waking)), quiet_(std::move(quiet)) {
-  if (quiet_) quiet_->set_read_timeout(std::chrono::milliseconds(0));  // drained, never waited on
+    : waking_(std::move(waking)), quiet_(std::move(quiet)), read_timeout_(waking_.read_timeout()) {
+  if (quiet_) quiet_->set_read_timeout(std::chrono::milliseconds(0));
 }
 
-void SplitWakeSource::drain_quiet() {
-  if (!quiet_) return;
-  CanFrame frame;
+void SplitWakeSource::set_wake(const std::vector<CanIdFilter>& wake) {
+  if (!options_) throw std::logic_error("SplitWakeSource::set_wake needs a source made by open()");
+  if (wake.empty() && !split()) return;
+  if (!wake.empty() && split()) {
+    throw std::logic_error("SplitWakeSource::set_wake: from one split to another, go through every frame");
+  }
+  if (!wake.empty()) {
+    // One socket -> two. The quiet socket first, then the waking socket's
+    // filters narrowed: a non-waking frame in between reaches both (handed
+    // out once, same_frame) rather than neither.
+    SocketCanSource quiet = quiet_ ? std::move(*quiet_) : SocketCanSource::open(quiet_options(*options_, wake));
+    quiet_.reset();
+    if (quiet_retiring_) quiet.set_filters(quiet_options(*options_, wake).filters, true);  // reused while emptying
+    waking_.set_filters(wake);
+    quiet_ = std::move(quiet);
+    quiet_retiring_ = false;
+    wake_ = wake;
+    return;
+  }
+  // Two sockets -> one. The waking socket takes every frame first, then the
+  // quiet one stops receiving; it is read until empty and closed (pull_quiet).
+  waking_.set_filters({});
+  quiet_->receive_nothing();
+  quiet_retiring_ = true;
+  quiet_flowing_ = false;
+  wake_.clear();
+}
+
+bool SplitWakeSource::same_frame(const Stamped& a, const Stamped& b) {
+  return a.stamp_ns == b.stamp_ns && a.frame.id == b.frame.id && a.frame.len == b.frame.len &&
+         a.frame.extended == b.frame.extended && a.frame.fd == b.frame.fd &&
+         std::memcmp(a.frame.data.data(), b.frame.data.data(), a.frame.len) == 0;
+}
+
+void SplitWakeSource::pull_quiet() {
+  if (quiet_next_ || !quiet_) return;
   for (;;) {
+    CanFrame frame;
     const ReadStatus s = quiet_->read(frame);
     if (s == ReadStatus::kFrame) {
-      quiet_frames_.push_back(Stamped{frame, quiet_->last_stamp_ns()});
-    } else if (s == ReadStatus::kTruncated) {
-      ++truncated_pending_;
-    } else {
-      // kTimeout: empty. kNetworkDown/kDeviceGone also reach the waking
-      // socket, which reports them; kInterrupted: the next read() drains on.
+      quiet_next_ = Stamped{frame, quiet_->last_stamp_ns()};
       return;
     }
+    if (s == ReadStatus::kTruncated) {
+      ++truncated_pending_;
+      continue;
+    }
+    if (s == ReadStatus::kTimeout && quiet_retiring_) {
+      const SocketCanStats& q = quiet_->stats();
+      closed_quiet_.frames += q.frames;
+      closed_quiet_.fd_frames += q.fd_frames;
+      closed_quiet_.error_frames += q.error_frames;
+      closed_quiet_.kernel_drops += q.kernel_drops;
+      closed_quiet_.truncated += q.truncated;
+      quiet_.reset();
+      quiet_retiring_ = false;
+    }
+    // kTimeout: empty. kNetworkDown/kDeviceGone reach the waking socket too,
+    // which reports them; kInterrupted: the next call reads on.
+    return;
   }
 }
 
-ReadStatus SplitWakeSource::pop_quiet(CanFrame& frame) {
-  frame = quiet_frames_.front().frame;
-  quiet_frames_.pop_front();
+ReadStatus SplitWakeSource::read_waking(bool wait) {
+  if (!wait) waking_.set_read_timeout(std::chrono::milliseconds(0));
+  CanFrame frame;
+  const ReadStatus s = waking_.read(frame);
+  if (!wait) waking_.set_read_timeout(read_timeout_);
+  if (s == ReadStatus::kFrame) held_ = Stamped{frame, waking_.last_stamp_ns()};
+  return s;
+}
+
+ReadStatus SplitWakeSource::hand_out(std::optional<Stamped>& slot, CanFrame& frame) {
+  frame = slot->frame;
+  slot.reset();
   return ReadStatus::kFrame;
 }
 
 ReadStatus SplitWakeSource::read(CanFrame& frame) {
-  if (!quiet_) return waking_.read(frame);
+  if (!quiet_ && !quiet_next_ && !held_ && !deferred_ && truncated_pending_ == 0) return waking_.read(frame);
   for (;;) {
     if (truncated_pending_ > 0) {
       --truncated_pending_;
@@ -65,36 +123,53 @@ ReadStatus SplitWakeSource::read(CanFrame& frame) {
     }
     if (held_) {
       // Quiet frames that arrived before the waking frame go first. Equal
-      // stamps: the quiet one, as the frames of a sample precede the one
-      // that completes it.
-      if (quiet_frames_.empty()) drain_quiet();
-      if (!quiet_frames_.empty() && quiet_frames_.front().stamp_ns <= held_->stamp_ns) return pop_quiet(frame);
-      frame = held_->frame;
-      held_.reset();
-      return ReadStatus::kFrame;
+      // stamps: the same frame through both sockets while the split changed,
+      // or else the quiet one, as a sample's frames precede the one completing it.
+      pull_quiet();
+      if (quiet_next_ && same_frame(*quiet_next_, *held_)) {
+        ++duplicates_skipped_;
+        quiet_next_.reset();
+        continue;
+      }
+      if (quiet_next_ && quiet_next_->stamp_ns <= held_->stamp_ns) return hand_out(quiet_next_, frame);
+      return hand_out(held_, frame);
     }
     if (deferred_) {
-      if (!quiet_frames_.empty()) return pop_quiet(frame);
+      // The caller may drop this source after the status: first what is queued.
+      pull_quiet();
+      if (quiet_next_) return hand_out(quiet_next_, frame);
       const ReadStatus s = *deferred_;
       deferred_.reset();
       return s;
     }
-    CanFrame waking_frame;
-    const ReadStatus s = waking_.read(waking_frame);
+    ReadStatus s = ReadStatus::kTimeout;
+    if (quiet_flowing_) {
+      // No waking frame came for read_timeout: quiet frames go out as they
+      // come, each after a look (not a wait) at the waking socket.
+      pull_quiet();
+      if (!quiet_next_) {
+        quiet_flowing_ = false;
+        continue;
+      }
+      s = read_waking(false);
+      if (s == ReadStatus::kTimeout) return hand_out(quiet_next_, frame);
+    } else {
+      s = read_waking(true);
+    }
     switch (s) {
       case ReadStatus::kFrame:
-        held_ = Stamped{waking_frame, waking_.last_stamp_ns()};
-        continue;
+        continue;  // held_: merge with the quiet frames
       case ReadStatus::kTimeout:
-        // No waking frame for read_timeout: hand out what the quiet socket has.
-        drain_quiet();
-        if (!quiet_frames_.empty()) return pop_quiet(frame);
+        pull_quiet();
+        if (quiet_next_) {
+          quiet_flowing_ = true;
+          ++waking_silences_;
+          return hand_out(quiet_next_, frame);
+        }
         if (truncated_pending_ > 0) continue;
         return s;
       case ReadStatus::kNetworkDown:
       case ReadStatus::kDeviceGone:
-        // The caller may drop this source: first everything already received.
-        drain_quiet();
         deferred_ = s;
         continue;
       case ReadStatus::kInterrupted:
@@ -107,13 +182,15 @@ ReadStatus SplitWakeSource::read(CanFrame& frame) {
 
 SocketCanStats SplitWakeSource::stats() const {
   SocketCanStats sum = waking_.stats();
-  if (!quiet_) return sum;
-  const SocketCanStats& q = quiet_->stats();
-  sum.frames += q.frames;
-  sum.fd_frames += q.fd_frames;
-  sum.error_frames += q.error_frames;
-  sum.kernel_drops += q.kernel_drops;
-  sum.truncated += q.truncated;
+  const auto add = [&sum](const SocketCanStats& q) {
+    sum.frames += q.frames;
+    sum.fd_frames += q.fd_frames;
+    sum.error_frames += q.error_frames;
+    sum.kernel_drops += q.kernel_drops;
+    sum.truncated += q.truncated;
+  };
+  add(closed_quiet_);
+  if (quiet_) add(quiet_->stats());
   return sum;
 }
 

@@ -84,11 +84,20 @@ TEST(DaemonConfig, BadValuesAreRejectedWithTheRule) {
             std::string::npos);
 }
 
-TEST(DaemonConfig, WakeIdsAreCanIdsAndDefaultToEveryFrame) {
-  EXPECT_TRUE(parse_daemon_config("", "t.toml").can.wake_ids.empty());
+TEST(DaemonConfig, WakeIdsAreAutoOrCanIds) {
+  const DaemonConfig d = parse_daemon_config("", "t.toml");
+  EXPECT_TRUE(d.can.wake_auto);
+  EXPECT_TRUE(d.can.wake_ids.empty());
+  EXPECT_TRUE(parse_daemon_config("[can]\nwake_ids = \"auto\"\n", "t.toml").can.wake_auto);
   const DaemonConfig c = parse_daemon_config("[can]\nwake_ids = [0x102, 0x18FF0001]\n", "t.toml");
+  EXPECT_FALSE(c.can.wake_auto);
   EXPECT_EQ(c.can.wake_ids, (std::vector<std::uint32_t>{0x102, 0x18FF0001}));
-  EXPECT_NE(error_of("[can]\nwake_ids = 0x102\n").find("test.toml:2: [can] wake_ids must be an array"), std::string::npos);
+  const DaemonConfig every = parse_daemon_config("[can]\nwake_ids = []\n", "t.toml");
+  EXPECT_FALSE(every.can.wake_auto);
+  EXPECT_TRUE(every.can.wake_ids.empty());
+  EXPECT_NE(error_of("[can]\nwake_ids = 0x102\n").find("test.toml:2: [can] wake_ids must be \"auto\" or an array"),
+            std::string::npos);
+  EXPECT_NE(error_of("[can]\nwake_ids = \"sometimes\"\n").find("must be \"auto\" or an array"), std::string::npos);
   EXPECT_NE(error_of("[can]\nwake_ids = [0x20000000]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);
   EXPECT_NE(error_of("[can]\nwake_ids = [-1]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);
   EXPECT_NE(error_of("[can]\nwake_ids = [\"0x102\"]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);

@@ -113,8 +113,8 @@ TEST(PipelineWakeIds, CountsSamplesCompletedByAFrameOutsideWakeIds) {
     RecordingSink sink;
     std::ostringstream diag;
     DaemonConfig config;
-    config.can.wake_ids = {wake};
     Pipeline pipeline(config, sink, diag);
+    pipeline.set_wake_ids({wake});  // what run_live does
     CanFrame info = bench::encode_bench_info(1'000'000, 3, 3, 16, 2000);
     pipeline.feed_untimed(info, 0);
     for (int k = 0; k < 12; ++k) {

@@ -104,7 +104,7 @@ TEST(SplitWakeSource, FramesComeOutInTheOrderTheyArrived) {
   CanFrame f;
   EXPECT_EQ(bus.source.read(f), ReadStatus::kTimeout);
   EXPECT_EQ(bus.source.stats().frames, sent.size());
-  EXPECT_EQ(bus.source.queued(), 0U);
+  EXPECT_EQ(bus.source.duplicates_skipped(), 0U);
 }
 
 TEST(SplitWakeSource, QuietFramesAfterTheLastWakingFrameWaitAtMostTheTimeout) {
@@ -167,6 +167,27 @@ TEST(SplitWakeSource, WithoutAQuietSocketEveryFrameWakes) {
   EXPECT_EQ(got.id, 0x100U);
   EXPECT_EQ(source.read(got), ReadStatus::kTimeout);
   ::close(peer);
+}
+
+TEST(SplitWakeSource, QuietFramesFlowWithoutWaitingOnceNoWakingFrameComes) {
+  // Wrong wake IDs (nothing wakes the reader): after one read timeout the
+  // quiet frames are handed out as they come, not one per timeout.
+  SplitBus bus;
+  for (int i = 0; i < 20; ++i) bus.send(0x100, static_cast<std::uint8_t>(i));
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(read_frame(bus.source).tag, i);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 25ms * 3) << "waited a timeout per frame";
+  EXPECT_EQ(bus.source.waking_silences(), 1U);
+  bus.send(kWakeId, 20);  // a waking frame still comes out in order
+  bus.send(0x100, 21);
+  EXPECT_EQ(read_frame(bus.source).id, kWakeId);
+  EXPECT_EQ(read_frame(bus.source).tag, 21);
+}
+
+TEST(SplitWakeSource, ChangingTheSplitNeedsASourceFromOpen) {
+  SplitBus bus;
+  EXPECT_TRUE(bus.source.split());
+  EXPECT_THROW(bus.source.set_wake({}), std::logic_error);
 }
 
 TEST(SplitWakeSource, OpenRefusesFiltersTogetherWithWakeIds) {
