@@ -556,8 +556,9 @@ def main():
     ap.add_argument("--live-burst", type=int, default=8,
                     help="latency and soak scenarios: frames per sender wake-up (8 = a burst per ms at 8000 frames/s)")
     ap.add_argument("--wake-ids", default="",
-                    help="latency and soak scenarios: resolverd's [can] wake_ids, comma-separated (e.g. 0x102): "
-                         "read through two sockets, woken only by these frames; default: every frame wakes")
+                    help="latency and soak scenarios: [can] wake_ids, comma-separated (e.g. 0x102): read through two "
+                         "sockets, woken only by these frames; default: soak = resolverd's default (\"auto\": learnt), "
+                         "latency = every frame wakes (the benchmark does not learn)")
     ap.add_argument("--canplayer-gap-ms", type=int, default=int(os.environ.get("RESOLVER_VCAN_CANPLAYER_GAP_MS", "1")),
                     help="canplayer -g: its sleep between clock checks [ms]; 1 is canplayer's default, "
                          "0 busy-loops for the log's exact timing")

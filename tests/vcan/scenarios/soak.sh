@@ -10,7 +10,7 @@
 # and that the RSS stayed flat. Parameters (environment natively, kernel
 # command line in the guest): resolver_vcan_soak_s (30: the suite's short
 # variant; 600 for the full soak), resolver_vcan_soak_flap_s (30),
-# resolver_vcan_wake_ids (none; e.g. 0x102: resolverd's [can] wake_ids).
+# resolver_vcan_wake_ids (none = resolverd's default, "auto"; e.g. 0x102 fixes [can] wake_ids).
 . "$(dirname "$0")/lib.sh"
 param() {
   eval "_v=\${$1:-}"
