@@ -144,9 +144,10 @@ void Pipeline::note_completing_frame(const CanFrame& frame) {
   // The frame came through the quiet socket, so the sample waited for the
   // next waking frame: the latency is a sample period or the read timeout.
   intake_.count_problem("completed_by_quiet_frame",
-                        fmt::format("a sample was completed by frame 0x{:X}, which is not in [can] wake_ids, so it "
-                                    "waited for the next waking frame; name the frame that completes samples "
-                                    "(see the run report) in wake_ids",
+                        fmt::format("a sample was completed by frame 0x{:X}, which does not wake the reader "
+                                    "([can] wake_ids), so it waited for the next wake-up; with wake_ids = \"auto\" "
+                                    "resolverd goes back to every frame if this repeats, with a fixed list name the "
+                                    "frame the run report says completes the samples",
                                     frame.id));
 }
 
