@@ -259,49 +259,47 @@ TEST(SocketCanSource, PeerClosedSeqPacketIsDeviceGone) {
 
 void on_alarm(int) {}
 
-TEST(SocketCanSource, SignalDuringWaitIsInterrupted) {
+struct AlarmedRead {
+  ReadStatus status;
+  std::chrono::steady_clock::duration waited;
+};
+
+/// read() with a 5 s timeout while SIGALRM (handler installed with
+/// `sa_flags`) fires after 20 ms.
+AlarmedRead read_with_alarm(int sa_flags) {
   Pair pair = make_pair(SOCK_DGRAM);
   pair.source.set_read_timeout(5s);
   struct sigaction action{};
   struct sigaction previous{};
   action.sa_handler = on_alarm;
   sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;  // poll() is never restarted anyway; be explicit
-  ASSERT_EQ(::sigaction(SIGALRM, &action, &previous), 0);
+  action.sa_flags = sa_flags;
+  EXPECT_EQ(::sigaction(SIGALRM, &action, &previous), 0);
   itimerval timer{};
   timer.it_value.tv_usec = 20'000;  // [us] fire once after 20 ms
-  ASSERT_EQ(::setitimer(ITIMER_REAL, &timer, nullptr), 0);
-
+  EXPECT_EQ(::setitimer(ITIMER_REAL, &timer, nullptr), 0);
   CanFrame frame;
   const auto start = std::chrono::steady_clock::now();
   const ReadStatus status = pair.source.read(frame);
   const auto waited = std::chrono::steady_clock::now() - start;
   ::sigaction(SIGALRM, &previous, nullptr);
   ::close(pair.peer);
-  EXPECT_EQ(status, ReadStatus::kInterrupted);
-  EXPECT_LT(waited, 4s);
+  return AlarmedRead{status, waited};
+}
+
+TEST(SocketCanSource, SignalDuringWaitIsInterrupted) {
+  const AlarmedRead r = read_with_alarm(0);
+  EXPECT_EQ(r.status, ReadStatus::kInterrupted);
+  EXPECT_LT(r.waited, 4s);
 }
 
 TEST(SocketCanSource, SignalInterruptsTheWaitEvenWithSaRestart) {
   // read() waits in recvmsg with SO_RCVTIMEO, and such calls are never
   // restarted after a handler (signal(7)): the daemon's loop sees its flags
   // whatever flags another library installed its handlers with.
-  Pair pair = make_pair(SOCK_DGRAM);
-  pair.source.set_read_timeout(5s);
-  struct sigaction action{};
-  struct sigaction previous{};
-  action.sa_handler = on_alarm;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESTART;
-  ASSERT_EQ(::sigaction(SIGALRM, &action, &previous), 0);
-  itimerval timer{};
-  timer.it_value.tv_usec = 20'000;
-  ASSERT_EQ(::setitimer(ITIMER_REAL, &timer, nullptr), 0);
-  CanFrame frame;
-  const ReadStatus status = pair.source.read(frame);
-  ::sigaction(SIGALRM, &previous, nullptr);
-  ::close(pair.peer);
-  EXPECT_EQ(status, ReadStatus::kInterrupted);
+  const AlarmedRead r = read_with_alarm(SA_RESTART);
+  EXPECT_EQ(r.status, ReadStatus::kInterrupted);
+  EXPECT_LT(r.waited, 4s);
 }
 
 TEST(SocketCanSource, ZeroTimeoutDoesNotWaitAndLaterTimeoutsApply) {

@@ -57,3 +57,27 @@ play() {
 # An independent listener: candump counts what really went over the bus.
 start_candump() { candump -L "$IFACE" > "$OUT/candump.log" 2> "$OUT/candump.err" & CANDUMP_PID=$!; sleep 0.3; }
 stop_candump() { sleep 0.3; kill "$CANDUMP_PID" 2>/dev/null; wait "$CANDUMP_PID" 2>/dev/null; fact frames_on_bus "$(wc -l < "$OUT/candump.log")"; }
+
+# flap_link: $IFACE down for 1 s and up again, 0.5 s of quiet on each side.
+flap_link() {
+  sleep 0.5
+  "$IP" link set "$IFACE" down; fact link_down_rc $?
+  sleep 1
+  "$IP" link set "$IFACE" up; fact link_up_rc $?
+  sleep 0.5
+}
+
+# Error frames: cansend with CAN_ERR_FLAG (0x20000000) in the ID, witnessed by
+# a candump with an error mask (resolverd must count exactly what it saw).
+start_error_dump() { candump -L "$IFACE,0~0,#FFFFFFFF" > "$OUT/candump_err.log" 2>&1 & ERRDUMP_PID=$!; sleep 0.3; }
+send_error_frames() {
+  _n=0
+  for _id in 20000004 20000010 20000040; do  # controller problem, bus warning... (linux/can/error.h)
+    cansend "$IFACE" "$_id#0000000000000000"; fact "cansend_${_id}_rc" $?; _n=$((_n + 1))
+  done
+  fact error_frames_sent "$_n"
+}
+stop_error_dump() {
+  kill "$ERRDUMP_PID"; wait "$ERRDUMP_PID" 2>/dev/null
+  fact error_frames_seen_by_candump "$(grep -c ' 2000' "$OUT/candump_err.log" || true)"
+}

@@ -4,11 +4,7 @@
 . "$(dirname "$0")/lib.sh"
 start_resolverd "$OUT/out.lcmlog" || exit 1
 play "$IN/half1.log"; fact canplayer1_rc $?
-sleep 0.5
-"$IP" link set "$IFACE" down; fact link_down_rc $?
-sleep 1
-"$IP" link set "$IFACE" up; fact link_up_rc $?
-sleep 0.5
+flap_link
 play "$IN/half2.log"; fact canplayer2_rc $?
 fact frames_sent "$(( $(wc -l < "$IN/half1.log") + $(wc -l < "$IN/half2.log") ))"
 sleep 1
