@@ -13,6 +13,12 @@
 //   BM_FrameDecoder         ID/DLC/CRC checks + role extraction      [frames/s]
 //   BM_FrameIntake          decode + counters + join into samples    [frames/s]
 //   BM_HwangUpdate          HwangIntegralEstimator::update           [samples/s]
+//   BM_SinCosLsReference    SinCosLeastSquares::add with reference   [samples/s]
+//                           (alpha, beta, offsets, K_3; DESIGN 6)
+//   BM_SinCosLsConic        SinCosLeastSquares::add, conic only      [samples/s]
+//   BM_AngleFourierUpdate   AngleErrorFourier::add, orders 1..4      [samples/s]
+//   BM_CompensateAngle      eps_hat(theta_rd) from a Fourier fit     [samples/s]
+//   BM_CompensateSinCos     corrected_angle: sin/cos corrected, atan2 [samples/s]
 //   BM_SampleProcessor      SampleProcessor::process                 [samples/s]
 //   BM_DqTransform          Clarke + one Park (cos/sin included)     [samples/s]
 //   BM_PipelineNullSink     Pipeline::feed, messages built, not sent [frames/s]
@@ -32,6 +38,7 @@
 #include <cstdio>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <ostream>
 #include <stdexcept>
 #include <streambuf>
@@ -48,7 +55,10 @@
 #include "daemon/app/pipeline.h"
 #include "daemon/core/angles.h"
 #include "daemon/core/estimation/dq_transform.h"
+#include "daemon/core/estimation/angle_error_fourier.h"
 #include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/core/estimation/sincos_compensation.h"
+#include "daemon/core/estimation/sincos_least_squares.h"
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/dbc/dbc_codec.h"
 #include "daemon/dbc/dbc_parser.h"
@@ -359,6 +369,88 @@ void BM_HwangUpdate(benchmark::State& state) {
   state.counters["revolutions"] = static_cast<double>(estimator.revolutions());
 }
 BENCHMARK(BM_HwangUpdate);
+
+void BM_SinCosLsReference(benchmark::State& state) {
+  resolver::SinCosLsConfig config;
+  config.harmonics = {3};
+  resolver::SinCosLeastSquares ls(config);
+  const auto& inputs = bench_inputs();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const resolver::SampleInput& in = inputs[i];
+    ls.add(in.sin, in.cos, kPr * in.theta_m_ref);
+    if (++i == inputs.size()) i = 0;
+  }
+  benchmark::DoNotOptimize(ls.state().ref_w);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_SinCosLsReference);
+
+void BM_SinCosLsConic(benchmark::State& state) {
+  resolver::SinCosLeastSquares ls{resolver::SinCosLsConfig{}};
+  const auto& inputs = bench_inputs();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    ls.add(inputs[i].sin, inputs[i].cos);
+    if (++i == inputs.size()) i = 0;
+  }
+  benchmark::DoNotOptimize(ls.state().conic_w);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_SinCosLsConic);
+
+void BM_AngleFourierUpdate(benchmark::State& state) {
+  resolver::AngleErrorFourier fourier{resolver::AngleFourierConfig{}};
+  const auto& inputs = bench_inputs();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    fourier.add(kPr * inputs[i].theta_m_ref, inputs[i].theta_rd);
+    if (++i == inputs.size()) i = 0;
+  }
+  benchmark::DoNotOptimize(fourier);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_AngleFourierUpdate);
+
+void BM_CompensateAngle(benchmark::State& state) {
+  // The fit of the stream itself (orders 1..4), as the daemon applies it.
+  resolver::AngleErrorFourier fourier{resolver::AngleFourierConfig{}};
+  const auto& inputs = bench_inputs();
+  for (const resolver::SampleInput& in : inputs) fourier.add(kPr * in.theta_m_ref, in.theta_rd);
+  const std::optional<resolver::AngleErrorFit> fit = fourier.solve();
+  if (!fit) {
+    state.SkipWithError("no Fourier fit of the synthetic stream");
+    return;
+  }
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(fit->compensate(inputs[i].theta_rd));
+    if (++i == inputs.size()) i = 0;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_CompensateAngle);
+
+void BM_CompensateSinCos(benchmark::State& state) {
+  resolver::SinCosLsConfig config;
+  config.harmonics = {3};
+  resolver::SinCosLeastSquares ls(config);
+  const auto& inputs = bench_inputs();
+  for (const resolver::SampleInput& in : inputs) ls.add(in.sin, in.cos, kPr * in.theta_m_ref);
+  const std::optional<resolver::SinCosFit> fit = ls.solve();
+  if (!fit) {
+    state.SkipWithError("no sin/cos fit of the synthetic stream");
+    return;
+  }
+  const resolver::SinCosCorrection corr = resolver::SinCosCorrection::from_fit(*fit);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(resolver::corrected_angle(corr, inputs[i].sin, inputs[i].cos));
+    if (++i == inputs.size()) i = 0;
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_CompensateSinCos);
 
 void BM_SampleProcessor(benchmark::State& state) {
   resolver::ProcessorConfig config;
