@@ -22,6 +22,8 @@
 //   BM_SampleProcessor      SampleProcessor::process                 [samples/s]
 //   BM_DqTransform          Clarke + one Park (cos/sin included)     [samples/s]
 //   BM_PipelineNullSink     Pipeline::feed, messages built, not sent [frames/s]
+//                           ([model] enabled = false, as the replay benchmark)
+//   BM_PipelineModelFit     the same with the live model fit         [frames/s]
 //   BM_PipelineLcmFile      Pipeline::feed into LCM file:// (what    [frames/s]
 //                           `resolverd --replay --lcm file://` does, minus log reading)
 //
@@ -489,11 +491,14 @@ BENCHMARK(BM_DqTransform);
 
 /// Feeds the looped stream through a Pipeline; timestamps keep rising across
 /// loops so health_t is published once per second of frame time, as in a log.
-void run_pipeline(benchmark::State& state, resolver::OutputSink& sink) {
+void run_pipeline(benchmark::State& state, resolver::OutputSink& sink, bool model_fit = false) {
   NullBuffer null_buffer;
   std::ostream diagnostics(&null_buffer);
   resolver::DaemonConfig config;
   config.dbc_path = RESOLVER_BENCH_DBC;
+  // As the replay benchmark's "full pipeline": the live model fit (its own
+  // row, BM_PipelineModelFit) waits for a fit per window in replay.
+  config.model.enabled = model_fit;
   resolver::Pipeline pipeline(config, sink, diagnostics);
   const auto& frames = bench_frames();
   const std::int64_t loop_us = static_cast<std::int64_t>(kPeriods) * kDtUs;
@@ -520,6 +525,13 @@ void BM_PipelineNullSink(benchmark::State& state) {
   state.counters["messages_per_frame"] = static_cast<double>(sink.messages) / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_PipelineNullSink);
+
+void BM_PipelineModelFit(benchmark::State& state) {
+  NullSink sink;
+  run_pipeline(state, sink, true);
+  state.counters["messages_per_frame"] = static_cast<double>(sink.messages) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_PipelineModelFit);
 
 void BM_PipelineLcmFile(benchmark::State& state) {
   const std::string path = "/tmp/bench_hot_paths_" + std::to_string(::getpid()) + ".lcmlog";
