@@ -14,16 +14,6 @@ namespace resolver {
 namespace {
 using Clock = std::chrono::steady_clock;
 
-std::vector<CanIdFilter> wake_filters(const std::vector<std::uint32_t>& ids) {
-  std::vector<CanIdFilter> out;
-  out.reserve(ids.size());
-  for (const std::uint32_t id : ids) {
-    const bool extended = id > 0x7FF;
-    out.push_back(CanIdFilter{id, extended ? 0x1FFFFFFFU : 0x7FFU, extended});
-  }
-  return out;
-}
-
 std::int64_t wall_us() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
       .count();
@@ -85,7 +75,7 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
   auto switch_wake = [&](Pipeline& pipeline, std::vector<std::uint32_t> ids) {
     const std::string before = WakePlanner::describe(planner.wake_ids());
     try {
-      source->set_wake(wake_filters(ids));
+      source->set_wake(exact_id_filters(ids));
     } catch (const SocketCanError& e) {
       pipeline.count_problem("wake_switch_failed", std::string(e.what()) + "; still woken by " + before);
       planner.switched(planner.wake_ids());  // count again rather than retry at once
@@ -106,7 +96,7 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
     service_tick(pipeline);
     if (!source) {
       try {
-        source.emplace(SplitWakeSource::open(so, wake_filters(planner.wake_ids())));
+        source.emplace(SplitWakeSource::open(so, exact_id_filters(planner.wake_ids())));
         err << "resolverd: reading " << options.iface;
         if (!planner.wake_ids().empty()) {
           err << " (two sockets: woken only by " << WakePlanner::describe(planner.wake_ids()) << ")";

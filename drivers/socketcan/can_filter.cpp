@@ -7,6 +7,16 @@
 
 namespace resolver {
 
+std::vector<CanIdFilter> exact_id_filters(const std::vector<std::uint32_t>& ids) {
+  std::vector<CanIdFilter> out;
+  out.reserve(ids.size());
+  for (const std::uint32_t id : ids) {
+    const bool extended = id > CAN_SFF_MASK;
+    out.push_back(CanIdFilter{id, extended ? CAN_EFF_MASK : CAN_SFF_MASK, extended});
+  }
+  return out;
+}
+
 KernelCanFilter to_kernel_filter(const CanIdFilter& filter) {
   const std::uint32_t width_mask = filter.extended ? CAN_EFF_MASK : CAN_SFF_MASK;
   if (filter.id > width_mask) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 namespace resolver {
 
@@ -15,6 +16,10 @@ struct CanIdFilter {
   bool extended = false;   ///< match 29-bit frames (true) or 11-bit frames (false)
   bool inverted = false;   ///< pass the frames that do NOT match (CAN_INV_FILTER)
 };
+
+/// One filter per ID matching exactly that ID; IDs above 0x7FF are taken as
+/// 29-bit ([can] wake_ids).
+[[nodiscard]] std::vector<CanIdFilter> exact_id_filters(const std::vector<std::uint32_t>& ids);
 
 /// The kernel's `struct can_filter`, without pulling <linux/can.h> into callers.
 struct KernelCanFilter {

@@ -39,36 +39,39 @@ void check_iface_name(const std::string& iface) {
   }
 }
 
-std::vector<can_filter> kernel_filters(const SocketCanOptions& options) {
-  if (options.filters.size() > CAN_RAW_FILTER_MAX) {
-    throw SocketCanError("setsockopt(CAN_RAW_FILTER)", options.iface, EINVAL,
+std::vector<can_filter> kernel_filters(const std::vector<CanIdFilter>& filters, const std::string& iface) {
+  if (filters.size() > CAN_RAW_FILTER_MAX) {
+    throw SocketCanError("setsockopt(CAN_RAW_FILTER)", iface, EINVAL,
                          "at most 512 filters per socket: merge IDs with masks");
   }
   std::vector<can_filter> out;
-  out.reserve(options.filters.size());
-  for (const CanIdFilter& filter : options.filters) {
+  out.reserve(filters.size());
+  for (const CanIdFilter& filter : filters) {
     try {
       const KernelCanFilter k = to_kernel_filter(filter);
       out.push_back(can_filter{k.can_id, k.can_mask});
     } catch (const std::invalid_argument& e) {
-      throw SocketCanError("setsockopt(CAN_RAW_FILTER)", options.iface, EINVAL,
-                           std::string("fix the filter: ") + e.what());
+      throw SocketCanError("setsockopt(CAN_RAW_FILTER)", iface, EINVAL, std::string("fix the filter: ") + e.what());
     }
   }
   return out;
 }
 
+/// CAN_RAW_FILTER (and CAN_RAW_JOIN_FILTERS when `join` and there is more
+/// than one filter); an empty list leaves the socket's filter as it is.
+void apply_filters(int fd, const std::vector<can_filter>& filters, bool join, const std::string& iface) {
+  if (filters.empty()) return;
+  set_option(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(), static_cast<socklen_t>(filters.size() * sizeof(can_filter)),
+             "CAN_RAW_FILTER", iface);
+  if (join && filters.size() > 1) set_flag(fd, SOL_CAN_RAW, CAN_RAW_JOIN_FILTERS, "CAN_RAW_JOIN_FILTERS", iface);
+}
+
 }  // namespace
 
 void SocketCanSource::set_filters(const std::vector<CanIdFilter>& filters, bool join) {
-  SocketCanOptions options;
-  options.iface = iface_;
-  options.filters = filters;
-  std::vector<can_filter> kernel = kernel_filters(options);
+  std::vector<can_filter> kernel = kernel_filters(filters, iface_);
   if (kernel.empty()) kernel.push_back(can_filter{0, 0});  // every frame, as a new socket
-  if (join && kernel.size() > 1) set_flag(fd_.get(), SOL_CAN_RAW, CAN_RAW_JOIN_FILTERS, "CAN_RAW_JOIN_FILTERS", iface_);
-  set_option(fd_.get(), SOL_CAN_RAW, CAN_RAW_FILTER, kernel.data(),
-             static_cast<socklen_t>(kernel.size() * sizeof(can_filter)), "CAN_RAW_FILTER", iface_);
+  apply_filters(fd_.get(), kernel, join, iface_);
 }
 
 void SocketCanSource::receive_nothing() {
@@ -81,7 +84,7 @@ void SocketCanSource::receive_nothing() {
 SocketCanSource SocketCanSource::open(const SocketCanOptions& options) {
   const std::string& iface = options.iface;
   check_iface_name(iface);
-  const std::vector<can_filter> filters = kernel_filters(options);
+  const std::vector<can_filter> filters = kernel_filters(options.filters, iface);
 
   UniqueFd fd(::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW));
   if (!fd.valid()) throw SocketCanError("socket(PF_CAN, SOCK_RAW, CAN_RAW)", iface, errno);
@@ -89,14 +92,7 @@ SocketCanSource SocketCanSource::open(const SocketCanOptions& options) {
   const unsigned int index = ::if_nametoindex(iface.c_str());
   if (index == 0) throw SocketCanError("if_nametoindex", iface, errno);
 
-  if (!filters.empty()) {
-    set_option(fd.get(), SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),
-               static_cast<socklen_t>(filters.size() * sizeof(can_filter)), "CAN_RAW_FILTER",
-               iface);
-  }
-  if (options.join_filters && filters.size() > 1) {
-    set_flag(fd.get(), SOL_CAN_RAW, CAN_RAW_JOIN_FILTERS, "CAN_RAW_JOIN_FILTERS", iface);
-  }
+  apply_filters(fd.get(), filters, options.join_filters, iface);
   const can_err_mask_t error_mask = options.receive_error_frames ? CAN_ERR_MASK : 0U;
   set_option(fd.get(), SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &error_mask, sizeof error_mask,
              "CAN_RAW_ERR_FILTER", iface);

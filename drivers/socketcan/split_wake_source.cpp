@@ -6,6 +6,19 @@
 #include <utility>
 
 namespace resolver {
+namespace {
+
+/// Adds a quiet socket's counts (timeouts and network_down stay the waking
+/// socket's: the quiet one is never waited on).
+void add_quiet_counts(SocketCanStats& into, const SocketCanStats& quiet) {
+  into.frames += quiet.frames;
+  into.fd_frames += quiet.fd_frames;
+  into.error_frames += quiet.error_frames;
+  into.kernel_drops += quiet.kernel_drops;
+  into.truncated += quiet.truncated;
+}
+
+}  // namespace
 
 SocketCanOptions SplitWakeSource::quiet_options(const SocketCanOptions& base, const std::vector<CanIdFilter>& wake) {
   SocketCanOptions q = base;
@@ -84,12 +97,7 @@ void SplitWakeSource::pull_quiet() {
       continue;
     }
     if (s == ReadStatus::kTimeout && quiet_retiring_) {
-      const SocketCanStats& q = quiet_->stats();
-      closed_quiet_.frames += q.frames;
-      closed_quiet_.fd_frames += q.fd_frames;
-      closed_quiet_.error_frames += q.error_frames;
-      closed_quiet_.kernel_drops += q.kernel_drops;
-      closed_quiet_.truncated += q.truncated;
+      add_quiet_counts(closed_quiet_, quiet_->stats());
       quiet_.reset();
       quiet_retiring_ = false;
     }
@@ -182,15 +190,8 @@ ReadStatus SplitWakeSource::read(CanFrame& frame) {
 
 SocketCanStats SplitWakeSource::stats() const {
   SocketCanStats sum = waking_.stats();
-  const auto add = [&sum](const SocketCanStats& q) {
-    sum.frames += q.frames;
-    sum.fd_frames += q.fd_frames;
-    sum.error_frames += q.error_frames;
-    sum.kernel_drops += q.kernel_drops;
-    sum.truncated += q.truncated;
-  };
-  add(closed_quiet_);
-  if (quiet_) add(quiet_->stats());
+  add_quiet_counts(sum, closed_quiet_);
+  if (quiet_) add_quiet_counts(sum, quiet_->stats());
   return sum;
 }
 

@@ -32,7 +32,6 @@
 #include <time.h>
 
 #include <CLI/CLI.hpp>
-#include <fmt/format.h>
 
 #include <algorithm>
 #include <atomic>
@@ -49,6 +48,7 @@
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/lcm_output.h"
 #include "daemon/app/pipeline.h"
+#include "daemon/app/wake_planner.h"
 #include "drivers/socketcan/socketcan_source.h"
 #include "drivers/socketcan/split_wake_source.h"
 #include "tests/bench/live_latency_feed.h"
@@ -131,13 +131,6 @@ struct Endpoints {
   [[nodiscard]] int writer_fd() const { return writer_can ? writer_can->fd() : writer_owned.get(); }
 };
 
-std::vector<resolver::CanIdFilter> wake_filters(const std::vector<std::uint32_t>& ids) {
-  std::vector<resolver::CanIdFilter> out;
-  out.reserve(ids.size());
-  for (const std::uint32_t id : ids) out.push_back(resolver::CanIdFilter{id, id > 0x7FF ? 0x1FFFFFFFU : 0x7FFU, id > 0x7FF});
-  return out;
-}
-
 /// A socket pair whose reading end gets what open() enables on a CAN_RAW
 /// socket; AF_UNIX stamps each datagram when it is sent (there is no receive
 /// interrupt to stamp at).
@@ -160,7 +153,7 @@ Endpoints open_endpoints(const Options& o) {
     resolver::SocketCanOptions wo;
     wo.iface = o.iface;
     wo.receive_error_frames = false;
-    return Endpoints{resolver::SplitWakeSource::open(ro, wake_filters(o.wake_ids)), resolver::UniqueFd(),
+    return Endpoints{resolver::SplitWakeSource::open(ro, resolver::exact_id_filters(o.wake_ids)), resolver::UniqueFd(),
                      resolver::UniqueFd(), resolver::SocketCanSource::open(wo)};
   }
   auto [reader, writer] = stamped_pair("sockpair0");
@@ -342,9 +335,8 @@ int run(int argc, char** argv) {
     std::cerr << "live_latency_bench: " << e.what() << "\n";
     return 2;
   }
-  std::string wake;
-  for (const std::uint32_t id : o.wake_ids) wake += fmt::format("{}0x{:X}", wake.empty() ? "" : ", ", id);
-  const std::string split = wake.empty() ? "" : "; split: only " + wake + " wake the reader";
+  const std::string split =
+      o.wake_ids.empty() ? "" : "; split: only " + resolver::WakePlanner::describe(o.wake_ids) + " wake the reader";
   const resolver::bench_live::Setup setup{(o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
                                                            : o.iface + " (CAN_RAW) -> SocketCanSource::open") + split,
                                           o.read_only ? std::string("none (--read-only: read path only)")
