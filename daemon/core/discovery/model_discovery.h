@@ -26,21 +26,12 @@
 #include <string_view>
 #include <vector>
 
+#include "daemon/core/sample.h"
+
 namespace resolver {
 
-/// One joined bench sample. NaN-free fields are flagged by has_*.
-struct DiscoverySample {
-  double t = 0.0;            ///< [s] sample time (any origin, increasing)
-  double theta_rd = 0.0;     ///< [rad] R/D converter angle, resolver electrical, wrapped
-  bool has_rd = false;
-  double sin = 0.0;          ///< [counts] demodulated sin envelope
-  double cos = 0.0;          ///< [counts] demodulated cos envelope
-  bool has_sincos = false;
-  double theta_m_ref = 0.0;  ///< [rad] reference encoder, mechanical, wrapped
-  bool has_ref = false;
-  double i_a = 0.0, i_b = 0.0, i_c = 0.0;  ///< [A] measured phase currents
-  bool has_currents = false;
-};
+/// Discovery reads the shared sample (daemon/core/sample.h).
+using DiscoverySample = Sample;
 
 struct DiscoveryInput {
   int p_r = 3;  ///< resolver pole pairs

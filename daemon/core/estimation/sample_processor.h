@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/sample.h"
 #include "daemon/core/estimation/angle_error_fourier.h"
 #include "daemon/core/estimation/hwang_integral.h"
 #include "daemon/core/estimation/sincos_compensation.h"
@@ -27,17 +28,8 @@
 
 namespace resolver {
 
-struct SampleInput {
-  double t = 0.0;                ///< [s] sample time
-  bool has_rd = false;
-  double theta_rd = 0.0;         ///< [rad] R/D converter angle (resolver electrical)
-  bool has_sincos = false;
-  double sin = 0.0, cos = 0.0;   ///< demodulated envelopes [any unit]
-  bool has_currents = false;
-  double i_a = 0.0, i_b = 0.0, i_c = 0.0;  ///< [A]
-  bool has_ref = false;
-  double theta_m_ref = 0.0;      ///< [rad] mechanical reference angle
-};
+/// The processor's input is the shared sample (daemon/core/sample.h).
+using SampleInput = Sample;
 
 /// Which estimator runs (DESIGN 6 "Estimators to provide and compare").
 enum class EstimatorMethod : std::uint8_t {
