@@ -3,7 +3,6 @@ import unittest
 
 import numpy as np
 
-import support  # noqa: F401  (puts benchgen on the path)
 from benchgen.profile import PRESETS, MotionProfile, ProfileError, parse_profile
 
 RPM = 2 * np.pi / 60

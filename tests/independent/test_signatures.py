@@ -19,7 +19,6 @@ import unittest
 
 import numpy as np
 
-import support
 from support import RD16_HALF_LSB, REF_HALF_LSB, fit_harmonics, run
 
 P_R = 3
