@@ -59,7 +59,7 @@ LiveModelFit::~LiveModelFit() {
   if (running_.valid()) running_.wait();
 }
 
-void LiveModelFit::add(const DiscoverySample& sample, int p_r, int p, const Stamp& stamp) {
+void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp) {
   last_stamp_ = stamp;
   if (window_.add(sample, p_r, p)) {
     DiscoveryInput w = window_.take();

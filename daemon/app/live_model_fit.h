@@ -20,6 +20,7 @@
 
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/output_sink.h"
+#include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/discovery/model_window.h"
 
 namespace resolver {
@@ -50,7 +51,7 @@ class LiveModelFit {
 
   /// One joined sample (pole pairs as currently known). May publish the previous
   /// window's model_fit_t.
-  void add(const DiscoverySample& sample, int p_r, int p, const Stamp& stamp);
+  void add(const Sample& sample, int p_r, int p, const Stamp& stamp);
   /// End of input: waits for the running fit and publishes it. The open, partial
   /// window is fitted too when it covers at least two revolutions.
   void finish();

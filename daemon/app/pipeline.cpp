@@ -239,7 +239,7 @@ void Pipeline::on_sample(const BenchSample& sample) {
 }
 
 void Pipeline::feed_model_fit(const SampleInput& in, const BenchSample& sample) {
-  DiscoverySample d;
+  Sample d;
   d.t = in.t;
   d.has_rd = in.has_rd;
   d.theta_rd = in.theta_rd;

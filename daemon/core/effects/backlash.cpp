@@ -39,9 +39,20 @@ class BacklashEffect final : public BasicEffect {
     }
     return seen;
   }
-  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
+  // Steady motion: eps = p_r (h/2) direction. During the take-up after a reversal
+  // (travel D < h from the turning point) the resolver stands still: eps_m runs
+  // from +h/2 to -h/2 of the new direction, eps = p_r direction (D - h/2).
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignatureColumns& out) const override {
     const double k = 0.5 * static_cast<double>(row.p_r) * row.direction;
-    out.col(0) = shift_column(k, -k);
+    const bool taking_up = row.since_reversal < v[0];
+    out.col(0) = shift_column(taking_up ? -k : k, taking_up ? k : -k);
+  }
+  [[nodiscard]] bool linear_in_params() const override { return false; }
+  void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
+    const double h = v[0];
+    const double eps_m = row.since_reversal < h ? row.since_reversal - 0.5 * h : 0.5 * h;
+    const double eps = static_cast<double>(row.p_r) * row.direction * eps_m;
+    out += shift_column(eps, -eps);
   }
 };
 

@@ -54,6 +54,7 @@ class CurrentGainMismatchEffect final : public BasicEffect {
                      "the phase current sensors differ in gain: i_d and i_q ripple at 2x theta_e proportional to the "
                      "current, while the resolver signals are clean (so it is not the resolver's amplitude imbalance)"},
                     kParams, EffectStage::kCurrents) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_e = 2}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
   void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
     if (stage == CurrentStage::kSensorGain) i = apply_current_gain_mismatch(CurrentGainMismatch{v[0], v[1]}, i);

@@ -64,6 +64,7 @@ class DeadTimeEffect final : public BasicEffect {
                      "inverter dead time: 5th and 7th harmonics of the phase currents, i.e. a 6x theta_e ripple on i_d "
                      "and i_q perpendicular to the current vector"},
                     kParams, EffectStage::kCurrents) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_e = 6}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
   void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
     if (stage == CurrentStage::kInverter) i = apply_dead_time(DeadTime{v[0]}, i);

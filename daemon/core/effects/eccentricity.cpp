@@ -50,6 +50,7 @@ class EccentricityEffect final : public BasicEffect {
                      "the rotor is not concentric: a 1x mechanical harmonic of the position error (order 1/p_r of "
                      "theta), only visible against the reference encoder"},
                     kParams, EffectStage::kMotion) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_m = 1}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool active(Values v) const override { return v[0] != 0.0; }
   void validate(Values v) const override {

@@ -12,6 +12,18 @@ bool Effect::active(Values v) const {
   return false;
 }
 
+HarmonicOrders Effect::orders(std::span<const int> /*params*/) const {
+  switch (stage()) {
+    case EffectStage::kWindings:
+    case EffectStage::kChannels:
+    case EffectStage::kConverter: return {.theta = 2};
+    case EffectStage::kCurrents: return {.theta_e = 1};
+    case EffectStage::kMotion:
+    case EffectStage::kNoise: return {};
+  }
+  return {};
+}
+
 void Effect::signature(const SignatureRow& /*row*/, const AngleBasis& /*basis*/, Values /*v*/,
                        SignatureColumns& out) const {
   out.clear();  // effects without a signature (noise, quantization) change no fitted signal

@@ -123,6 +123,15 @@ struct Impairments {
   double outlier_size = 0.0;     ///< [counts] their size (sign random)
 };
 
+/// The highest harmonic orders an effect's columns use, of the resolver angle theta,
+/// the mechanical angle theta_m and the motor angle theta_e: a fit needs the log to
+/// cover every one of 2N bins of each angle (discovery's coverage check).
+struct HarmonicOrders {
+  int theta = 0;
+  int theta_m = 0;
+  int theta_e = 0;
+};
+
 /// The parameter values of one effect, in the order of its params().
 using Values = std::span<const double>;
 
@@ -160,6 +169,9 @@ class Effect {
   /// Only a log with changing speed or reversals separates it from the others
   /// (tracking loop, delay and backlash look like constants at one speed).
   [[nodiscard]] virtual bool needs_speed_change() const { return false; }
+  /// The harmonic orders the columns of the fitted parameters `params` use.
+  /// Default by stage: windings/channels/converter 2 theta, motion 0, currents 1 theta_e.
+  [[nodiscard]] virtual HarmonicOrders orders(std::span<const int> params) const;
   /// Checks a whole parameter set beyond the per-parameter ranges (e.g. the play
   /// must be smaller than a turn). Throws std::invalid_argument naming the effect
   /// and parameter. Default: nothing more to check.

@@ -1,5 +1,6 @@
 #include "daemon/core/effects/harmonics.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -95,6 +96,12 @@ class HarmonicsEffect final : public BasicEffect {
                      "at another order (K_n at n theta lands on (n-1) theta, K_n_opp on (n+1) theta; Hanselman eq. "
                      "8-9)"},
                     kParams, EffectStage::kWindings) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> params) const override {
+    // k0: 1 theta; k_n: (n - 1) theta in the angle, n theta in the envelopes; k_n_opp: (n + 1) theta.
+    int top = 0;
+    for (int p : params) top = std::max(top, p == 0 ? 1 : (p <= kOrders ? p + 1 : p - kOrders + 2));
+    return {.theta = top};
+  }
   void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {
     if (stage != WindingStage::kAdditive) return;
     const SinCos h = harmonics_part(from_values(v), theta);

@@ -1,5 +1,6 @@
 #include "daemon/core/effects/mechanical_harmonics.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -39,6 +40,11 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
                      "the shaft or coupling makes the resolver see a mechanical harmonic of the angle: a position "
                      "error at a whole order of the mechanical turn, only visible against the reference encoder"},
                     kParams, EffectStage::kMotion) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> params) const override {
+    int top = 0;
+    for (int p : params) top = std::max(top, p / 2 + 1);
+    return {.theta_m = top};
+  }
   [[nodiscard]] bool needs_reference() const override { return true; }
   void validate(Values v) const override {
     double sum = 0.0;

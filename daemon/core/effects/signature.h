@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -38,6 +39,9 @@ struct SignatureRow {
   double omega = 0.0;      ///< [rad/s] resolver electrical speed (signed)
   double accel = 0.0;      ///< [rad/s^2] resolver electrical acceleration
   double direction = 1.0;  ///< +1 / -1: direction of motion (held through a standstill)
+  /// [rad, mechanical] travel since the last reversal of direction (from its turning
+  /// point); infinity when the rotor has not reversed. Backlash's take-up needs it.
+  double since_reversal = std::numeric_limits<double>::infinity();
   double theta_e = 0.0;    ///< [rad] true motor electrical angle (currents only)
   double i_d0 = 0.0;       ///< [A] operating point: mean measured d current
   double i_q0 = 0.0;       ///< [A] mean measured q current
