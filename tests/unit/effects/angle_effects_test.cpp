@@ -22,12 +22,8 @@ using test::forward_chain;
 
 constexpr int kGrid = 3600;  // theta grid over one turn
 
-/// The quadrature signature's remainder bound of signatures_test (QuadratureMatchesHanselmanEq7):
-/// |eps_exact - eps_first_order| <= beta^2/2 (2+|beta|)/(1-|beta|)^2.
-double quadrature_bound(double beta) {
-  const double b = std::abs(beta);
-  return 0.5 * b * b * (2.0 + b) / ((1.0 - b) * (1.0 - b));
-}
+/// The quadrature signature's remainder bound (QuadratureMatchesHanselmanEq7 in signatures_test).
+double quadrature_bound(double beta) { return test::quadrature_remainder_bound(beta); }
 
 /// The pair the DSP samples (bench_simulator.h): the sin channel of the chain's
 /// envelopes at the sample instant's angle, the cos channel at the angle of the

@@ -4,6 +4,7 @@
 // so a range slip in a test throws instead of testing a value the CLI refuses.
 #pragma once
 
+#include <cmath>
 #include <initializer_list>
 #include <string_view>
 
@@ -39,5 +40,19 @@ struct Setting {
 [[nodiscard]] inline double exact_error(const ForwardChain& chain, double theta) {
   return wrap_pi(theta - static_rd_angle(chain.envelopes(theta)));
 }
+
+/// Bound on the remainder of the quadrature signature (quadrature.h) after its
+/// first-order term: phi(beta) = atan2(sin theta, cos(theta + beta)) has
+/// |phi''| <= (2 + |beta|) / (1 - |beta|)^2 (signatures_test derives it), so
+/// |eps_exact - eps_first_order| <= beta^2/2 (2 + |beta|) / (1 - |beta|)^2 [rad].
+[[nodiscard]] inline double quadrature_remainder_bound(double beta) {
+  const double b = std::abs(beta);
+  return 0.5 * b * b * (2.0 + b) / ((1.0 - b) * (1.0 - b));
+}
+
+/// Bound on the second-order remainder of atan2 for an additive perturbation of
+/// length d from the unit circle: the Hessian of atan2 has norm 1/r^2 and
+/// r >= 1 - d on the segment, so |remainder| <= d^2 / (2 (1 - d)^2) [rad].
+[[nodiscard]] inline double atan2_second_order_bound(double d) { return 0.5 * d * d / ((1.0 - d) * (1.0 - d)); }
 
 }  // namespace resolver::test

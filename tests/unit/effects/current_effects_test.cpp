@@ -144,7 +144,9 @@ TEST(EffectsCurrentGainMismatch, RippleAtTwoTimesThetaE) {
 }
 
 TEST(EffectsDeadTime, FifthAndSeventhGiveRippleAtSixTimesThetaE) {
-  for (const auto& [i_d, i_q] : {std::pair{0.0, 10.0}, std::pair{-4.0, 6.0}, std::pair{5.0, 0.0}}) {
+  for (const auto& current : {std::pair{0.0, 10.0}, std::pair{-4.0, 6.0}, std::pair{5.0, 0.0}}) {
+    const double i_d = current.first;  // [A] (locals, not a structured binding: lambdas capture them)
+    const double i_q = current.second;
     const DeadTime dead{2e-6};  // [s] -> k_dt = 0.02
     const ForwardChain chain = forward_chain({{"dead_time", "t_d", dead.t_d}});
     const double k = 2e-6 / 100e-6;

@@ -215,8 +215,10 @@ TEST(ChainValues, SpecsSetTheParameters) {
   // Every effect is active now, in registry order; what truth files record.
   const std::vector<ChainValues::ActiveEffect> active = c.active_effects();
   std::vector<std::string_view> names;
+  names.reserve(active.size());
   for (const auto& a : active) names.push_back(a.effect->name());
   std::vector<std::string_view> all;
+  all.reserve(effect_registry().size());
   for (const Effect* e : effect_registry()) all.push_back(e->name());
   EXPECT_EQ(names, all);
   const auto of = [&](std::string_view name) -> const ChainValues::ActiveEffect& {

@@ -40,10 +40,7 @@ Residual residual(const ForwardChain& chain, Signature&& signature) {
   return r;
 }
 
-/// Bound on the second-order remainder of atan2 for a perturbation of length d
-/// from the unit circle: the Hessian of atan2 has norm 1/r^2 and r >= 1 - d on the
-/// segment, so |remainder| <= d^2 / (2 (1 - d)^2).
-double atan2_second_order_bound(double d) { return 0.5 * d * d / ((1.0 - d) * (1.0 - d)); }
+using test::atan2_second_order_bound;
 
 TEST(EffectsSignatures, IdealChainHasNoError) {
   const ForwardChain ideal = forward_chain({});
@@ -92,7 +89,7 @@ TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
     // |N|, |N'|, |D'| <= 1, 1-|beta| <= D <= 1+|beta|, so |phi''| <= (2+|beta|)/(1-|beta|)^2 and the
     // Taylor remainder after the first-order term is <= beta^2/2 * (2+|beta|)/(1-|beta|)^2.
     const double b = std::abs(beta);
-    const double bound = 0.5 * b * b * (2.0 + b) / ((1.0 - b) * (1.0 - b));
+    const double bound = test::quadrature_remainder_bound(beta);
     EXPECT_LE(r.max_residual, bound) << "beta=" << beta;
     EXPECT_LT(bound, 0.05 * r.max_signature) << "beta=" << beta;
     EXPECT_NEAR(r.max_signature, b, 1e-6 * b);  // peak of (beta/2)(1 - cos 2theta) is beta
@@ -100,7 +97,9 @@ TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
 }
 
 TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
-  for (const auto& [o_s, o_c] : {std::pair{0.001, -0.002}, std::pair{-0.01, 0.0}, std::pair{0.0, 0.02}}) {
+  for (const auto& offsets : {std::pair{0.001, -0.002}, std::pair{-0.01, 0.0}, std::pair{0.0, 0.02}}) {
+    const double o_s = offsets.first;  // (locals, not a structured binding: the lambda captures them)
+    const double o_c = offsets.second;
     const ForwardChain chain = forward_chain({{"offsets", "o_s", o_s}, {"offsets", "o_c", o_c}});
     const Residual r = residual(chain, [&](double theta) { return offsets_error({o_s, o_c}, theta); });
     const double bound = atan2_second_order_bound(std::hypot(o_s, o_c));

@@ -18,7 +18,6 @@
 namespace resolver {
 namespace {
 
-using test::SimRecord;
 using test::simulate;
 
 SimConfig fourier_sim(double seconds, double rpm0, double rpm1) {

@@ -18,7 +18,6 @@
 namespace resolver {
 namespace {
 
-using test::SimRecord;
 using test::simulate;
 
 SimConfig imperfect_sim(double seconds) {

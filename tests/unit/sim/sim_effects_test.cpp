@@ -30,7 +30,6 @@ namespace {
 using test::changed_signals;
 using test::kCurrents;
 using test::kRd;
-using test::kReference;
 using test::kSinCos;
 using test::quiet;
 using test::run;

@@ -70,6 +70,7 @@ TEST(SimBacklash, OffsetFlipsWithDirectionAndTheTakeUpLastsThePlay) {
     c.chain.set("backlash", "h", h);
     const std::vector<SimSample> samples = run(c);
     std::vector<double> theta_m;  // [rad] continuous reference angle
+    theta_m.reserve(samples.size());
     AngleUnwrapper unwrap;
     for (const SimSample& s : samples) theta_m.push_back(unwrap.update(reference_angle_m(s)));
     const std::size_t turn = argmax(theta_m);

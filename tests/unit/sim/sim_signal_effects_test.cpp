@@ -26,14 +26,9 @@ namespace {
 using test::quiet;
 using test::run;
 
-constexpr double kHalfLsb = 0.5 * 9.587379924285257e-05;  // [rad] half a 16-bit R/D count, 2pi / 2^17
+using test::quadrature_remainder_bound;
 
-/// The quadrature signature's second-order remainder bound (signatures_test:
-/// |eps_exact - eps_first_order| <= beta^2/2 (2+|beta|)/(1-|beta|)^2).
-double quadrature_bound(double beta) {
-  const double b = std::abs(beta);
-  return 0.5 * b * b * (2.0 + b) / ((1.0 - b) * (1.0 - b));
-}
+const double kHalfLsb = 0.5 * quantization_lsb(16);  // [rad] half a count of the 16-bit R/D field
 
 TEST(SimChannelDelay, RdAngleShowsQuadratureMinusOmegaTauUnlikeSamplingSkew) {
   const double tau = 2e-5;  // [s] the cos path's extra group delay
@@ -58,7 +53,7 @@ TEST(SimChannelDelay, RdAngleShowsQuadratureMinusOmegaTauUnlikeSamplingSkew) {
         // The converter sees the delayed cos too: the exact quadrature error, and
         // to first order (omega tau / 2)(1 - cos 2theta) (channel_delay.h).
         ASSERT_NEAR(eps_rd, test::exact_error(quad, s.theta), kHalfLsb + 1e-12) << s.index;
-        ASSERT_NEAR(eps_rd, quadrature_error({beta}, s.theta), kHalfLsb + quadrature_bound(beta)) << s.index;
+        ASSERT_NEAR(eps_rd, quadrature_error({beta}, s.theta), kHalfLsb + quadrature_remainder_bound(beta)) << s.index;
       } else {
         // The converter has its own analog front end: no error at all.
         ASSERT_NEAR(eps_rd, 0.0, kHalfLsb + 1e-12) << s.index;
@@ -68,7 +63,7 @@ TEST(SimChannelDelay, RdAngleShowsQuadratureMinusOmegaTauUnlikeSamplingSkew) {
     mean_rd /= static_cast<double>(samples.size());
     // Over whole turns the 2theta part averages out: the R/D angle's mean error is
     // -beta/2 = +omega tau / 2 (3.1e-3 rad) for the delay, 0 for the skew.
-    EXPECT_NEAR(mean_rd, analog ? 0.5 * omega * tau : 0.0, kHalfLsb + quadrature_bound(beta)) << analog;
+    EXPECT_NEAR(mean_rd, analog ? 0.5 * omega * tau : 0.0, kHalfLsb + quadrature_remainder_bound(beta)) << analog;
   }
 }
 
@@ -100,8 +95,7 @@ TEST(SimHarmonics, OppositeSequenceK3GivesFourThetaAndOppositeSignsAtThreeTheta)
     // harmonics.h: eps ~ -K_3_opp sin 4theta (opposite) or -K_3 sin 2theta (same), plus
     // second-order terms <= d^2 / (2 (1-d)^2), d = sqrt2 K (the atan2 bound, signatures_test),
     // plus rounding: a coefficient 2/N sum(...) of values <= LSB/2 moves by <= one LSB.
-    const double d = std::sqrt(2.0) * k;
-    const double tol = 2.0 * kHalfLsb + 0.5 * d * d / ((1.0 - d) * (1.0 - d));
+    const double tol = 2.0 * kHalfLsb + test::atan2_second_order_bound(std::sqrt(2.0) * k);
     const std::size_t order = opposite ? 4 : 2;
     for (std::size_t m = 1; m < eps.size(); ++m) {
       if (m == order) {
