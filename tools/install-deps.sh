@@ -9,6 +9,7 @@ PACKAGES=(
   liblcm-dev liblcm-bin
   libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
   can-utils python3 python3-can
+  python3-numpy  # tests/independent (benchgen)
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
   chromium  # headless, screenshots the resolver-model HTML report (tests/model)

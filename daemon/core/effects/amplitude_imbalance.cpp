@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "daemon/core/angles.h"
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
@@ -59,7 +60,7 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
       rd += pw * b.rd_sin(2 * n);
       pw *= -r;
     }
-    out.col(0) = SignalValues{.rd = dr * rd, .s = 0.0, .c = b.env_cos(1)};
+    out.col(0) = envelope_column(b, dr * rd, 0.0, b.env_cos(1));
   }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
@@ -70,7 +71,10 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
       out.rd -= pw / n * b.rd_sin(2 * n);
       pw *= -r;
     }
-    out.c += a * b.env_cos(1);
+    // The envelope pair (s, (1 + a) c) exactly: angle error -(phi - theta), radius - 1.
+    const double sn = b.env_sin(1), cs = b.env_cos(1);
+    out.sa += wrap_pi(b.env_angle() - std::atan2(sn, (1.0 + a) * cs));
+    out.sr += std::hypot(sn, (1.0 + a) * cs) - 1.0;
   }
 };
 

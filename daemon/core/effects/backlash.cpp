@@ -39,9 +39,9 @@ class BacklashEffect final : public BasicEffect {
     }
     return seen;
   }
-  void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
     const double k = 0.5 * static_cast<double>(row.p_r) * row.direction;
-    out.col(0) = shift_column(b, k, -k);
+    out.col(0) = shift_column(k, -k);
   }
 };
 

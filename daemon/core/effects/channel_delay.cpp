@@ -29,7 +29,7 @@ class ChannelDelayEffect final : public BasicEffect {
     timing.dsp_cos_dt -= v[0];
   }
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
-    out.col(0) = SignalValues{.rd = 0.5 * row.omega * (1.0 - b.rd_cos(2)), .s = 0.0, .c = row.omega * b.env_sin(1)};
+    out.col(0) = envelope_column(b, 0.5 * row.omega * (1.0 - b.rd_cos(2)), 0.0, row.omega * b.env_sin(1));
   }
 };
 

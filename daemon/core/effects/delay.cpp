@@ -30,9 +30,8 @@ class DelayEffect final : public BasicEffect {
   void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double d = v[0];
     out.rd += row.omega * d - 0.5 * row.accel * d * d;
-    // The ideal envelopes at the late angle (the basis already is at theta - omega d).
-    out.s += b.env_sin(1) - std::sin(row.theta);
-    out.c += b.env_cos(1) - std::cos(row.theta);
+    // The envelopes carry the late angle exactly: a rotation, radius unchanged.
+    out.sa += row.theta - b.env_angle();
   }
 };
 

@@ -64,14 +64,14 @@ class EccentricityEffect final : public BasicEffect {
   // Columns for x = e cos(phase), y = e sin(phase): e sin(theta_m + phase) = x sin theta_m + y cos theta_m.
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
     const double pr = row.p_r;
-    out.col(0) = shift_column(b, -pr * b.rd_mech_sin(1), pr * b.env_mech_sin(1));
-    out.col(1) = shift_column(b, -pr * b.rd_mech_cos(1), pr * b.env_mech_cos(1));
+    out.col(0) = shift_column(-pr * b.rd_mech_sin(1), pr * b.env_mech_sin(1));
+    out.col(1) = shift_column(-pr * b.rd_mech_cos(1), pr * b.env_mech_cos(1));
   }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double x = v[0] * std::cos(v[1]), y = v[0] * std::sin(v[1]);
     const double pr = row.p_r;
-    out += shift_column(b, -pr * (x * b.rd_mech_sin(1) + y * b.rd_mech_cos(1)),
+    out += shift_column(-pr * (x * b.rd_mech_sin(1) + y * b.rd_mech_cos(1)),
                         pr * (x * b.env_mech_sin(1) + y * b.env_mech_cos(1)));
   }
 };

@@ -24,8 +24,8 @@ void Effect::contribution(const SignatureRow& row, const AngleBasis& basis, Valu
   for (std::size_t i = 0; i < v.size(); ++i) {
     const SignalValues& c = cols.col(i);
     out.rd += c.rd * v[i];
-    out.s += c.s * v[i];
-    out.c += c.c * v[i];
+    out.sa += c.sa * v[i];
+    out.sr += c.sr * v[i];
     out.d += c.d * v[i];
     out.q += c.q * v[i];
   }

@@ -105,13 +105,13 @@ class HarmonicsEffect final : public BasicEffect {
   // error is sin(theta) dc - cos(theta) ds to first order (harmonics.h).
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values /*v*/,
                  SignatureColumns& out) const override {
-    out.col(0) = SignalValues{.rd = b.rd_sin(1) - b.rd_cos(1), .s = 1.0, .c = 1.0};
+    out.col(0) = envelope_column(b, b.rd_sin(1) - b.rd_cos(1), 1.0, 1.0);
     for (int i = 0; i < kOrders; ++i) {
       const int n = i + 2;
       out.col(static_cast<std::size_t>(1 + i)) =
-          SignalValues{.rd = -b.rd_sin(n - 1), .s = b.env_sin(n), .c = b.env_cos(n)};
+          envelope_column(b, -b.rd_sin(n - 1), b.env_sin(n), b.env_cos(n));
       out.col(static_cast<std::size_t>(1 + kOrders + i)) =
-          SignalValues{.rd = -b.rd_sin(n + 1), .s = b.env_sin(n), .c = -b.env_cos(n)};
+          envelope_column(b, -b.rd_sin(n + 1), b.env_sin(n), -b.env_cos(n));
     }
   }
 };

@@ -62,8 +62,8 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
     const double pr = row.p_r;
     for (int n = 1; n <= kMaxMechanicalOrder; ++n) {
       const auto i = static_cast<std::size_t>(2 * (n - 1));
-      out.col(i) = shift_column(b, -pr * b.rd_mech_sin(n), pr * b.env_mech_sin(n));
-      out.col(i + 1) = shift_column(b, -pr * b.rd_mech_cos(n), pr * b.env_mech_cos(n));
+      out.col(i) = shift_column(-pr * b.rd_mech_sin(n), pr * b.env_mech_sin(n));
+      out.col(i + 1) = shift_column(-pr * b.rd_mech_cos(n), pr * b.env_mech_cos(n));
     }
   }
 };

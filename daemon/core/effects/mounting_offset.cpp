@@ -62,9 +62,9 @@ class MountingOffsetEffect final : public BasicEffect {
   [[nodiscard]] double drive_frame_offset(Values v) const override { return v[0]; }
   // The dq currents against the reference show the offset only as a steady
   // current, which the operating point (the fit's DC i_d, i_q) absorbs: no dq column.
-  void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
     const double r = static_cast<double>(row.p_r) / static_cast<double>(row.p);
-    out.col(0) = shift_column(b, -r, r);
+    out.col(0) = shift_column(-r, r);
   }
 };
 

@@ -35,8 +35,8 @@ class OffsetsEffect final : public BasicEffect {
   }
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values /*v*/,
                  SignatureColumns& out) const override {
-    out.col(0) = SignalValues{.rd = -b.rd_cos(1), .s = 1.0, .c = 0.0};
-    out.col(1) = SignalValues{.rd = b.rd_sin(1), .s = 0.0, .c = 1.0};
+    out.col(0) = envelope_column(b, -b.rd_cos(1), 1.0, 0.0);
+    out.col(1) = envelope_column(b, b.rd_sin(1), 0.0, 1.0);
   }
 };
 

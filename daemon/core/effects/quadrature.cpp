@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 
+#include "daemon/core/angles.h"
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
@@ -38,13 +39,16 @@ class QuadratureEffect final : public BasicEffect {
   // the omitted terms are O(beta^2)). c: the exact derivative of cos(theta + beta).
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignatureColumns& out) const override {
     const double th = b.env_angle();
-    out.col(0) = SignalValues{.rd = -0.5 * (1.0 - b.rd_cos(2)), .s = 0.0, .c = -std::sin(th + v[0])};
+    out.col(0) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + v[0]));
   }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double th = b.env_angle();
     out.rd += -0.5 * v[0] * (1.0 - b.rd_cos(2));
-    out.c += std::cos(th + v[0]) - b.env_cos(1);
+    // The pair (sin th, cos(th + beta)) exactly.
+    const double sn = b.env_sin(1), cq = std::cos(th + v[0]);
+    out.sa += wrap_pi(th - std::atan2(sn, cq));
+    out.sr += std::hypot(sn, cq) - 1.0;
   }
 };
 

@@ -41,7 +41,7 @@ class SamplingSkewEffect final : public BasicEffect {
   void channel_timing(Values v, ChannelTiming& timing) const override { timing.dsp_cos_dt += v[0]; }
   // c = C(theta(t + tau)) = cos(theta + omega tau): dc/dtau = -omega sin theta (first order).
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
-    out.col(0) = SignalValues{.rd = 0.0, .s = 0.0, .c = -row.omega * b.env_sin(1)};
+    out.col(0) = envelope_column(b, 0.0, 0.0, -row.omega * b.env_sin(1));
   }
 };
 

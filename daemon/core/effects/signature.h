@@ -1,9 +1,15 @@
 // What an effect's signature sees of one sample, and what it returns.
 //
 // The fit compares five signals with the model (all deviations from an ideal chain):
-//   rd     position error of the R/D angle      eps = theta_true - theta_rd       [rad]
-//   s, c   sin/cos envelope deviations          s/A - sin theta, c/A - cos theta  [1]
-//   d, q   dq currents in the frame of the true motor angle theta_e = p theta_m   [A]
+//   rd     position error of the R/D angle       eps = theta_true - theta_rd             [rad]
+//   sa     position error of the sin/cos angle   theta_true - atan2(s, c)                [rad]
+//   sr     radius deviation of the envelopes     sqrt(s^2 + c^2) / A - 1                 [1]
+//   d, q   dq currents in the frame of the true motor angle theta_e = p theta_m         [A]
+// The envelopes enter as angle and radius, not as s and c: a constant rotation
+// (mounting offset, delay at one speed, backlash) is then exactly a constant of sa
+// however large, where the s/c deviations would be linear only for small angles.
+// To first order an envelope deviation (ds, dc) at angle theta is
+//   sa = sin(theta) dc - cos(theta) ds,   sr = sin(theta) ds + cos(theta) dc.
 // Each effect gives, per parameter, the derivative of each signal (its column),
 // evaluated at the true angles of the row (first order in the small parameters,
 // as the effect headers derive them).
@@ -42,14 +48,14 @@ struct SignatureRow {
 /// The five signals' values (a prediction or one column).
 struct SignalValues {
   double rd = 0.0;  ///< [rad]
-  double s = 0.0;   ///< [1]
-  double c = 0.0;   ///< [1]
+  double sa = 0.0;  ///< [rad]
+  double sr = 0.0;  ///< [1]
   double d = 0.0;   ///< [A]
   double q = 0.0;   ///< [A]
   SignalValues& operator+=(const SignalValues& o) {
     rd += o.rd;
-    s += o.s;
-    c += o.c;
+    sa += o.sa;
+    sr += o.sr;
     d += o.d;
     q += o.q;
     return *this;
@@ -138,11 +144,18 @@ class AngleBasis {
 };
 
 /// The column of a parameter that shifts the angle the resolver sees by `shift`
-/// [rad, resolver electrical, per unit parameter]: the envelopes turn with it
-/// (ds = shift cos theta', dc = -shift sin theta') and the R/D angle's error is
-/// `rd` (-shift, through the converter when the shift varies with the angle).
-[[nodiscard]] inline SignalValues shift_column(const AngleBasis& b, double rd, double shift) {
-  return SignalValues{.rd = rd, .s = shift * b.env_cos(1), .c = -shift * b.env_sin(1)};
+/// [rad, resolver electrical, per unit parameter]: the envelopes turn with it (sa
+/// = -shift, radius unchanged) and the R/D angle's error is `rd` (-shift, through
+/// the converter when the shift varies with the angle).
+[[nodiscard]] inline SignalValues shift_column(double rd, double shift) {
+  return SignalValues{.rd = rd, .sa = -shift, .sr = 0.0};
+}
+
+/// The column of a parameter that changes the envelopes by (ds, dc) [1, per unit
+/// parameter] at the envelopes' angle, with R/D angle error `rd` (see the header).
+[[nodiscard]] inline SignalValues envelope_column(const AngleBasis& b, double rd, double ds, double dc) {
+  const double sn = b.env_sin(1), cs = b.env_cos(1);
+  return SignalValues{.rd = rd, .sa = sn * dc - cs * ds, .sr = sn * ds + cs * dc};
 }
 
 }  // namespace resolver

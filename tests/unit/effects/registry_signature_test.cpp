@@ -8,7 +8,7 @@
 //   rd    theta_true - phi, phi from the converter: atan2 of its envelopes (ideal),
 //         or the type-II loop integrated to steady state (tracking_loop.h) when the
 //         chain has one
-//   s, c  the DSP's envelopes minus sin/cos of the true angle
+//   sa    theta_true - atan2 of the DSP's envelopes; sr their radius - 1
 //   d, q  the measured currents in the frame of the true theta_e, minus the command
 // Model side: the effect's SignatureColumns through AngleBasis (signature.h).
 //
@@ -80,8 +80,8 @@ SignalValues forward_signals(const ChainValues& values, const Bench& b, int i) {
   out.rd = wrap_pi(theta_true - phi);
   const SinCos s_at = chain.envelopes(seen(tr));
   const SinCos c_at = chain.envelopes(seen(tr + chain.timing().dsp_cos_dt));
-  out.s = s_at.s - std::sin(theta_true);
-  out.c = c_at.c - std::cos(theta_true);
+  out.sa = wrap_pi(theta_true - std::atan2(s_at.s, c_at.c));
+  out.sr = std::hypot(s_at.s, c_at.c) - 1.0;
   const double theta_e = b.p * theta_m_at(b, t);
   const PhaseCurrents m = chain.measured_currents(chain.machine_currents(b.i_d_cmd, b.i_q_cmd, theta_e), theta_e);
   const ClarkeTransform ab(m.a, m.b, m.c);
@@ -109,9 +109,9 @@ SignatureRow row_at(const Bench& b, int i) {
 
 using Series = std::vector<std::vector<double>>;  // [signal][grid point]
 constexpr int kSignals = 5;
-const char* const kSignalNames[kSignals] = {"rd", "s", "c", "d", "q"};
+const char* const kSignalNames[kSignals] = {"rd", "sa", "sr", "d", "q"};
 
-std::vector<double> as_array(const SignalValues& v) { return {v.rd, v.s, v.c, v.d, v.q}; }
+std::vector<double> as_array(const SignalValues& v) { return {v.rd, v.sa, v.sr, v.d, v.q}; }
 
 void compare(const Series& column, const Series& fd, const std::string& what, double rounding) {
   for (int k = 0; k < kSignals; ++k) {
@@ -239,7 +239,7 @@ void check_nonlinear(const std::string& spec, const Bench& b, double tol_rad) {
     const SignalValues f = forward_signals(v, b, i);
     const SignalValues m = model_prediction(v, b, i);
     worst = std::max(worst, std::abs(f.rd - m.rd));
-    worst_s = std::max({worst_s, std::abs(f.s - m.s), std::abs(f.c - m.c)});
+    worst_s = std::max({worst_s, std::abs(f.sa - m.sa), std::abs(f.sr - m.sr)});
   }
   EXPECT_LE(worst, tol_rad) << spec << ": model rd prediction vs forward chain";
   EXPECT_LE(worst_s, tol_rad) << spec << ": model sin/cos prediction vs forward chain";
