@@ -234,8 +234,10 @@ ModelFit fit_model(const DiscoveryInput& input, std::span<const std::string> eff
   return fit_prepared(log, effects, options);
 }
 
-Explanation explain_prepared(const PreparedLog& log, std::span<const std::string> effects,
-                             const DiscoveryOptions& options) {
+namespace {
+
+Explanation explain_steps(const PreparedLog& log, std::span<const std::string> effects,
+                          const DiscoveryOptions& options) {
   Explanation ex;
   ex.fit = fit_prepared(log, effects, options);
   if (options.progress) options.progress(0.4);
@@ -336,6 +338,14 @@ Explanation explain_prepared(const PreparedLog& log, std::span<const std::string
       }
     }
   }
+  return ex;
+}
+
+}  // namespace
+
+Explanation explain_prepared(const PreparedLog& log, std::span<const std::string> effects,
+                             const DiscoveryOptions& options) {
+  Explanation ex = explain_steps(log, effects, options);
   if (options.progress) options.progress(1.0);
   return ex;
 }

@@ -22,8 +22,12 @@ constexpr int kOrdersTried = 3;
 constexpr double kSignificance = 4.0;
 /// Nonlinear candidates refitted to convergence (the best by their linearised score).
 constexpr int kNonlinearRefits = 2;
-/// Candidates within this BIC of each other are not told apart by the log.
+/// Candidates within this BIC of each other, or whose improvements differ by less
+/// than this share, are not told apart by the log (e.g. K_3 and a 6th mechanical
+/// harmonic with p_r = 3: the same 2 theta in the angle, and alpha takes up the
+/// radius; channel delay and quadrature at one speed).
 constexpr double kIndistinguishableBic = 10.0;
+constexpr double kIndistinguishableShare = 0.02;
 
 std::vector<int> significant_orders(const std::vector<HarmonicResidual>& h, double floor, std::int64_t n, int lowest) {
   std::vector<HarmonicResidual> v;
@@ -234,11 +238,34 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   }
   std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
   // Candidates this log cannot tell apart.
+  auto alike = [&](const Candidate& a, const Candidate& b) {
+    const double gain = std::max(excess_base - a.weighted_rss, excess_base - b.weighted_rss);
+    return std::abs(a.score - b.score) < kIndistinguishableBic ||
+           (gain > 0.0 && std::abs(a.weighted_rss - b.weighted_rss) < kIndistinguishableShare * gain);
+  };
   for (Candidate& c : out.candidates) {
     if (!c.proposed) continue;
     for (const Candidate& o : out.candidates) {
       if (&o == &c || !o.proposed) continue;
-      if (std::abs(o.score - c.score) < kIndistinguishableBic) c.fits_as_well.push_back(o.effect);
+      if (alike(c, o)) c.fits_as_well.push_back(o.effect);
+    }
+  }
+  // Among candidates the log cannot tell apart, name the simplest first: fewer
+  // parameters, then one that needs no change of speed (constant at one speed is the
+  // plainer explanation), then the lower BIC.
+  auto simpler = [&options](const Candidate& a, const Candidate& b) {
+    const ModelSpec sa = ModelSpec::parse(std::vector<std::string>{a.effect}, options.customs);
+    if (a.params.size() != b.params.size()) return a.params.size() < b.params.size();
+    const ModelSpec sb = ModelSpec::parse(std::vector<std::string>{b.effect}, options.customs);
+    const bool va = sa.terms.front().effect->needs_speed_change(), vb = sb.terms.front().effect->needs_speed_change();
+    if (va != vb) return !va;
+    return a.score < b.score;
+  };
+  for (std::size_t i = 0; i < out.candidates.size(); ++i) {
+    for (std::size_t j = i + 1; j < out.candidates.size(); ++j) {
+      const Candidate& a = out.candidates[i];
+      const Candidate& b = out.candidates[j];
+      if (a.proposed && b.proposed && alike(a, b) && simpler(b, a)) std::swap(out.candidates[i], out.candidates[j]);
     }
   }
   return out;
