@@ -22,7 +22,14 @@
 set(RESOLVER_DATADIR ${CMAKE_INSTALL_DATADIR}/resolver-bench)
 
 # --- programs ---------------------------------------------------------------
-option(RESOLVER_MAN_PAGES "man pages from each program's --help (needs help2man)" ON)
+# Off by default in a sanitizer build: it is never installed, and help2man would
+# run instrumented programs at build time (a leak report would fail the build).
+if(RESOLVER_SANITIZE)
+  set(resolver_man_default OFF)
+else()
+  set(resolver_man_default ON)
+endif()
+option(RESOLVER_MAN_PAGES "man pages from each program's --help (needs help2man)" ${resolver_man_default})
 find_program(HELP2MAN help2man)
 find_program(GZIP gzip)
 set(RESOLVER_MAN_DIR ${PROJECT_BINARY_DIR}/man/man1)
