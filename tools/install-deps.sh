@@ -16,7 +16,7 @@ PACKAGES=(
   # packaging (cmake/Packaging.cmake, tests/install): man pages from --help, the
   # .deb's shared-library dependencies (dpkg-shlibdeps), systemd-analyze for the
   # installed units, /bin/kill their ExecReload= names; numpy for resolver_lcm's arrays
-  help2man dpkg-dev systemd procps python3-numpy
+  help2man dpkg-dev systemd procps
 )
 
 missing=()
