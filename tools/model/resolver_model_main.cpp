@@ -128,6 +128,17 @@ int run(int argc, char** argv) {
         ->delimiter(',');
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
   };
+  std::string direction = "both";
+  bool moving_only = false;
+  auto add_slicing = [&](CLI::App* sub) {
+    sub->add_option("--direction", direction,
+                    "fit only the samples moving this way: forward, backward or both (default both); the others are "
+                    "counted as excluded")
+        ->check(CLI::IsMember({"forward", "backward", "both"}));
+    sub->add_flag("--moving-only", moving_only,
+                  "leave standstill samples out of everything, the noise floor too (default: they give the floor "
+                  "and never enter a fit)");
+  };
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config_path,
                     "resolverd config (TOML): its [layout] DBC and signals decode the log, [bench] p_r/p apply "
@@ -149,6 +160,9 @@ int run(int argc, char** argv) {
   add_config(fit);
   add_config(explain);
   add_config(report);
+  add_slicing(fit);
+  add_slicing(explain);
+  add_slicing(report);
   CLI11_PARSE(app, argc, argv);
 
   const bool do_explain = explain->parsed();
@@ -164,6 +178,10 @@ int run(int argc, char** argv) {
     }
     resolver::DiscoveryOptions options;
     options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
+    options.prepare.direction = direction == "forward"    ? resolver::DirectionFilter::kForward
+                                : direction == "backward" ? resolver::DirectionFilter::kBackward
+                                                          : resolver::DirectionFilter::kBoth;
+    options.prepare.moving_only = moving_only;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
     resolver::Explanation ex;
     {
