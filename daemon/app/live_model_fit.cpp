@@ -30,6 +30,9 @@ model_fit_t make_model_fit_message(const Explanation* ex, bool candidates, const
   }
   m.residual_rms_rad = ex->fit.residual_rms_rad;
   m.noise_floor_rad = ex->fit.noise_floor_rad;
+  m.reason = ex->summary;
+  m.samples_fitted = ex->fit.account.fitted;
+  m.samples_window = ex->fit.account.samples_in;
   for (const auto& h : ex->fit.harmonics) {
     m.harmonic_order.push_back(static_cast<std::int16_t>(h.order));
     m.residual_by_harmonic_rad.push_back(h.amplitude);
@@ -84,6 +87,20 @@ void LiveModelFit::finish() {
   if (window_.revolutions() >= kMinTailRevolutions) {
     start(window_.take(), last_stamp_);
     publish_ready(true);
+  } else if (window_.size() > 0 && counters_.windows_fitted + counters_.windows_insufficient == 0) {
+    // Nothing was published in the whole run (a stopped motor): say so, with the reason.
+    model_fit_t m = make_model_fit_message(nullptr, options_.candidates, options_.effects);
+    m.reason = "the rotor turned " + std::to_string(window_.revolutions()) +
+               " resolver revolutions in the whole run: a stopped motor, nothing to fit";
+    m.samples_window = static_cast<std::int64_t>(window_.size());
+    m.utime = last_stamp_.utime;
+    m.sample_index = last_stamp_.sample_index;
+    m.counter = last_stamp_.counter;
+    ++counters_.windows_insufficient;
+    diagnostics_ << "resolverd: model fit: the rotor turned " << window_.revolutions()
+                 << " resolver revolutions in the whole run (stopped?): model_fit_t verdict insufficient_data\n";
+    sink_.publish(m);
+    last_ = std::move(m);
   }
 }
 
@@ -101,10 +118,13 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
       else ex.fit = fit_model(w, opt.effects, dopt);
       m = make_model_fit_message(&ex, opt.candidates, opt.effects);
       r.fitted = FittedModel{ex.fit.model, ex.fit.account.fitted, ex.fit.account.revolutions_electrical};
+      r.fitted->model.keep(opt.customs);
     } catch (const std::exception& e) {
       // Too few revolutions, no R/D angle, no currents for a current-side effect:
       // the window says so in its verdict instead of disappearing.
       m = make_model_fit_message(nullptr, opt.candidates, opt.effects);
+      m.reason = e.what();
+      m.samples_window = static_cast<std::int64_t>(w.samples.size());
       r.error = e.what();
     }
     m.utime = stamp.utime;

@@ -1,6 +1,8 @@
 // resolverd — resolver bench daemon. Wiring only: parse options, load the
 // config, build the pipeline with an LCM output, run a source, print a report.
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <fstream>
@@ -38,6 +40,46 @@ Channels (configurable in [channels]): RESOLVER_ANGLE, RESOLVER_DQ, RESOLVER_EST
 RESOLVER_MODEL_FIT, RESOLVER_HEALTH. Signals: SIGTERM/SIGINT exit cleanly (with --replay,
 after printing the report), SIGHUP reloads the config (a bad config keeps the old one).
 )";
+
+using resolver::Calibration;
+using resolver::CustomEffect;
+using resolver::CustomEffectSpec;
+using resolver::CustomEffects;
+using resolver::DaemonConfig;
+using resolver::Model;
+using resolver::ModelSpec;
+using resolver::ModelTerm;
+
+/// The saved model, with the config's custom effects and the file's own.
+Model model_from_calibration(const Calibration& cal, const DaemonConfig& config) {
+  std::vector<CustomEffectSpec> specs = config.model.custom;
+  for (const auto& c : cal.custom) {
+    bool known = false;
+    for (const auto& s : specs) known = known || s.name == c.name;
+    if (!known) specs.push_back(CustomEffectSpec{c.name, c.signal, c.terms, "", "saved calibration"});
+  }
+  auto customs = std::make_shared<const CustomEffects>(specs);
+  Model m(ModelSpec::parse(cal.model, customs.get()), cal.p_r, cal.p);
+  m.keep(customs);
+  for (const auto& p : cal.params) {
+    try {
+      m.set(p.name, p.value, p.std_error);
+    } catch (const std::invalid_argument&) {
+      // a parameter of another model (an older file): not part of this one
+    }
+  }
+  return m;
+}
+
+/// The model's references and custom effects into the calibration (format 2).
+void describe_model(const Model& model, Calibration& cal) {
+  cal.model = model.spec().references();
+  for (const ModelTerm& t : model.spec().terms) {
+    if (const auto* c = dynamic_cast<const CustomEffect*>(t.effect)) {
+      cal.custom.push_back({c->spec().name, c->spec().signal, c->spec().terms});
+    }
+  }
+}
 
 }  // namespace
 
@@ -108,8 +150,19 @@ static int run(int argc, char** argv) {
   if (!state_dir.empty()) {
     const LoadResult loaded = load_calibration(state_dir);
     if (loaded.status == LoadResult::Status::kLoaded) {
-      for (const auto& param : loaded.calibration->params) {
-        if (param.name == "amplitude_imbalance.alpha") {
+      const Calibration& cal = *loaded.calibration;
+      if (config.method == EstimatorMethod::kModel && !cal.model.empty()) {
+        try {
+          pipeline->seed_model(model_from_calibration(cal, config));
+          std::cerr << "resolverd: compensating with the saved model (" << fmt::format("{}", fmt::join(cal.model, ", "))
+                    << ") from " << calibration_path(state_dir) << " until this run's first window is fitted\n";
+        } catch (const std::exception& e) {
+          std::cerr << "resolverd: the saved model in " << calibration_path(state_dir) << " is not used: " << e.what()
+                    << "\n";
+        }
+      }
+      for (const auto& param : cal.params) {
+        if (param.name == "amplitude_imbalance.alpha" && config.method != EstimatorMethod::kModel) {
           pipeline->seed_alpha(param.value);
           std::cerr << "resolverd: compensating with the saved alpha = " << param.value << " from "
                     << calibration_path(state_dir) << " until this run's estimate converges\n";
@@ -171,6 +224,7 @@ static int run(int argc, char** argv) {
     cal.method = model.method;
     cal.samples = model.samples;
     for (const ParamEstimate& prm : model.params) cal.params.push_back({prm.name, prm.value, prm.std_error});
+    if (pipeline->processor().config().method == EstimatorMethod::kModel) describe_model(pipeline->processor().model(), cal);
     if (auto problem = save_calibration(state_dir, cal)) {
       std::cerr << "resolverd: " << *problem << "\n";
     } else {

@@ -123,7 +123,7 @@ std::optional<std::string> format_calibration(const Calibration& c, std::string&
     if (!seen.insert(param.name).second) {
       return "cannot save the calibration: parameter '" + param.name + "' appears twice";
     }
-    if (!std::isfinite(param.value) || !std::isfinite(param.std_error) || param.std_error < 0.0) {
+    if (!std::isfinite(param.value) || std::isinf(param.std_error) || param.std_error < 0.0) {
       return "cannot save the calibration: parameter '" + param.name + "' has value " + shortest(param.value) +
              " and std_error " + shortest(param.std_error) +
              "; only finite values and a finite std_error >= 0 are saved (the estimate has not converged?)";
@@ -137,6 +137,26 @@ std::optional<std::string> format_calibration(const Calibration& c, std::string&
   body += "p " + std::to_string(c.p) + "\n";
   body += "method " + c.method + "\n";
   body += "samples " + std::to_string(c.samples) + "\n";
+  if (!c.model.empty()) {
+    std::string line = "model";
+    for (const auto& m : c.model) {
+      if (m.empty() || m.find_first_of(" \t\r\n") != std::string::npos) {
+        return "cannot save the calibration: effect reference '" + printable(m) + "' is empty or contains blanks";
+      }
+      line += " " + m;
+    }
+    body += line + "\n";
+  }
+  for (const auto& cu : c.custom) {
+    std::string line = "custom " + cu.name + "\t" + cu.signal;
+    for (const auto& t : cu.terms) {
+      if (t.find_first_of("\t\r\n") != std::string::npos) {
+        return "cannot save the calibration: a term of custom effect '" + printable(cu.name) + "' contains a tab or line break";
+      }
+      line += "\t" + t;
+    }
+    body += line + "\n";
+  }
   for (const auto& param : c.params) {
     body += "param " + param.name + " " + shortest(param.value) + " " + shortest(param.std_error) + "\n";
   }
@@ -181,10 +201,10 @@ std::optional<Calibration> parse_calibration(const std::string& text, const std:
       return fail("no 'format N' line after the identity line (found '" + printable(version_line) +
                   "'); the file is truncated or damaged and is ignored");
     }
-    if (version != kCalibrationFormatVersion) {
+    if (version != kCalibrationFormatVersion && version != 1) {
       return fail("calibration format version " + std::to_string(version) + ", but this resolverd reads only version " +
                   std::to_string(kCalibrationFormatVersion) +
-                  "; it was written by another resolverd release and is ignored (it is replaced at the next save)");
+                  " and 1; it was written by another resolverd release and is ignored (it is replaced at the next save)");
     }
   }
 
@@ -246,13 +266,36 @@ std::optional<Calibration> parse_calibration(const std::string& text, const std:
         return fail(at + "samples '" + printable(rest) + "' is not a count >= 0; ignored");
       }
       have_samples = true;
+    } else if (key == "model") {
+      std::string_view rest_refs = rest;
+      while (!rest_refs.empty()) {
+        const auto [ref, more] = split_key(rest_refs);
+        if (!ref.empty()) c.model.emplace_back(ref);
+        rest_refs = more;
+      }
+    } else if (key == "custom") {
+      Calibration::Custom cu;
+      std::vector<std::string> fields;
+      std::size_t start = 0;
+      const std::string text_rest(rest);
+      for (std::size_t i = 0; i <= text_rest.size(); ++i) {
+        if (i == text_rest.size() || text_rest[i] == '\t') {
+          fields.push_back(text_rest.substr(start, i - start));
+          start = i + 1;
+        }
+      }
+      if (fields.size() < 3) return fail(at + "'custom' needs NAME<TAB>SIGNAL<TAB>TERM...; ignored");
+      cu.name = fields[0];
+      cu.signal = fields[1];
+      cu.terms.assign(fields.begin() + 2, fields.end());
+      c.custom.push_back(std::move(cu));
     } else if (key == "param") {
       const auto [name, values] = split_key(rest);
       const auto [value_text, error_text] = split_key(values);
       CalibrationParam param;
       param.name = std::string(name);
       if (!valid_name(name) || !parse_number(value_text, param.value) || !parse_number(error_text, param.std_error) ||
-          !std::isfinite(param.value) || !std::isfinite(param.std_error) || param.std_error < 0.0) {
+          !std::isfinite(param.value) || std::isinf(param.std_error) || param.std_error < 0.0) {
         return fail(at + "'" + printable(line) + "' is not 'param NAME VALUE STD_ERROR' with finite numbers; ignored");
       }
       if (!names.insert(param.name).second) return fail(at + "parameter '" + param.name + "' appears twice; ignored");

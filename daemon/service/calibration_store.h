@@ -4,15 +4,18 @@
 // their standard errors, for the bench identity p_r/p) in one small text file,
 // `<state dir>/calibration.txt` — under systemd the state dir is
 // /var/lib/resolverd (StateDirectory=resolverd, passed as --state-dir
-// ${STATE_DIRECTORY}). The file, format version 1:
+// ${STATE_DIRECTORY}). The file, format version 2 (version 1, without the model
+// and custom lines, is still read):
 //
 //   resolverd-calibration                      magic/identity line (first line)
-//   format 1                                   format version
+//   format 2                                   format version
+//   model amplitude_imbalance harmonics(k5)    the model's effect references (space separated)
+//   custom drift<TAB>position_error<TAB>t*sin(2*theta)   a [[model.custom]] effect the model uses
 //   p_r 1                                      resolver pole pairs
 //   p 4                                        motor pole pairs
 //   method hwang_integral                      estimator that produced it (may be empty)
 //   samples 123456                             samples the estimate used
-//   param amplitude_imbalance.alpha 0.0123 4.5e-05    name value std_error
+//   param amplitude_imbalance.alpha 0.0123 4.5e-05    name value std_error (nan: not identifiable)
 //   ...
 //   crc32 1a2b3c4d                             CRC-32 (IEEE 802.3) of every byte above
 //
@@ -40,7 +43,7 @@ namespace resolver {
 struct CalibrationParam {
   std::string name;        ///< [A-Za-z0-9_.:-]+, unique within a calibration
   double value = 0.0;      ///< in the parameter's own unit (see the effect catalog)
-  double std_error = 0.0;  ///< one standard error, same unit; >= 0
+  double std_error = 0.0;  ///< one standard error, same unit; >= 0, or NaN (not identifiable)
   bool operator==(const CalibrationParam&) const = default;
 };
 
@@ -49,19 +52,28 @@ struct Calibration {
   int p = 1;    ///< motor pole pairs (theta_e = p * theta_m), 1..255
   std::string method;        ///< estimator name, printable, no newline; may be empty
   std::int64_t samples = 0;  ///< samples the estimate is based on, >= 0
+  /// The model's effect references (format 2; empty in a version-1 file).
+  std::vector<std::string> model;
+  /// The [[model.custom]] effects it uses: name, signal, terms (format 2).
+  struct Custom {
+    std::string name, signal;
+    std::vector<std::string> terms;
+    bool operator==(const Custom&) const = default;
+  };
+  std::vector<Custom> custom;
   std::vector<CalibrationParam> params;
   bool operator==(const Calibration&) const = default;
 };
 
 /// File name inside the state directory.
 inline constexpr const char* kCalibrationFileName = "calibration.txt";
-/// Format version this code writes and the only one it reads.
-inline constexpr int kCalibrationFormatVersion = 1;
+/// Format version this code writes; it also reads version 1.
+inline constexpr int kCalibrationFormatVersion = 2;
 
 /// Full path of the calibration file in `dir`.
 std::string calibration_path(const std::string& dir);
 
-/// Serialises `calibration` in format version 1 (with its checksum line).
+/// Serialises `calibration` in format version 2 (with its checksum line).
 /// Returns an error text instead if a field cannot be written (bad name,
 /// non-finite value, p_r/p out of range, newline in method).
 std::optional<std::string> format_calibration(const Calibration& calibration, std::string& text);

@@ -7,11 +7,13 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "daemon/core/effects/signature.h"
+#include "daemon/core/model/custom_effect.h"
 #include "daemon/core/model/design.h"
 #include "daemon/core/model/model_spec.h"
 
@@ -53,12 +55,15 @@ class Model {
   /// True when some term changes the R/D or sin/cos angle (compensation has work to do).
   [[nodiscard]] bool has_angle_terms() const;
   [[nodiscard]] bool empty() const { return spec_.terms.empty(); }
+  /// Keeps the custom effects the model's terms point into alive as long as the model.
+  void keep(std::shared_ptr<const CustomEffects> customs) { customs_ = std::move(customs); }
 
  private:
   ModelSpec spec_;
   int p_r_ = 1, p_ = 1;
   std::vector<std::vector<double>> values_;
   std::vector<double> std_errors_;
+  std::shared_ptr<const CustomEffects> customs_;
   mutable Design scratch_;
   mutable bool scratch_valid_ = false;
 };
