@@ -102,7 +102,7 @@ std::string verdict_words(const DiscoveryRun& run, double explained_ratio) {
 
 std::string coverage_table(const ModelFit& f) {
   const SampleAccount& a = f.account;
-  auto row = [](std::string what, const std::string& value, std::string unit) {
+  auto row = [](const std::string& what, const std::string& value, const std::string& unit) {
     return std::vector<std::string>{escape(what), num_cell(value), escape(unit)};
   };
   const std::vector<std::vector<std::string>> rows = {

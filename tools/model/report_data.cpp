@@ -111,7 +111,7 @@ Axis theta_e_axis() {
   return a;
 }
 
-Axis order_axis(std::string of, std::string column, int lo, int hi) {
+Axis order_axis(const std::string& of, std::string column, int lo, int hi) {
   Axis a = axis("harmonic order of " + of, "cycles/rev", std::move(column));
   a.lo = lo - 0.5;
   a.hi = hi + 0.5;
