@@ -16,6 +16,10 @@ PACKAGES=(
   chromium  # headless: renders, zooms and screenshots the resolver-model HTML report (tests/model)
   libmatio-dev  # resolver-model export-data --mat (tools/model/export_data.h)
   python3-scipy  # tests/model/test_export_data.py reads the .mat with scipy.io.loadmat
+  # packaging (cmake/Packaging.cmake, tests/install): man pages from --help, the
+  # .deb's shared-library dependencies (dpkg-shlibdeps), systemd-analyze for the
+  # installed units, /bin/kill their ExecReload= names; numpy for resolver_lcm's arrays
+  help2man dpkg-dev systemd procps
 )
 
 missing=()

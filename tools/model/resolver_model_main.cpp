@@ -26,10 +26,17 @@
 #include <vector>
 
 #include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/model/calibration_table.h"
+#include "daemon/service/table_file.h"
 #include "tools/model/export_data.h"
+
+#include <ctime>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -107,6 +114,28 @@ int write_report(const resolver::LogSamples& samples, const std::string& log, co
   return 0;
 }
 
+/// `export`: fit, tabulate, write; one summary line on stderr.
+int write_export(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
+                 const resolver::DiscoveryOptions& options, const std::string& format, int points,
+                 const std::string& out) {
+  const resolver::ModelFit fit = resolver::fit_model(samples.input, effects, options);
+  const resolver::CalibrationTable table = resolver::tabulate(fit.model, points);
+  char date[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  const resolver::TableOrigin origin{log, date, "resolver-model"};
+  const std::string text = format == "json"       ? resolver::format_table_json(table, origin)
+                           : format == "c-header" ? resolver::format_table_c_header(table, origin)
+                                                  : resolver::format_table_csv(table, origin);
+  if (out.empty()) std::cout << text;
+  else resolver::write_text_file(out, text);
+  std::cerr << "resolver-model: exported " << points << " points of " << fmt::format("{}", fmt::join(fit.effects, ", "))
+            << " (position-error residual " << fit.residual_rms_rad << " rad, " << fit.residual_rms_rad / fit.noise_floor_rad
+            << "x floor; interpolation error " << table.interpolation_error << " rad)" << (out.empty() ? "" : " to " + out)
+            << "\n";
+  return 0;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"resolver-model: compare the effect model with a log, see where it fails, name the missing effect.\n"
                "Examples:\n"
@@ -116,6 +145,7 @@ int run(int argc, char** argv) {
                "  resolver-model report build/demo/demo.log --html demo.html\n"
                "  resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
   std::vector<std::string> effects_args;
   std::string config_path;
@@ -128,6 +158,17 @@ int run(int argc, char** argv) {
                     "comma-separated catalog effects of the model (default amplitude_imbalance); fittable: " + fittable)
         ->delimiter(',');
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
+  };
+  std::string direction = "both";
+  bool moving_only = false;
+  auto add_slicing = [&](CLI::App* sub) {
+    sub->add_option("--direction", direction,
+                    "fit only the samples moving this way: forward, backward or both (default both); the others are "
+                    "counted as excluded")
+        ->check(CLI::IsMember({"forward", "backward", "both"}));
+    sub->add_flag("--moving-only", moving_only,
+                  "leave standstill samples out of everything, the noise floor too (default: they give the floor "
+                  "and never enter a fit)");
   };
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config_path,
@@ -160,6 +201,24 @@ int run(int argc, char** argv) {
   add_config(explain);
   add_config(report);
   add_config(export_data);
+  add_slicing(fit);
+  add_slicing(explain);
+  add_slicing(report);
+  CLI::App* exporter = app.add_subcommand(
+      "export", "fit the model and write what a drive firmware loads: a correction table over one mechanical "
+                "revolution with its harmonic coefficients (resolverd --calibration reads the CSV)");
+  std::string export_format = "csv", export_out;
+  int export_points = 1024;
+  exporter->add_option("LOG", log, "the log to fit (as for fit)")->required();
+  exporter->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)")->delimiter(',');
+  exporter->add_option("--format", export_format, "csv (default), json or c-header")
+      ->check(CLI::IsMember({"csv", "json", "c-header"}));
+  exporter->add_option("--points", export_points, "table points over one mechanical revolution (default 1024)")
+      ->check(CLI::Range(8, 1 << 20));
+  exporter->add_option("--out", export_out, "file to write (default: standard output)");
+  add_config(exporter);
+  add_slicing(exporter);
+  add_slicing(export_data);
   CLI11_PARSE(app, argc, argv);
 
   const bool do_explain = explain->parsed();
@@ -178,7 +237,13 @@ int run(int argc, char** argv) {
       samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config);
     }
     resolver::DiscoveryOptions options;
+    options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
+    options.prepare.direction = direction == "forward"    ? resolver::DirectionFilter::kForward
+                                : direction == "backward" ? resolver::DirectionFilter::kBackward
+                                                          : resolver::DirectionFilter::kBoth;
+    options.prepare.moving_only = moving_only;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
+    if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
     if (export_data->parsed()) {
       std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
       return 0;
