@@ -252,6 +252,26 @@ class ReportHtml(unittest.TestCase):
     def test_notes_section(self):
         self.assertTrue(any(h.startswith("Notes") for h in self.page.h2), self.page.h2)
 
+    def test_unexplained_log_gets_the_suggested_custom_block(self):
+        # Alpha drifting in time is outside the catalog (resolver-sim --alpha-drift): unexplained,
+        # and the page carries the [[model.custom]] block that describes the residual.
+        log = os.path.join(ARGS.work, "alpha_drift.log")
+        out = os.path.join(ARGS.work, "alpha_drift.html")
+        run([os.path.join(ARGS.bin, "resolver-sim"), "-o", log, "--alpha-drift", "0.002", "-e",
+             "amplitude_imbalance:alpha=0.003", "--seed", "5"])
+        p = run([self.model, "report", log, "--html", out])
+        self.assertTrue(p.stdout.startswith("unexplained after 1 step"), p.stdout)
+        page = Page()
+        with open(out, encoding="utf-8") as f:
+            html = f.read()
+        page.feed(html)
+        self.assertEqual(page.verdict_class, "v-unexplained")
+        self.assertIn("Suggested custom effect", page.h2)
+        block = re.search(r'<pre class="custom">(.*?)</pre>', html, re.S)
+        self.assertIsNotNone(block)
+        self.assertTrue(block.group(1).startswith("[[model.custom]]\nname = &quot;"), block.group(1)[:80])
+        self.assertIn("t*sin(2*theta)", block.group(1))  # the residual changes with time at 2 theta
+
     def test_unwritable_output_names_the_file(self):
         bad = os.path.join(ARGS.work, "no-such-dir", "x.html")
         p = run([self.model, "report", self.log, "--html", bad], expect_rc=1)
