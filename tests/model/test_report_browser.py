@@ -69,6 +69,11 @@ def make_pages():
     run([sim, "-o", part, "--rpm", "5", "--duration", "2", "-e", "amplitude_imbalance:alpha=0.003"])
     PAGES["half_turn"] = os.path.join(ARGS.work, "half_turn.html")
     run([model, "report", part, "--effects", "mounting_offset", "--html", PAGES["half_turn"]])
+    # Without the reference encoder: no dq plots, the self-calibrated angle.
+    noref = os.path.join(ARGS.work, "no_reference.log")
+    run([sim, "-o", noref, "--no-reference", "-e", "amplitude_imbalance:alpha=0.003", "--duration", "3"])
+    PAGES["no_reference"] = os.path.join(ARGS.work, "no_reference.html")
+    run([model, "report", noref, "--html", PAGES["no_reference"]])
 
 
 def hex_colour(c):
@@ -135,6 +140,18 @@ def continuity(page):
 
 
 class Screenshot(unittest.TestCase):
+    def test_pages_run_without_script_errors(self):
+        for name, page in PAGES.items():
+            with Chromium(ARGS.work) as b:
+                b.open("file://" + page)
+                plots = b.evaluate("resolverReport.plots.map(p => p.id)")
+                drawn = b.evaluate("resolverReport.plots.filter(p => resolverReport.chart(p.id)).length")
+                errors = [e["params"] for e in b.events if e["method"] == "Runtime.exceptionThrown" or (
+                    e["method"] == "Runtime.consoleAPICalled" and e["params"].get("type") in ("error", "assert"))]
+            self.assertEqual(errors, [], name)
+            self.assertEqual(drawn, len(plots), f"{name}: every plot has its chart")
+            self.assertGreaterEqual(len(plots), 5, name)
+
     def test_page_renders_with_the_step_colours(self):
         with Chromium(ARGS.work, width=1200, height=900) as b:
             b.open("file://" + PAGES["full"])
