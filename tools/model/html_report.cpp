@@ -292,7 +292,9 @@ std::string candidates_table(const Explanation& ex, bool currents) {
   if (currents) header.emplace_back("i<sub>dq</sub> residual with it [A]");
   header.insert(header.end(), {"BIC drop", "ERR [share of the residual]", "proposed", "reaches the floor",
                                "fits as well here", "why, and its fitted values"});
-  std::string o = "<details open><summary>candidates ranked at the last step (lowest BIC first)</summary>\n" +
+  // Open while something is missing; folded once the model explains the log (nothing is proposed then).
+  std::string o = std::string(ex.verdict == Verdict::kExplained ? "<details>" : "<details open>") +
+                  "<summary>candidates ranked at the last step (lowest BIC first)</summary>\n" +
                   (rows.empty() ? std::string("<p>None ranked.</p>") : table("params", header, rows));
   for (const auto& n : ex.not_evaluated) o += "<p class=\"small\">not evaluated: " + escape(n) + "</p>";
   if (!ex.missing_pair.empty()) {
@@ -362,8 +364,8 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
   o += fmt::format("<div class=\"verdict v-{}\"><b>{}</b><br><span class=\"small\">final step: {}</span></div>\n",
                    to_string(last.verdict), escape(verdict_words(run, explained_ratio)), escape(last.summary));
   o += "<nav class=\"small\">Contents: <a href=\"#coverage\">what the statistics cover</a> · <a href=\"#steps\">steps</a> · "
-       "<a href=\"#final\">final model</a> · <a href=\"#floors\">floors</a> · <a href=\"#candidates\">candidates</a> · "
-       "<a href=\"#plots\">plots</a> · <a href=\"#notes\">notes</a></nav>\n";
+       "<a href=\"#final\">final model</a> · <a href=\"#plots\">plots</a> · <a href=\"#floors\">floors</a> · "
+       "<a href=\"#candidates\">candidates</a> · <a href=\"#notes\">notes</a></nav>\n";
 
   o += "<h2 id=\"coverage\">What the statistics cover</h2>\n" + coverage_table(f);
 
@@ -382,17 +384,14 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
     o += "<p><b>Where the final model fails</b></p>" + list(last.where_it_fails);
   }
 
-  o += fmt::format("<h2 id=\"final\">Final model: {}</h2>\n", escape(model_name(f)));
-  o += params_table(f) + signals_table(f, explained_ratio);
-  o += "<h2 id=\"floors\">Noise floors, outliers, whiteness, directions</h2>\n" + floors_table(f.floors) +
-       outliers_section(f) + whiteness_and_directions(f);
-  o += "<h2 id=\"candidates\">Candidates</h2>\n" + candidates_table(last, f.currents_used);
   if (!last.suggested_custom.empty()) {
     o += "<h2 id=\"custom\">Suggested custom effect</h2>\n<p>No catalog effect explains the residual. This "
          "<code>[[model.custom]]</code> block describes it; paste it into the resolverd config and add its name to "
          "<code>[model] effects</code>:</p>\n<pre class=\"custom\">" +
          escape(last.suggested_custom) + "</pre>\n";
   }
+  o += fmt::format("<h2 id=\"final\">Final model: {}</h2>\n", escape(model_name(f)));
+  o += params_table(f) + signals_table(f, explained_ratio);
 
   const std::vector<report::Plot> plots = report::report_plots(run);
   o += "<h2 id=\"plots\">Plots</h2>\n"
@@ -401,8 +400,12 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
        "together. Click a legend entry to show or hide it (the individual samples start hidden). <i>download CSV</i> "
        "saves the plot's data: one row per point, with its series, in the units of the axes.</p>\n"
        "<noscript><p class=\"bad\">The plots are drawn by the page's script: enable JavaScript to see them. The "
-       "tables above do not need it.</p></noscript>\n";
+       "tables do not need it.</p></noscript>\n";
   o += figures(plots);
+
+  o += "<h2 id=\"floors\">Noise floors, outliers, whiteness, directions</h2>\n" + floors_table(f.floors) +
+       outliers_section(f) + whiteness_and_directions(f);
+  o += "<h2 id=\"candidates\">Candidates</h2>\n" + candidates_table(last, f.currents_used);
 
   std::vector<std::string> notes = log.notes;
   if (log.bad_lines > 0) notes.push_back(fmt::format("{} malformed log lines skipped", log.bad_lines));
