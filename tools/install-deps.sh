@@ -13,7 +13,9 @@ PACKAGES=(
   python3-numpy  # tests/independent (benchgen)
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
-  chromium  # headless, screenshots the resolver-model HTML report (tests/model)
+  chromium  # headless: renders, zooms and screenshots the resolver-model HTML report (tests/model)
+  libmatio-dev  # resolver-model export-data --mat (tools/model/export_data.h)
+  python3-scipy  # tests/model/test_export_data.py reads the .mat with scipy.io.loadmat
   # packaging (cmake/Packaging.cmake, tests/install): man pages from --help, the
   # .deb's shared-library dependencies (dpkg-shlibdeps), systemd-analyze for the
   # installed units, /bin/kill their ExecReload= names; numpy for resolver_lcm's arrays
@@ -24,8 +26,12 @@ missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# npm: the build installs uPlot for the resolver-model report from the npm registry
+# (tools/model/web/package-lock.json). The machine images ship Node.js with npm; where
+# there is no npm at all, Debian's nodejs and npm packages provide it.
+command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  echo "install-deps: all ${#PACKAGES[@]} packages and npm present"
   exit 0
 fi
 

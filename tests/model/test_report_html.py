@@ -4,15 +4,19 @@ amplitude imbalance (Hanselman eq. 5 and 7: alpha = 0.003, beta = 0.002 rad);
 `resolver-model report LOG --html OUT` must walk the discovery from the default
 model to `explained` by adding quadrature, and write one self-contained page.
 
-The page is checked with Python's html.parser (no browser): every element closed
-in order, at least 4 inline <svg> plots, every axis labelled with a unit in
-brackets, no external reference (src, href other than #anchors, url() other than
-url(#...), @import, script), a title and the log name, the verdict in words,
-the step table showing quadrature added and why, and a notes section.
+The page is checked with Python's html.parser (no browser; test_report_browser.py
+renders it): every element closed in order; no external reference (src, href other
+than #anchors, url() other than url(#...), @import; scripts inline only); the plots'
+data (one inline JSON element) with a unit and a CSV column name on every axis, one
+residual panel per step, i_d and i_q against θ_e; every table with its units (the
+parameters' unit column filled); what the statistics cover, the floors and where
+they come from, held-back validation; a title and the log name, the verdict in
+words, the step table showing quadrature added and why, and a notes section.
 
   test_report_html.py --bin BUILD/bin --work DIR
 """
 import argparse
+import json
 import os
 import re
 import subprocess
@@ -23,7 +27,8 @@ from html.parser import HTMLParser
 
 ARGS = None
 VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
-EXTERNAL_TAGS = {"script", "link", "img", "iframe", "object", "embed", "image", "use", "audio", "video"}
+EXTERNAL_TAGS = {"link", "img", "iframe", "object", "embed", "image", "use", "audio", "video"}
+IDENTIFIER = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")  # a MATLAB variable / pandas column name
 
 
 def run(cmd, expect_rc=0):
@@ -43,6 +48,8 @@ class Page(HTMLParser):
         self.title = ""
         self.axis_labels = []      # text of every <text class="axis"> (x and y labels)
         self.steps = []            # rows of <table class="steps">, each a list of cell texts
+        self.tables = []           # every table: rows of cell texts
+        self.data_json = ""        # the plots' data (<script type="application/json" id="report-data">)
         self.verdict_class, self.verdict_text = None, ""
         self.h2 = []
         self._in = Counter()       # open elements of interest
@@ -58,13 +65,18 @@ class Page(HTMLParser):
         if tag == "text" and "axis" in cls:
             self.axis_labels.append("")
             return "axis"
-        if tag == "table" and "steps" in cls:
-            return "steps"
-        if tag == "tr" and self._in["steps"]:
-            self.steps.append([])
-        if tag in ("td", "th") and self._in["steps"]:
-            self.steps[-1].append("")
+        if tag == "table":
+            self.tables.append([])
+            if "steps" in cls:
+                self.steps = self.tables[-1]
+            return "table"
+        if tag == "tr" and self._in["table"]:
+            self.tables[-1].append([])
+        if tag in ("td", "th") and self._in["table"]:
+            self.tables[-1][-1].append("")
             return "cell"
+        if tag == "script" and a.get("id") == "report-data":
+            return "data"
         if tag == "div" and "verdict" in cls:
             self.verdict_class = next((c for c in cls if c.startswith("v-")), None)
             return "verdict"
@@ -100,7 +112,9 @@ class Page(HTMLParser):
         if self._in["axis"]:
             self.axis_labels[-1] += data
         if self._in["cell"]:
-            self.steps[-1][-1] += data
+            self.tables[-1][-1][-1] += data
+        if self._in["data"]:
+            self.data_json += data
         if self._in["verdict"]:
             self.verdict_text += data
         if self._in["title"]:
@@ -145,14 +159,70 @@ class ReportHtml(unittest.TestCase):
         self.assertEqual({t for t in self.page.tags if t in EXTERNAL_TAGS}, set())
         self.assertIsNone(re.search(r"url\(\s*['\"]?(?!#)", self.html), "url() to something other than an #id")
         self.assertNotIn("@import", self.html)
+        self.assertNotIn("import(", self.html, "a dynamic import")
+        # uPlot, its licence notice and the page's script are inline.
+        self.assertGreaterEqual(self.page.tags["script"], 3)
+        self.assertIn("Permission is hereby granted, free of charge", self.html)
+        self.assertIn("var uPlot=", self.html)
 
-    def test_plots_with_units_on_every_axis(self):
-        svgs = self.page.tags["svg"]
-        self.assertGreaterEqual(svgs, 4)
-        self.assertEqual(len(self.page.axis_labels), 2 * svgs, "an x and a y label per plot")
-        for label in self.page.axis_labels:
-            self.assertRegex(label, r"\[[^\]]+\]", f"axis label without a unit: {label!r}")
-        self.assertNotIn("no data", self.html)
+    def test_plots_data_with_units_on_every_axis(self):
+        plots = json.loads(self.page.data_json)["plots"]
+        ids = [p["id"] for p in plots]
+        self.assertEqual(len(ids), len(set(ids)), "plot ids are unique")
+        self.assertGreaterEqual(len(plots), 8)
+        for p in plots:
+            for axis in (p["x"], p["y"]):
+                self.assertTrue(axis["unit"], f"{p['id']}: axis {axis['label']!r} without a unit")
+                self.assertRegex(axis["column"], IDENTIFIER, p["id"])
+            self.assertTrue(p["series"], p["id"])
+            for s in p["series"]:
+                self.assertEqual(len(s["x"]), len(s["y"]), f"{p['id']} {s['label']}")
+                self.assertTrue(s["label"], p["id"])
+            # Every plot has a figure with a chart, a legend and a CSV button.
+            for attr in ("data-plot", "data-legend", "data-csv"):
+                self.assertIn(f'{attr}="{p["id"]}"', self.html)
+        # One residual panel per discovery step, measured drawn over the model.
+        self.assertIn("res1", ids)
+        self.assertIn("res2", ids)
+        self.assertNotIn("res3", ids)
+        pe = next(p for p in plots if p["id"] == "pe")
+        marks = [s["mark"] for s in pe["series"]]
+        self.assertLess(marks.index("line"), marks.index("band"), "the model line first, the measured band on top")
+        # The dq currents against the motor electrical angle.
+        for pid in ("dqd", "dqq"):
+            self.assertEqual(next(p for p in plots if p["id"] == pid)["x"]["column"], "theta_e_deg")
+
+    def test_tables_carry_units(self):
+        params = next(t for t in self.page.tables if t[0][:4] == ["parameter", "value", "standard error", "unit"])
+        self.assertGreaterEqual(len(params), 3, "alpha and beta")
+        for row in params[1:]:
+            self.assertTrue(row[3].strip(), f"{row[0]} has no unit")
+        # Every bare number in every table has its unit: a "unit" column, a unit in brackets in
+        # its header, or it is a count (samples, rows, steps, parameters k) or a BIC.
+        counts = {"step", "k", "BIC", "BIC drop", "samples", "rows"}
+        for table in self.page.tables:
+            header = [h.strip() for h in table[0]]
+            if "unit" in header:
+                continue
+            for row in table[1:]:
+                for h, cell in zip(header, row):
+                    if re.fullmatch(r"\s*-?[0-9.]+(e[-+]?[0-9]+)?\s*", cell):
+                        self.assertTrue("[" in h or h in counts, f"{cell!r} under {h!r} has no unit")
+
+    def test_coverage_floors_and_held_back_validation(self):
+        self.assertTrue(any(h.startswith("What the statistics cover") for h in self.page.h2), self.page.h2)
+        cover = next(t for t in self.page.tables if t[0] == ["what", "count", "unit"])
+        fitted = next(r for r in cover if r[0].startswith("fitted"))
+        self.assertEqual(fitted[1].strip(), "10000")  # 5 s at 2 kHz, all moving
+        floors = next(t for t in self.page.tables if "floor used" in t[0])
+        self.assertEqual([r[0] for r in floors[1:]], ["position_error", "sin_cos", "i_dq"])
+        col = floors[0].index("from")
+        for r in floors[1:]:
+            self.assertIn(r[col].strip(), ("standstill", "second_differences"))
+        signals = next(t for t in self.page.tables if "held back / floor" in t[0])
+        self.assertEqual(len(signals), 4)
+        self.assertIn("Held-back validation", self.html)
+        self.assertIn("Whiteness", self.html)
 
     def test_title_log_name_verdict_in_words(self):
         name = os.path.basename(self.log)
@@ -181,6 +251,26 @@ class ReportHtml(unittest.TestCase):
 
     def test_notes_section(self):
         self.assertTrue(any(h.startswith("Notes") for h in self.page.h2), self.page.h2)
+
+    def test_unexplained_log_gets_the_suggested_custom_block(self):
+        # Alpha drifting in time is outside the catalog (resolver-sim --alpha-drift): unexplained,
+        # and the page carries the [[model.custom]] block that describes the residual.
+        log = os.path.join(ARGS.work, "alpha_drift.log")
+        out = os.path.join(ARGS.work, "alpha_drift.html")
+        run([os.path.join(ARGS.bin, "resolver-sim"), "-o", log, "--alpha-drift", "0.002", "-e",
+             "amplitude_imbalance:alpha=0.003", "--seed", "5"])
+        p = run([self.model, "report", log, "--html", out])
+        self.assertTrue(p.stdout.startswith("unexplained after 1 step"), p.stdout)
+        page = Page()
+        with open(out, encoding="utf-8") as f:
+            html = f.read()
+        page.feed(html)
+        self.assertEqual(page.verdict_class, "v-unexplained")
+        self.assertIn("Suggested custom effect", page.h2)
+        block = re.search(r'<pre class="custom">(.*?)</pre>', html, re.S)
+        self.assertIsNotNone(block)
+        self.assertTrue(block.group(1).startswith("[[model.custom]]\nname = &quot;"), block.group(1)[:80])
+        self.assertIn("t*sin(2*theta)", block.group(1))  # the residual changes with time at 2 theta
 
     def test_unwritable_output_names_the_file(self):
         bad = os.path.join(ARGS.work, "no-such-dir", "x.html")

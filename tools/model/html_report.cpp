@@ -10,70 +10,82 @@
 #include <stdexcept>
 
 #include "daemon/core/angles.h"
-#include "tools/model/svg_plot.h"
+#include "tools/model/report_assets.h"
+#include "tools/model/report_data.h"
 
 namespace resolver {
 
 namespace {
 
-using svg::escape;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kRadToDeg = 180.0 / kPi;
-constexpr int kAngleBins = 36;  // 10 deg bins for the dq means: ~55 samples each at 2000 series points
-
-std::string g3(double v) { return fmt::format("{:.3g}", v); }
-
-std::string join(const std::vector<std::string>& v, std::string_view sep) {
+/// Escapes & < > " ' so any text is safe in HTML text and attribute values.
+std::string escape(std::string_view text) {
   std::string o;
-  for (const auto& s : v) o += (o.empty() ? "" : std::string(sep)) + s;
+  o.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      case '\'': o += "&#39;"; break;
+      default: o += c;
+    }
+  }
   return o;
 }
 
-std::string model_name(const ModelFit& f) { return f.effects.empty() ? "(nuisance only)" : join(f.effects, " + "); }
+std::string g3(double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : std::string("–"); }
+std::string ratio(double v) { return std::isfinite(v) ? fmt::format("{:.2f}x", v) : std::string("–"); }
 
-const SignalResidual* find_signal(const ModelFit& f, std::string_view name) {
-  for (const auto& s : f.signals) {
-    if (s.signal == name) return &s;
+std::string list(const std::vector<std::string>& items) {
+  std::string o = "<ul>";
+  for (const auto& s : items) o += "<li>" + escape(s) + "</li>";
+  return o + "</ul>\n";
+}
+
+/// A table: header cells (HTML allowed: units with <sub>) and rows of cells (already HTML).
+std::string table(std::string_view cls, const std::vector<std::string>& header,
+                  const std::vector<std::vector<std::string>>& rows) {
+  std::string o = fmt::format("<table class=\"{}\"><tr>", cls);
+  for (const auto& h : header) o += "<th>" + h + "</th>";
+  o += "</tr>\n";
+  for (const auto& r : rows) {
+    o += "<tr>";
+    for (const auto& c : r) o += c.starts_with("<td") ? c : "<td>" + c + "</td>";
+    o += "</tr>\n";
   }
-  return nullptr;
+  return o + "</table>\n";
 }
 
-/// Effects of `later` that `earlier` lacks, in order.
-std::vector<std::string> added_effects(const ModelFit& earlier, const ModelFit& later) {
-  std::vector<std::string> out;
-  for (const auto& e : later.effects) {
-    if (std::find(earlier.effects.begin(), earlier.effects.end(), e) == earlier.effects.end()) out.push_back(e);
-  }
-  return out;
+std::string num_cell(const std::string& text) { return "<td class=\"num\">" + text + "</td>"; }
+
+/// Unit of each fitted signal as the tables show it.
+std::string signal_unit(std::string_view signal) {
+  if (signal == "position_error") return "rad";
+  if (signal == "i_dq") return "A";
+  return "1 (fraction of the amplitude)";
 }
 
-/// Start red, end blue, in between distinct hues: the spectrum and speed plots read left to right as "before -> after".
-std::string step_color(std::size_t i, std::size_t n) {
-  static constexpr const char* kMiddle[] = {"#e67e22", "#8e44ad", "#16a085", "#b7950b", "#7f8c8d"};
-  if (i + 1 == n) return "#1f5fa8";
-  if (i == 0) return "#c0392b";
-  return kMiddle[(i - 1) % std::size(kMiddle)];
-}
-
-std::string step_label(const DiscoveryRun& run, std::size_t i) {
-  if (i == 0) return fmt::format("step 1: {}", model_name(run.steps[0].fit));
-  return fmt::format("step {}: + {}", i + 1, join(added_effects(run.steps[i - 1].fit, run.steps[i].fit), " + "));
+std::string signal_value(std::string_view signal, double v) {
+  if (signal == "position_error" && std::isfinite(v)) return fmt::format("{:.3g} rad = {:.3g} arcmin", v, rad_to_arcmin(v));
+  return g3(v) + (signal == "i_dq" ? " A" : "");
 }
 
 // ---- words -------------------------------------------------------------------------------
 
-std::string verdict_words(const DiscoveryRun& run, double ratio) {
+std::string verdict_words(const DiscoveryRun& run, double explained_ratio) {
   const Explanation& first = run.steps.front();
   const Explanation& last = run.steps.back();
   const auto added = added_effects(first.fit, last.fit);
   const std::string added_text =
       added.empty() ? std::string()
-                    : fmt::format(" after adding {} to {}", join(added, " and "), model_name(first.fit));
+                    : fmt::format(" after adding {} to {}", fmt::join(added, " and "), model_name(first.fit));
   switch (last.verdict) {
     case Verdict::kExplained:
       return fmt::format(
           "Explained: the model {} accounts for every signal in this log to within {}x its noise floor{}.",
-          model_name(last.fit), g3(ratio), added.empty() ? "; the starting model needed nothing more" : added_text);
+          model_name(last.fit), g3(explained_ratio),
+          added.empty() ? "; the starting model needed nothing more" : added_text);
     case Verdict::kMissingEffect:
       return fmt::format("Not finished: after {} step{} the model {} still misses an effect ({}).", run.steps.size(),
                          run.steps.size() == 1 ? "" : "s", model_name(last.fit), run.stopped);
@@ -86,21 +98,55 @@ std::string verdict_words(const DiscoveryRun& run, double ratio) {
       model_name(last.fit), added_text);
 }
 
-std::string ratio_cell(const SignalResidual* s, double ratio, std::string_view unit) {
-  if (s == nullptr) return "<td class=\"na\">not fitted</td>";
-  const double x = s->rms / s->floor;
-  return fmt::format("<td class=\"{}\" title=\"residual {} {}, floor {} {}\"><b>{:.2f}x</b> floor</td>",
-                     x <= ratio ? "ok" : "bad", g3(s->rms), unit, g3(s->floor), unit, x);
+// ---- tables ------------------------------------------------------------------------------
+
+std::string coverage_table(const ModelFit& f) {
+  const SampleAccount& a = f.account;
+  auto row = [](const std::string& what, const std::string& value, const std::string& unit) {
+    return std::vector<std::string>{escape(what), num_cell(value), escape(unit)};
+  };
+  const std::vector<std::vector<std::string>> rows = {
+      row("samples in the log", std::to_string(a.samples_in), "samples"),
+      row("with an angle (and the reference, when the fit uses one): rows", std::to_string(a.rows), "samples"),
+      row("fitted: moving, not outliers, not excluded", fmt::format("<b>{}</b>", a.fitted), "samples"),
+      row("moving", std::to_string(a.moving), "samples"),
+      row("at standstill (noise floor only, never fitted)", std::to_string(a.standstill), "samples"),
+      row("outliers (impulsive; kept out of fits and floors)", std::to_string(a.outliers), "samples"),
+      row("excluded (--direction, or unusable without a reference)", std::to_string(a.excluded), "samples"),
+      row("without an angle", std::to_string(a.without_angle), "samples"),
+      row("without the reference angle", std::to_string(a.without_reference), "samples"),
+      row("time span", g3(a.span_s), "s"),
+      row("travelled while moving, electrical", g3(a.revolutions_electrical), "rev"),
+      row("travelled while moving, mechanical", g3(a.revolutions_mechanical), "rev"),
+      row("reversals of direction", std::to_string(a.reversals), ""),
+      row("standstills", std::to_string(a.standstills), ""),
+  };
+  return table("params", {"what", "count", "unit"}, rows) +
+         fmt::format("<p class=\"small\">Residuals, harmonics, speed, time and direction breakdowns and the plots "
+                     "cover the fitted samples; the noise floors use the standstill samples when the log has them. "
+                     "Held-back validation: {}. Units: {}.</p>\n",
+                     escape(a.fold_rule), escape(a.units));
 }
 
-std::string steps_table(const DiscoveryRun& run, double ratio) {
-  std::string o =
-      "<table class=\"steps\"><tr><th>step</th><th>model</th><th>position-error residual</th><th>sin/cos</th>"
-      "<th>i<sub>dq</sub></th><th>k</th><th>BIC</th><th>verdict</th><th>added next, and why</th></tr>\n";
+std::string ratio_cell(const SignalResidual* s, double explained_ratio) {
+  if (s == nullptr) return "<td class=\"na\">not fitted</td>";
+  const double x = s->rms / s->floor;
+  return fmt::format("<td class=\"{}\">{}<br><b>{}</b> floor (held back {})</td>", x <= explained_ratio ? "ok" : "bad",
+                     escape(signal_value(s->signal, s->rms)), ratio(x), ratio(s->held_back_rms / s->floor));
+}
+
+const SignalResidual* find_signal(const ModelFit& f, std::string_view name) {
+  for (const auto& s : f.signals) {
+    if (s.signal == name) return &s;
+  }
+  return nullptr;
+}
+
+std::string steps_table(const DiscoveryRun& run, double explained_ratio) {
+  std::vector<std::vector<std::string>> rows;
   for (std::size_t i = 0; i < run.steps.size(); ++i) {
     const Explanation& ex = run.steps[i];
     const ModelFit& f = ex.fit;
-    const double x = f.residual_rms_rad / f.noise_floor_rad;
     std::string next;
     if (ex.verdict == Verdict::kMissingEffect && !ex.candidates.empty() && i + 1 < run.steps.size()) {
       const Candidate& c = ex.candidates.front();
@@ -108,420 +154,258 @@ std::string steps_table(const DiscoveryRun& run, double ratio) {
     } else {
       next = escape(i + 1 == run.steps.size() ? run.stopped : "");
     }
-    o += fmt::format(
-        "<tr><td>{}</td><td><span class=\"swatch\" style=\"background:{}\"></span>{}</td>"
-        "<td class=\"{}\">{} rad = {} arcmin<br><b>{:.2f}x</b> floor ({} rad)</td>{}{}<td>{}</td><td>{:.1f}</td>"
-        "<td class=\"verdict-{}\">{}</td><td class=\"why\">{}</td></tr>\n",
-        i + 1, step_color(i, run.steps.size()), escape(model_name(f)), x <= ratio ? "ok" : "bad",
-        g3(f.residual_rms_rad), g3(rad_to_arcmin(f.residual_rms_rad)), x, g3(f.noise_floor_rad),
-        ratio_cell(find_signal(f, "sin_cos"), ratio, "of the amplitude"),
-        ratio_cell(find_signal(f, "i_dq"), ratio, "A"), f.parameters, f.bic, to_string(ex.verdict),
-        to_string(ex.verdict), next);
+    rows.push_back({std::to_string(i + 1),
+                    fmt::format("<span class=\"swatch\" style=\"background:{}\"></span>{}", step_color(i, run.steps.size()),
+                                escape(model_name(f))),
+                    ratio_cell(find_signal(f, "position_error"), explained_ratio),
+                    ratio_cell(find_signal(f, "sin_cos"), explained_ratio),
+                    ratio_cell(find_signal(f, "i_dq"), explained_ratio), num_cell(std::to_string(f.parameters)),
+                    num_cell(fmt::format("{:.1f}", f.bic)),
+                    fmt::format("<td class=\"verdict-{0}\">{0}</td>", to_string(ex.verdict)),
+                    "<td class=\"why\">" + next + "</td>"});
   }
-  return o + "</table>\n";
+  return table("steps",
+               {"step", "model", "position-error residual", "sin/cos residual [1]", "i<sub>dq</sub> residual [A]", "k",
+                "BIC", "verdict", "added next, and why"},
+               rows);
 }
 
 std::string params_table(const ModelFit& f) {
-  std::string o = "<table class=\"params\"><tr><th>parameter</th><th>value</th><th>standard error</th></tr>\n";
+  std::vector<std::vector<std::string>> rows;
   for (const auto& p : f.params) {
-    o += fmt::format("<tr><td><code>{}</code></td><td class=\"num\">{:.5g}</td><td class=\"num\">{:.2g}</td></tr>\n",
-                     escape(p.name), p.value, p.std_error);
+    rows.push_back({"<code>" + escape(p.name) + "</code>", num_cell(fmt::format("{:.5g}", p.value)),
+                    num_cell(fmt::format("{:.2g}", p.std_error)), escape(report::bare_unit(p.unit))});
   }
-  return o + "</table>\n";
+  if (rows.empty()) return "<p>The model has no fitted parameters (nuisance terms only).</p>\n";
+  return table("params", {"parameter", "value", "standard error", "unit"}, rows) +
+         fmt::format("<p class=\"small\">Standard errors {}.</p>\n",
+                     f.robust_errors ? "from the revolution-to-revolution spread of the fit's scores (robust to "
+                                       "correlated residuals)"
+                                     : "formal (too few revolutions for the revolution-to-revolution spread)");
 }
 
-std::string candidates_table(const Explanation& ex) {
-  std::string o =
-      "<details><summary>candidates ranked at the last step (lowest BIC first)</summary>\n"
-      "<table class=\"params\"><tr><th>effect</th><th>residual after [rad]</th><th>BIC drop</th>"
-      "<th>proposed</th><th>why</th></tr>\n";
-  for (const auto& c : ex.candidates) {
-    o += fmt::format(
-        "<tr><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{:.1f}</td><td>{}</td><td "
-        "class=\"why\">{}</td></tr>\n",
-        escape(c.effect), g3(c.residual_after_rad), c.bic_drop, c.proposed ? "yes" : "no", escape(c.reason));
+std::string signals_table(const ModelFit& f, double explained_ratio) {
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& s : f.signals) {
+    const double x = s.rms / s.floor;
+    const double h = s.held_back_rms / s.floor;
+    rows.push_back({escape(s.signal), escape(signal_unit(s.signal)), num_cell(escape(signal_value(s.signal, s.rms))),
+                    num_cell(escape(signal_value(s.signal, s.raw_rms))), num_cell(escape(signal_value(s.signal, s.floor))),
+                    fmt::format("<td class=\"num {}\">{}</td>", x <= explained_ratio ? "ok" : "bad", ratio(x)),
+                    num_cell(escape(signal_value(s.signal, s.held_back_rms))),
+                    fmt::format("<td class=\"num {}\">{}</td>",
+                                !std::isfinite(h) ? "na" : h <= explained_ratio ? "ok" : "bad", ratio(h)),
+                    num_cell(std::to_string(s.rows))});
   }
-  o += "</table>";
-  for (const auto& n : ex.not_evaluated) o += "<p class=\"small\">not evaluated: " + escape(n) + "</p>";
-  return o + "</details>\n";
+  return table("params",
+               {"signal", "unit", "residual rms", "before (nuisance only)", "noise floor", "residual / floor",
+                "held back rms", "held back / floor", "rows"},
+               rows) +
+         fmt::format("<p class=\"small\">Explained means every signal within {}x its floor, in-sample and held back "
+                     "(fitted on one fold of the log, evaluated on the other).</p>\n",
+                     g3(explained_ratio));
 }
 
-std::string list(const std::vector<std::string>& items) {
-  std::string o = "<ul>";
-  for (const auto& s : items) o += "<li>" + escape(s) + "</li>";
-  return o + "</ul>\n";
+std::string floors_table(const FloorReport& floors) {
+  std::vector<std::vector<std::string>> rows;
+  auto row = [&](const char* signal, const FloorEstimate& e) {
+    if (e.source.empty() || e.source == "none") return;
+    rows.push_back({signal, escape(signal_unit(signal)), num_cell(escape(signal_value(signal, e.chosen))),
+                    "<b>" + escape(e.source) + "</b>", num_cell(g3(e.second_difference)),
+                    num_cell(fmt::format("{} ({} samples)", g3(e.standstill), e.standstill_samples)),
+                    num_cell(g3(e.quantization))});
+  };
+  row("position_error", floors.rd);
+  row("sin_cos", floors.sc);
+  row("i_dq", floors.cur);
+  return table("params",
+               {"signal", "unit", "floor used", "from", "second differences", "standstill spread",
+                "quantization part"},
+               rows) +
+         "<p class=\"small\">The noise floor is the residual a perfect model would leave. From standstill: the spread "
+         "of each signal about its stretch's mean plus the quantization that motion adds (LSB²/12 per quantized "
+         "channel); from second differences: per speed bin, the rms of the second differences of a saturated "
+         "harmonic fit's residual / √6. The standstill estimate is used when the log has one.</p>\n";
 }
 
-// ---- figures -----------------------------------------------------------------------------
+std::string outliers_section(const ModelFit& f) {
+  if (f.outliers.empty()) {
+    return "<p>No outliers: no sample's second difference exceeds 12 robust standard deviations.</p>\n";
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& o : f.outliers) {
+    std::vector<std::string> t;
+    for (const double x : o.times) t.push_back(fmt::format("{:.4g}", x));
+    rows.push_back({escape(o.signal), num_cell(std::to_string(o.count)), num_cell(g3(o.largest)), num_cell(g3(o.scale)),
+                    escape(signal_unit(o.signal)), escape(fmt::format("{}", fmt::join(t, ", ")))});
+  }
+  return table("params",
+               {"signal", "samples", "largest spike", "robust σ of second differences", "unit", "first at [s]"}, rows) +
+         fmt::format("<p class=\"small\">Kept out of the fit and the floors. The position-error residual with them "
+                     "included: {} ({} the floor).</p>\n",
+                     escape(signal_value("position_error", f.rms_with_outliers_rad)),
+                     ratio(f.rms_with_outliers_rad / f.noise_floor_rad));
+}
 
-std::vector<double> scaled(const std::vector<double>& v, double k) {
-  std::vector<double> o(v.size());
-  std::transform(v.begin(), v.end(), o.begin(), [k](double a) { return a * k; });
+std::string whiteness_and_directions(const ModelFit& f) {
+  std::string o;
+  const Whiteness& w = f.whiteness;
+  if (w.lags > 0) {
+    o += fmt::format("<p><b>Whiteness</b> of the position-error residual (autocorrelation at lags 1..{} against the 99 % "
+                     "band ±{} of white noise over {} samples): {} lag{} outside, largest |ρ| = {}. {}</p>\n",
+                     w.lags, g3(w.band), w.samples, w.outside, w.outside == 1 ? "" : "s", g3(w.max_abs),
+                     w.outside == 0 ? "The residual looks like white noise."
+                                    : "Correlated residual: structure left, or noise that is not white (a filter, "
+                                      "the R/D loop); standard errors account for it when they come from the spread.");
+  }
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& d : f.directions) {
+    rows.push_back({d.direction > 0 ? "forward" : "backward", num_cell(std::to_string(d.samples)),
+                    num_cell(escape(signal_value("position_error", d.rms))), num_cell(ratio(d.rms / f.noise_floor_rad)),
+                    num_cell(escape(signal_value("position_error", d.mean)))});
+  }
+  if (!rows.empty()) {
+    o += table("params", {"direction", "samples", "residual rms", "/ floor", "residual mean"}, rows) +
+         "<p class=\"small\">An offset that flips sign with the direction is backlash or a delay.</p>\n";
+  }
   return o;
 }
 
-/// Means of y in equal bins of x over [0, 360): the ripple through the angle, with the noise averaged down.
-std::pair<std::vector<double>, std::vector<double>> binned_mean(const std::vector<double>& x_deg,
-                                                                const std::vector<double>& y) {
-  std::vector<double> sum(kAngleBins, 0.0), cnt(kAngleBins, 0.0), xc(kAngleBins), ym(kAngleBins, kNaN);
-  for (std::size_t i = 0; i < x_deg.size() && i < y.size(); ++i) {
-    const int b = std::clamp(static_cast<int>(x_deg[i] / 360.0 * kAngleBins), 0, kAngleBins - 1);
-    sum[b] += y[i];
-    cnt[b] += 1.0;
-  }
-  for (int b = 0; b < kAngleBins; ++b) {
-    xc[b] = (b + 0.5) * 360.0 / kAngleBins;
-    if (cnt[b] > 0.0) ym[b] = sum[b] / cnt[b];
-  }
-  return {xc, ym};
-}
-
-svg::Axis axis(std::string label) {
-  svg::Axis a;
-  a.label = std::move(label);
-  return a;
-}
-
-svg::Plot make_plot(std::string id, std::string title, svg::Axis x, svg::Axis y) {
-  svg::Plot p;
-  p.id = std::move(id);
-  p.title = std::move(title);
-  p.x = std::move(x);
-  p.y = std::move(y);
-  return p;
-}
-
-svg::Series make_series(std::string label, std::string color, std::vector<double> x, std::vector<double> y,
-                        svg::Mark mark = svg::Mark::kLine, double size = 1.5, double opacity = 1.0) {
-  svg::Series s;
-  s.label = std::move(label);
-  s.color = std::move(color);
-  s.x = std::move(x);
-  s.y = std::move(y);
-  s.mark = mark;
-  s.size = size;
-  s.opacity = opacity;
-  return s;
-}
-
-svg::HLine floor_line(double y, std::string label, std::string color) {
-  svg::HLine h;
-  h.y = y;
-  h.label = std::move(label);
-  h.color = std::move(color);
-  return h;
-}
-
-/// θ as the library's series has it: the reference encoder's, else the speed-smoothed ideal angle.
-svg::Axis angle_axis(bool reference) {
-  svg::Axis a = axis(reference ? "θ, resolver electrical angle from the reference encoder [deg]"
-                               : "θ, resolver electrical angle, speed-smoothed ideal [deg]");
-  a.lo = 0.0;
-  a.hi = 360.0;
-  a.tick_step = 45.0;
-  return a;
-}
-
-std::string figure(std::string_view id, std::string_view caption, const std::string& body) {
-  return fmt::format("<figure id=\"{}\">{}<figcaption>{}</figcaption></figure>\n", id, body, caption);
-}
-
-/// Log-scale spectra: the range ends this far below the floor, so a harmonic the fit
-/// removed to 1e-10 does not squeeze the ones that matter into the top of the plot.
-constexpr double kSpectrumRangeBelowFloor = 1e-3;
-
-/// [deg] Model lines connect samples at most this far apart in θ. At 2000 series points
-/// a constant-speed log has ~10 deg between samples; at high speed the decimation skips
-/// round the revolution, the lines break up, and the model's dots carry the curve.
-constexpr double kMaxLineStepDeg = 30.0;
-
-std::string fig_position_error(const DiscoveryRun& run) {
-  const ModelFit& first = run.steps.front().fit;
-  const ModelFit& last = run.steps.back().fit;
-  const ResidualSeries& s = last.series;
-  const std::size_t n = run.steps.size();
-  const auto theta = scaled(s.theta, kRadToDeg);
-  const double am = rad_to_arcmin(1.0);
-
-  svg::Plot a = make_plot("pe", "Position error ε = θ_true − θ_rd vs angle: measured and model",
-                          angle_axis(last.reference), axis("ε [arcmin]"));
-  a.height = 300;
-  if (n > 1) {
-    svg::Series m =
-        make_series("model, step 1: " + model_name(first), step_color(0, n), scaled(first.series.theta, kRadToDeg),
-                    scaled(first.series.eps_model, am), svg::Mark::kLine, 2.0);
-    m.dashed = true;
-    m.max_x_step = kMaxLineStepDeg;
-    a.series.push_back(m);
-  }
-  svg::Series m = make_series(fmt::format("model, step {}: {}", n, model_name(last)), step_color(n - 1, n), theta,
-                              scaled(s.eps_model, am), svg::Mark::kLine, 2.5);
-  m.max_x_step = kMaxLineStepDeg;
-  a.series.push_back(m);
-  a.series.push_back(make_series("", m.color, m.x, m.y, svg::Mark::kDots, 3.0));  // where the line breaks up
-  // Measured on top of the models: where they agree the dots sit on the line.
-  a.series.push_back(make_series("measured", "#222", theta, scaled(s.eps_measured, am), svg::Mark::kDots, 3.0, 0.55));
-
-  svg::Plot b = make_plot("pr", fmt::format("Residual ε − model of step {} vs angle", n), angle_axis(last.reference),
-                          axis("residual [arcmin]"));
-  b.height = 260;
-  std::vector<double> residual(s.eps_measured.size());
-  for (std::size_t i = 0; i < residual.size(); ++i) residual[i] = (s.eps_measured[i] - s.eps_model[i]) * am;
-  b.series.push_back(make_series(fmt::format("residual, step {}: {}", n, model_name(last)), step_color(n - 1, n), theta,
-                                 residual, svg::Mark::kDots, 4.0, 0.7));
-  const double fl = rad_to_arcmin(last.noise_floor_rad);
-  b.hlines.push_back(floor_line(fl, fmt::format("± noise floor (rms) {} arcmin", g3(fl)), "#222"));
-  b.hlines.push_back(floor_line(-fl, "", "#222"));
-  return figure(
-      "fig-position",
-      fmt::format(
-          "Position error against {}, {} samples (evenly decimated). The lines are the fitted ε̂(θ); the residual "
-          "is what the final model leaves, to be compared with the noise floor{}.",
-          last.reference ? "the reference encoder" : "the speed-smoothed ideal angle", s.theta.size(),
-          n > 1 ? " (the starting model's residual is the gap between the dots and the dashed line)" : ""),
-      svg::render(a) + svg::render(b));
-}
-
-std::string fig_spectrum(const DiscoveryRun& run) {
-  svg::Plot p = make_plot("spec", "Position-error residual by harmonic of θ, before and after each added effect",
-                          axis("harmonic order of θ, resolver electrical [cycles per revolution of θ]"),
-                          axis("residual amplitude [arcmin]"));
-  p.y.log = true;
-  p.height = 300;
-  for (const auto& h : run.steps.front().fit.harmonics) {
-    p.x.categories.push_back(h.order == 0 ? std::string("0 (constant)") : fmt::format("{}θ", h.order));
-  }
-  for (std::size_t i = 0; i < run.steps.size(); ++i) {
-    std::vector<double> v;
-    for (const auto& h : run.steps[i].fit.harmonics) v.push_back(rad_to_arcmin(h.amplitude));
-    p.bars.push_back({step_label(run, i), step_color(i, run.steps.size()), v});
-  }
-  const double fl = rad_to_arcmin(run.steps.back().fit.noise_floor_rad);
-  p.y.lo = fl * kSpectrumRangeBelowFloor;
-  p.hlines.push_back(floor_line(fl, fmt::format("noise floor (rms per sample) {} arcmin", g3(fl)), "#222"));
-  p.hlines.push_back(floor_line(fl / 5.0, "a fifth of the floor: harmonics named in 'where it fails'", "#999"));
-  return figure(
-      "fig-spectrum",
-      "Amplitude of each harmonic of the position-error residual, one bar per discovery step (log scale; hover a bar "
-      "for its value). A missing effect shows as bars far above the floor that drop in the step that adds it.",
-      svg::render(p));
-}
-
-std::string fig_dq_spectrum(const DiscoveryRun& run) {
-  const ModelFit& last = run.steps.back().fit;
-  const SignalResidual* dq = find_signal(last, "i_dq");
-  if (dq == nullptr || last.harmonics_id.empty()) return {};
-  svg::Plot p = make_plot("dqspec", "i_d, i_q residual by harmonic of θ_e, per step",
-                          axis("harmonic order of θ_e [cycles per motor electrical revolution]"),
-                          axis("amplitude √(A_d² + A_q²) [mA]"));
-  p.y.log = true;
-  p.height = 260;
-  for (const auto& h : last.harmonics_id)
-    p.x.categories.push_back(h.order == 0 ? std::string("0 (constant)") : fmt::format("{}θ_e", h.order));
-  for (std::size_t i = 0; i < run.steps.size(); ++i) {
-    const ModelFit& f = run.steps[i].fit;
-    std::vector<double> v;
-    for (std::size_t k = 0; k < f.harmonics_id.size() && k < f.harmonics_iq.size(); ++k) {
-      v.push_back(1e3 * std::hypot(f.harmonics_id[k].amplitude, f.harmonics_iq[k].amplitude));
+std::string candidates_table(const Explanation& ex, bool currents) {
+  std::vector<std::vector<std::string>> rows;
+  for (const auto& c : ex.candidates) {
+    std::vector<std::string> values;
+    for (const auto& p : c.params) {
+      values.push_back(fmt::format("{} = {:.4g} ± {:.2g} {}", p.name, p.value, p.std_error, report::bare_unit(p.unit)));
     }
-    p.bars.push_back({step_label(run, i), step_color(i, run.steps.size()), v});
+    std::vector<std::string> r = {"<code>" + escape(c.effect) + "</code>",
+                                  num_cell(escape(signal_value("position_error", c.residual_after_rad)))};
+    if (currents) r.push_back(num_cell(g3(c.dq_residual_after)));
+    r.insert(r.end(), {num_cell(fmt::format("{:.1f}", c.bic_drop)), num_cell(fmt::format("{:.3f}", c.err)),
+                       c.proposed ? "yes" : "no", c.reaches_floor ? "yes" : "no",
+                       escape(fmt::format("{}", fmt::join(c.fits_as_well, ", "))),
+                       "<td class=\"why\">" + escape(c.reason) + "<br><span class=\"small\">" +
+                           escape(fmt::format("{}", fmt::join(values, "; "))) + "</span></td>"});
+    rows.push_back(std::move(r));
   }
-  p.y.lo = 1e3 * dq->floor * kSpectrumRangeBelowFloor;
-  p.hlines.push_back(floor_line(1e3 * dq->floor, fmt::format("noise floor {} mA", g3(1e3 * dq->floor)), "#222"));
-  return figure(
-      "fig-dq-spectrum",
-      "The dq-current residual by harmonic of the motor electrical angle: current-sensor offsets show at 1θ_e, gain "
-      "mismatch at 2θ_e, dead time at 6θ_e.",
-      svg::render(p));
+  std::vector<std::string> header = {"effect", "position-error residual with it"};
+  if (currents) header.emplace_back("i<sub>dq</sub> residual with it [A]");
+  header.insert(header.end(), {"BIC drop", "ERR [share of the residual]", "proposed", "reaches the floor",
+                               "fits as well here", "why, and its fitted values"});
+  // Open while something is missing; folded once the model explains the log (nothing is proposed then).
+  std::string o = std::string(ex.verdict == Verdict::kExplained ? "<details>" : "<details open>") +
+                  "<summary>candidates ranked at the last step (lowest BIC first)</summary>\n" +
+                  (rows.empty() ? std::string("<p>None ranked.</p>") : table("params", header, rows));
+  for (const auto& n : ex.not_evaluated) o += "<p class=\"small\">not evaluated: " + escape(n) + "</p>";
+  if (!ex.missing_pair.empty()) {
+    o += "<p>Two effects are missing: " + escape(fmt::format("{}", fmt::join(ex.missing_pair, " and "))) +
+         " reach the floor only together.</p>";
+  }
+  return o + "</details>\n";
 }
 
-std::string fig_speed(const DiscoveryRun& run, int width) {
-  svg::Plot p = make_plot("speed", "Position-error residual vs speed, per step", axis("speed, mechanical [r/min]"),
-                          axis("residual rms [arcmin]"));
-  p.y.log = true;
-  p.width = width;
-  p.height = 280;
-  std::size_t bins = 0;
-  for (std::size_t i = 0; i < run.steps.size(); ++i) {
-    svg::Series s = make_series(step_label(run, i), step_color(i, run.steps.size()), {}, {}, svg::Mark::kLineDots, 2.0);
-    for (const auto& b : run.steps[i].fit.speed_bins) {
-      s.x.push_back(b.rpm_mid);
-      s.y.push_back(rad_to_arcmin(b.rms));
+// ---- plots -------------------------------------------------------------------------------
+
+std::string figure(const report::Plot& p) {
+  return fmt::format(
+      "<figure class=\"plot{}\" id=\"fig-{}\"><div class=\"plot-title\">{}</div>"
+      "<div class=\"chart\" data-plot=\"{}\"></div><div class=\"legend\" data-legend=\"{}\"></div>"
+      "<div class=\"tools\"><button type=\"button\" data-csv=\"{}\">download CSV</button> "
+      "<button type=\"button\" data-reset=\"{}\">reset zoom</button> <span class=\"readout\" data-readout=\"{}\"></span>"
+      "</div><figcaption>{}</figcaption></figure>\n",
+      p.half ? " half" : "", p.id, escape(p.title), p.id, p.id, p.id, p.id, p.id, escape(p.caption));
+}
+
+std::string figures(const std::vector<report::Plot>& plots) {
+  std::string o;
+  for (std::size_t i = 0; i < plots.size(); ++i) {
+    if (plots[i].half && i + 1 < plots.size() && plots[i + 1].half) {
+      o += "<div class=\"row\">" + figure(plots[i]) + figure(plots[i + 1]) + "</div>\n";
+      ++i;
+    } else {
+      o += figure(plots[i]);
     }
-    bins = std::max(bins, s.x.size());
-    p.series.push_back(std::move(s));
   }
-  const double fl = rad_to_arcmin(run.steps.back().fit.noise_floor_rad);
-  p.hlines.push_back(floor_line(fl, fmt::format("noise floor {} arcmin", g3(fl)), "#222"));
-  return figure(
-      "fig-speed",
-      fmt::format("Residual rms in {} speed bin{} (empty bins dropped). A residual that grows with speed points at "
-                  "sampling skew or the R/D tracking loop.{}",
-                  bins, bins == 1 ? "" : "s", bins <= 1 ? " This log runs at one speed: one point per step." : ""),
-      svg::render(p));
+  return o;
 }
 
-std::string fig_time(const DiscoveryRun& run, int width) {
-  svg::Plot p = make_plot("time", "Position-error residual vs time, per step",
-                          axis("time from the log's first sample [s]"), axis("residual rms [arcmin]"));
-  p.y.log = true;
-  p.width = width;
-  p.height = 280;
-  for (std::size_t i = 0; i < run.steps.size(); ++i) {
-    svg::Series s = make_series(step_label(run, i), step_color(i, run.steps.size()), {}, {}, svg::Mark::kLineDots, 2.0);
-    for (const auto& b : run.steps[i].fit.time_bins) {
-      s.x.push_back(0.5 * (b.t_lo + b.t_hi));
-      s.y.push_back(rad_to_arcmin(b.rms));
-    }
-    p.series.push_back(std::move(s));
+/// Text for an inline <script>: nothing in it may close the element early.
+std::string_view script_safe(std::string_view js, std::string_view what) {
+  if (js.find("</script") != std::string_view::npos || js.find("<!--") != std::string_view::npos) {
+    throw std::runtime_error(fmt::format("{} contains </script or <!--: it cannot be inlined", what));
   }
-  if (!run.steps.back().fit.time_bins.empty()) {  // the whole log, so the windows' centres sit inside
-    p.x.lo = 0.0;
-    p.x.hi = run.steps.back().fit.time_bins.back().t_hi;
-  }
-  const double fl = rad_to_arcmin(run.steps.back().fit.noise_floor_rad);
-  p.hlines.push_back(floor_line(fl, fmt::format("noise floor {} arcmin", g3(fl)), "#222"));
-  return figure(
-      "fig-time",
-      fmt::format("Residual rms in {} equal windows of the log. No catalog effect changes with time: a residual that "
-                  "grows or shrinks from window to window at the same speed is a drift outside the catalog "
-                  "(e.g. with temperature).",
-                  run.steps.back().fit.time_bins.size()),
-      svg::render(p));
+  return js;
 }
-
-std::string fig_dq(const DiscoveryRun& run, int width) {
-  const ModelFit& last = run.steps.back().fit;
-  const ResidualSeries& s = last.series;
-  if (s.i_d_raw.empty()) return {};
-  const auto theta = scaled(s.theta, kRadToDeg);
-  const auto panel = [&](std::string_view id, std::string_view name, const std::vector<double>& raw,
-                         const std::vector<double>& comp, const std::vector<double>& ref) {
-    svg::Plot p = make_plot(std::string(id), fmt::format("{}: raw, compensated and reference angle", name),
-                            angle_axis(last.reference), axis(fmt::format("{}, mean per 10° of θ [A]", name)));
-    p.width = width;
-    p.height = 280;
-    p.x.tick_step = 90.0;
-    auto [x1, y1] = binned_mean(theta, raw);
-    auto [x2, y2] = binned_mean(theta, comp);
-    auto [x3, y3] = binned_mean(theta, ref);
-    p.series.push_back(make_series("raw R/D angle", "#c0392b", x1, y1, svg::Mark::kLine, 2.0));
-    p.series.push_back(make_series("compensated (final model)", "#1f5fa8", x2, y2, svg::Mark::kLine, 2.0));
-    svg::Series r = make_series("reference encoder", "#222", x3, y3, svg::Mark::kLine, 1.5);
-    r.dashed = true;
-    p.series.push_back(r);
-    return svg::render(p);
-  };
-  return figure(
-      "fig-dq",
-      "dq currents (Park transform at θ_e) with three angles: the raw R/D angle, the R/D angle corrected by the final "
-      "model's ε̂, and the reference encoder; means over 10° bins of θ, so the per-sample noise averages down. An angle "
-      "error ε puts a ripple of about i_q·ε on i_d; compensation brings the blue line onto the dashed reference.",
-      "<div class=\"row\">" + panel("dqd", "i_d", s.i_d_raw, s.i_d_comp, s.i_d_ref) +
-          panel("dqq", "i_q", s.i_q_raw, s.i_q_comp, s.i_q_ref) + "</div>");
-}
-
-constexpr std::string_view kCss = R"(
-body{font:14px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,"DejaVu Sans",sans-serif;color:#1d1d1f;margin:24px auto;max-width:1108px;padding:0 16px}
-h1{font-size:24px;margin:0 0 4px}h2{font-size:18px;margin:28px 0 8px;border-bottom:1px solid #ddd;padding-bottom:4px}
-.meta{color:#555;margin:0 0 12px}code{font:13px ui-monospace,"DejaVu Sans Mono",monospace}
-.verdict{padding:10px 14px;border-radius:6px;border-left:6px solid;margin:12px 0}
-.v-explained{background:#eaf6ec;border-color:#2e8b57}.v-missing_effect{background:#fff4e0;border-color:#e67e22}.v-unexplained{background:#fdecea;border-color:#c0392b}
-table{border-collapse:collapse;margin:8px 0;width:100%}th,td{border:1px solid #ddd;padding:4px 6px;vertical-align:top;text-align:left}
-th{background:#f4f4f6}td.num{text-align:right;font-variant-numeric:tabular-nums}td.ok{background:#eaf6ec}td.bad{background:#fdecea}td.na{color:#999}
-td.why{font-size:12px;max-width:420px}.verdict-explained{color:#2e8b57;font-weight:600}.verdict-missing_effect{color:#c66a00;font-weight:600}
-.verdict-unexplained{color:#c0392b;font-weight:600}.swatch{display:inline-block;width:10px;height:10px;margin-right:6px;border-radius:2px}
-table.params{width:auto}.small{font-size:12px;color:#555;margin:2px 0}
-figure{margin:16px 0}.row{display:flex;gap:20px}.row figure{margin:16px 0;flex:1}figcaption{font-size:12px;color:#555;max-width:1000px}
-svg.plot{display:block;font:12px system-ui,"DejaVu Sans",sans-serif}svg .title{font-weight:600;font-size:13px}
-svg .tick{fill:#444;font-size:11px}svg .axis{fill:#222}svg .grid{stroke:#e4e4e4}svg .grid.minor{stroke:#f2f2f2}
-svg .frame{fill:none;stroke:#999}
-)";
 
 }  // namespace
-
-DiscoveryRun run_discovery(const DiscoveryInput& input, std::vector<std::string> effects,
-                           const DiscoveryOptions& options, int max_steps, const std::function<void(int)>& on_step) {
-  DiscoveryRun run;
-  max_steps = std::max(1, max_steps);
-  const PreparedLog log = prepare_log(input, options.prepare);  // once: every step fits the same rows
-  for (int step = 0; step < max_steps; ++step) {
-    if (on_step) on_step(step + 1);
-    try {
-      run.steps.push_back(explain_prepared(log, effects, options));
-    } catch (const std::exception& e) {
-      if (run.steps.empty()) throw;
-      run.stopped = fmt::format("adding {} failed: {}", effects.back(), e.what());
-      return run;
-    }
-    const Explanation& ex = run.steps.back();
-    if (ex.verdict != Verdict::kMissingEffect || ex.candidates.empty()) {
-      run.stopped = ex.verdict == Verdict::kExplained ? "done: every signal is at the noise floor"
-                                                      : "done: no catalog effect explains the rest of the residual";
-      return run;
-    }
-    effects.push_back(ex.candidates.front().effect);
-  }
-  run.stopped = fmt::format("stopped at the limit of {} step{}; {} is proposed next", max_steps,
-                            max_steps == 1 ? "" : "s", effects.back());
-  return run;
-}
-
-std::string summarize_discovery(const DiscoveryRun& run) {
-  const ModelFit& f = run.steps.back().fit;
-  return fmt::format("{} after {} step{}: {}, position-error residual {} rad = {} arcmin ({:.2f}x floor)",
-                     to_string(run.steps.back().verdict), run.steps.size(), run.steps.size() == 1 ? "" : "s",
-                     model_name(f), g3(f.residual_rms_rad), g3(rad_to_arcmin(f.residual_rms_rad)),
-                     f.residual_rms_rad / f.noise_floor_rad);
-}
 
 std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, std::string_view log_path,
                               double explained_ratio) {
   const Explanation& first = run.steps.front();
   const Explanation& last = run.steps.back();
+  const ModelFit& f = last.fit;
   const std::string name = std::string(log_path.substr(log_path.find_last_of('/') + 1));
   std::vector<std::string> signals;
-  for (const auto& s : last.fit.signals) signals.push_back(s.signal);
+  for (const auto& s : f.signals) signals.push_back(s.signal);
 
   std::string o =
       "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta name=\"viewport\" "
       "content=\"width=device-width\">\n";
-  o += fmt::format("<title>resolver-model report: {}</title>\n<style>{}</style></head><body>\n", escape(name), kCss);
+  o += fmt::format("<title>resolver-model report: {}</title>\n<style>{}</style>\n<style>{}</style></head><body>\n",
+                   escape(name), report_assets::uplot_css(), report_assets::page_css());
   o += fmt::format("<h1>Resolver model discovery report: {}</h1>\n", escape(name));
   o += fmt::format(
       "<p class=\"meta\">log <code>{}</code> · {} samples from {} frames · p<sub>r</sub> = {}, p = {}{} · "
       "position error against {} · signals fitted: {}</p>\n",
       escape(log_path), log.input.samples.size(), log.frames, log.input.p_r, log.input.p,
       log.bench_info ? " (BENCH_INFO)" : " (assumed)",
-      last.fit.reference ? "the reference encoder" : "the speed-smoothed ideal angle", escape(join(signals, ", ")));
+      f.reference ? "the reference encoder" : "the speed-smoothed ideal angle",
+      escape(fmt::format("{}", fmt::join(signals, ", "))));
   o += fmt::format("<div class=\"verdict v-{}\"><b>{}</b><br><span class=\"small\">final step: {}</span></div>\n",
                    to_string(last.verdict), escape(verdict_words(run, explained_ratio)), escape(last.summary));
+  o += "<nav class=\"small\">Contents: <a href=\"#coverage\">what the statistics cover</a> · <a href=\"#steps\">steps</a> · "
+       "<a href=\"#final\">final model</a> · <a href=\"#plots\">plots</a> · <a href=\"#floors\">floors</a> · "
+       "<a href=\"#candidates\">candidates</a> · <a href=\"#notes\">notes</a></nav>\n";
 
-  o += "<h2>Discovery, step by step</h2>\n";
+  o += "<h2 id=\"coverage\">What the statistics cover</h2>\n" + coverage_table(f);
+
+  o += "<h2 id=\"steps\">Discovery, step by step</h2>\n";
   o += fmt::format(
       "<p class=\"small\">Each step fits the model, compares each signal's residual with its noise floor (explained: "
-      "at most {}x), ranks the catalog effects not yet in the model by BIC, and adds the best one while the verdict is "
-      "missing_effect. k: fitted parameters including nuisance terms. {}.</p>\n",
+      "at most {}x, held back too), ranks the catalog effects not yet in the model by BIC, and adds the best one "
+      "while the verdict is missing_effect. k: fitted parameters including nuisance terms. {}.</p>\n",
       g3(explained_ratio), escape(run.stopped));
   o += steps_table(run, explained_ratio);
   if (!first.where_it_fails.empty()) {
     o += fmt::format("<p><b>Where the {} fails</b></p>", run.steps.size() > 1 ? "starting model" : "model") +
          list(first.where_it_fails);
   }
-  if (run.steps.size() > 1 && !last.where_it_fails.empty())
+  if (run.steps.size() > 1 && !last.where_it_fails.empty()) {
     o += "<p><b>Where the final model fails</b></p>" + list(last.where_it_fails);
+  }
 
-  o += fmt::format("<h2>Final model: {}</h2>\n", escape(model_name(last.fit)));
-  o += params_table(last.fit) + candidates_table(last);
+  if (!last.suggested_custom.empty()) {
+    o += "<h2 id=\"custom\">Suggested custom effect</h2>\n<p>No catalog effect explains the residual. This "
+         "<code>[[model.custom]]</code> block describes it; paste it into the resolverd config and add its name to "
+         "<code>[model] effects</code>:</p>\n<pre class=\"custom\">" +
+         escape(last.suggested_custom) + "</pre>\n";
+  }
+  o += fmt::format("<h2 id=\"final\">Final model: {}</h2>\n", escape(model_name(f)));
+  o += params_table(f) + signals_table(f, explained_ratio);
 
-  o += "<h2>Plots</h2>\n";
-  // Two plots side by side in the 1108 px content width (body max-width minus padding).
-  constexpr int kHalf = 544;
-  o += fig_position_error(run) + fig_spectrum(run);
-  o += "<div class=\"row\">" + fig_speed(run, kHalf) + fig_time(run, kHalf) + "</div>\n";
-  o += fig_dq_spectrum(run);
-  const std::string dq = fig_dq(run, kHalf);
-  o += dq;
+  const std::vector<report::Plot> plots = report::report_plots(run);
+  o += "<h2 id=\"plots\">Plots</h2>\n"
+       "<p class=\"small\">Drag across a plot to zoom into that range, turn the mouse wheel to zoom about the "
+       "pointer, shift-drag to pan, double-click (or <i>reset zoom</i>) to see it all; plots of the same angle zoom "
+       "together. Click a legend entry to show or hide it (the individual samples start hidden). <i>download CSV</i> "
+       "saves the plot's data: one row per point, with its series, in the units of the axes.</p>\n"
+       "<noscript><p class=\"bad\">The plots are drawn by the page's script: enable JavaScript to see them. The "
+       "tables do not need it.</p></noscript>\n";
+  o += figures(plots);
+
+  o += "<h2 id=\"floors\">Noise floors, outliers, whiteness, directions</h2>\n" + floors_table(f.floors) +
+       outliers_section(f) + whiteness_and_directions(f);
+  o += "<h2 id=\"candidates\">Candidates</h2>\n" + candidates_table(last, f.currents_used);
 
   std::vector<std::string> notes = log.notes;
   if (log.bad_lines > 0) notes.push_back(fmt::format("{} malformed log lines skipped", log.bad_lines));
@@ -534,14 +418,21 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
   for (const auto& n : last.not_evaluated) {
     if (n.find(": needs ") != std::string::npos) notes.push_back("not evaluated: " + n);
   }
-  if (dq.empty()) notes.emplace_back("no dq-current plot: it needs phase currents and the reference angle");
-  if (notes.empty())
+  if (f.series.i_d_ref.empty()) notes.emplace_back("no dq-current plots: they need phase currents and the reference angle");
+  if (notes.empty()) {
     notes.emplace_back("none: the log has the R/D angle, sin/cos envelopes, the reference angle and phase currents");
-  o += "<h2>Notes: what the log lacks, assumptions</h2>\n" + list(notes);
-  o +=
-      "<p class=\"small\">Noise floor: rms of second differences of a saturated per-speed Fourier fit's residual / √6, "
-      "estimated from the same data. BIC = n ln(RSS<sub>w</sub>/n) + k ln n over all weighted rows. Written by "
-      "<code>resolver-model report</code>.</p>\n";
+  }
+  o += "<h2 id=\"notes\">Notes: what the log lacks, assumptions</h2>\n" + list(notes);
+  o += fmt::format(
+      "<p class=\"small\">BIC = n ln(RSS<sub>w</sub>/n) + k ln n over all weighted rows; ERR: the share of the model's "
+      "weighted residual a candidate removes. Written by <code>resolver-model report</code>. Plots drawn with uPlot "
+      "{} (MIT licence, embedded in this page with its notice).</p>\n",
+      escape(report_assets::uplot_version()));
+  o += "<script type=\"application/json\" id=\"report-data\">{\"plots\":" + report::plots_json(plots) + "}</script>\n";
+  o += fmt::format("<script>/*! uPlot {}\n{}\n*/\n{}</script>\n", report_assets::uplot_version(),
+                   script_safe(report_assets::uplot_license(), "uPlot's LICENSE"),
+                   script_safe(report_assets::uplot_js(), "uPlot.iife.min.js"));
+  o += fmt::format("<script>{}</script>\n", script_safe(report_assets::page_js(), "report_page.js"));
   return o + "</body></html>\n";
 }
 

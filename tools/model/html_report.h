@@ -1,43 +1,23 @@
-// resolver-model report: the discovery loop of DESIGN 7 run to its end on one log,
-// and one self-contained HTML page of it (inline CSS and SVG; no JavaScript, no
-// external files, so it can be mailed or archived with the log).
+// resolver-model report: one self-contained HTML page of a discovery run
+// (discovery_run.h): verdict, what the statistics cover, the steps, the final
+// model's parameters with units, residuals against the noise floors and where the
+// floors come from, held-back validation, outliers, whiteness, the candidates, the
+// suggested custom effect, and interactive plots (report_data.h: binned means with a
+// spread band over the model; one residual panel per step; spectra; i_d, i_q vs θ_e).
 //
-//   run_discovery:  model ─► explain_model ─► verdict missing_effect? ─► add the best
-//                   candidate ─► explain again ... (at most max_steps passes)
-//   format_model_html: the steps as a table, the final model's parameters, and plots:
-//                   position error vs angle (measured, model, residual), residual
-//                   spectrum by harmonic per step, residual vs speed per step, dq
-//                   currents with the raw, compensated and reference angle; notes.
+// One file, no external reference: uPlot (npm, pinned in web/package-lock.json) and
+// the page's script and style are embedded at build time (report_assets.h); the
+// plots' data is one inline JSON element. Zoom (drag, wheel), pan (shift-drag),
+// reset (double-click) and a CSV download per plot are in web/report_page.js.
 #pragma once
 
-#include <functional>
 #include <string>
 #include <string_view>
-#include <vector>
 
-#include "daemon/core/discovery/model_discovery.h"
+#include "tools/model/discovery_run.h"
 #include "tools/model/log_samples.h"
 
 namespace resolver {
-
-struct DiscoveryRun {
-  /// One explain_model pass per step: first the starting model, last the final one.
-  /// While a step's verdict is missing_effect, its first candidate is what the next step adds.
-  std::vector<Explanation> steps;
-  std::string stopped;  ///< why the loop ended, in words
-};
-
-/// Explains `effects`, then adds the best candidate and explains again while the
-/// verdict is missing_effect, for at most max_steps passes. on_step(k) (may be empty)
-/// is called before pass k = 1, 2, ...; options.progress sees the fraction of that
-/// pass. Throws like explain_model when the starting model cannot be fitted; a later
-/// step that cannot ends the run, and `stopped` says why.
-[[nodiscard]] DiscoveryRun run_discovery(const DiscoveryInput& input, std::vector<std::string> effects,
-                                         const DiscoveryOptions& options, int max_steps,
-                                         const std::function<void(int)>& on_step = {});
-
-/// One line for the terminal: verdict, steps, final model and its residual.
-[[nodiscard]] std::string summarize_discovery(const DiscoveryRun& run);
 
 /// The HTML page. `log_path` is shown as given; `explained_ratio` is the option the run used.
 [[nodiscard]] std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, std::string_view log_path,

@@ -2,6 +2,7 @@
 //   resolver-model fit LOG [--effects a,b] [--json]
 //   resolver-model explain LOG [--effects a,b] [--json]
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
+//   resolver-model export-data LOG [--effects a,b] --csv OUT.csv | --mat OUT.mat
 // All take --config FILE: a resolverd config whose [layout] (DBC, signal map),
 // [bench] pole pairs and [model] effects apply (logs of a user's own layout).
 // Reads the log (default bench layout), fits the named catalog effects
@@ -27,6 +28,7 @@
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
 #include "daemon/service/table_file.h"
+#include "tools/model/export_data.h"
 
 #include <ctime>
 #include <fmt/format.h>
@@ -95,7 +97,7 @@ std::vector<std::string> split_effects(const std::vector<std::string>& args) {
 /// `report`: the discovery steps, the HTML page, one summary line and where it went.
 int write_report(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
                  resolver::DiscoveryOptions options, int max_steps, const std::string& html_out) {
-  options.series_points = 2000;  // per-sample plots: enough to show the ripple, ~100 kB per dotted plot
+  options.series_points = 4000;  // the samples overlay: ~22 per 2 deg angle bin (report_data.h)
   resolver::DiscoveryRun run;
   {
     std::optional<ProgressBar> bar;  // one per step: the number of steps is not known ahead
@@ -140,7 +142,8 @@ int run(int argc, char** argv) {
                "  resolver-model fit build/demo/demo.log\n"
                "  resolver-model explain build/demo/demo.log\n"
                "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json\n"
-               "  resolver-model report build/demo/demo.log --html demo.html"};
+               "  resolver-model report build/demo/demo.log --html demo.html\n"
+               "  resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat"};
   app.require_subcommand(1);
   app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
@@ -185,9 +188,19 @@ int run(int argc, char** argv) {
   report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)")->delimiter(',');
   report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
   report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
+  CLI::App* export_data = app.add_subcommand(
+      "export-data", "write the log's samples, the fitted model's prediction and residual per sample, and the "
+                     "parameters with units: CSV (MATLAB readtable, pandas) and/or MATLAB .mat");
+  std::string csv_out, mat_out;
+  export_data->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+  export_data->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)")->delimiter(',');
+  export_data->add_option("--csv", csv_out, "CSV of the samples [one header line, units in the column names]; the "
+                                            "parameters go to OUT's stem + .params.csv");
+  export_data->add_option("--mat", mat_out, "MATLAB MAT-5 file: structs samples, units, descriptions, params, info");
   add_config(fit);
   add_config(explain);
   add_config(report);
+  add_config(export_data);
   add_slicing(fit);
   add_slicing(explain);
   add_slicing(report);
@@ -205,9 +218,14 @@ int run(int argc, char** argv) {
   exporter->add_option("--out", export_out, "file to write (default: standard output)");
   add_config(exporter);
   add_slicing(exporter);
+  add_slicing(export_data);
   CLI11_PARSE(app, argc, argv);
 
   const bool do_explain = explain->parsed();
+  if (export_data->parsed() && csv_out.empty() && mat_out.empty()) {
+    std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
+    return 2;
+  }
   try {
     resolver::DaemonConfig config;
     if (!config_path.empty()) config = resolver::load_daemon_config(config_path);  // throws naming file and key
@@ -226,6 +244,10 @@ int run(int argc, char** argv) {
     options.prepare.moving_only = moving_only;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
     if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
+    if (export_data->parsed()) {
+      std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
+      return 0;
+    }
     resolver::Explanation ex;
     {
       ProgressBar bar("fitting");
