@@ -135,6 +135,10 @@ for _h_ in HIDDEN.values():
 
 # Controls: ({generator: generator arguments}, profiles, why a generator is missing).
 CONTROLS = {
+    # Nothing hidden beyond the modelled imbalance: on every profile "explained", nothing
+    # proposed (a candidate here would be a false discovery).
+    "control_alpha_only": ({"sim": [], "benchgen": []},
+                           ("const", "oab3", "oab1", "steps", "ramps", "reversals", "angle1"), ""),
     # Spikes of 3000 counts (0.115 of the amplitude) at 2/s on the sin channel: over 5 s
     # ~10 spikes in 10000 samples add sqrt(10/10000) x 0.115 = 3.6e-3 rms to sin/cos,
     # 45x its floor: they matter, so the log must never be "explained".

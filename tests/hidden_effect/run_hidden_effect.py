@@ -236,6 +236,12 @@ def control_case(check, bin_dir, log, case, config, work):
     first, _ = explain(bin_dir, log, config=config)
     best = first_candidate(first)
     print(f"  default model: verdict {first['verdict']}, first {describe(best)}")
+    if case == "control_alpha_only":
+        check("verdict", first["verdict"] == "explained", f"alpha only: explained (got {first['verdict']})")
+        proposed = [c["effect"] for c in first["candidates"] if c["proposed"]]
+        check("nothing_proposed", not proposed, f"alpha only: nothing proposed (got {proposed})")
+        check_floor(check, first, "default", "alpha only")
+        return
     if case.startswith("control_outliers"):
         check("verdict", first["verdict"] != "explained", f"spikes: not explained (got {first['verdict']})")
         n = sum(o["count"] for o in first["outliers"])
