@@ -14,6 +14,10 @@ PACKAGES=(
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
   chromium  # headless, screenshots the resolver-model HTML report (tests/model)
+  # packaging (cmake/Packaging.cmake, tests/install): man pages from --help, the
+  # .deb's shared-library dependencies (dpkg-shlibdeps), systemd-analyze for the
+  # installed units, /bin/kill their ExecReload= names; numpy for resolver_lcm's arrays
+  help2man dpkg-dev systemd procps
 )
 
 missing=()

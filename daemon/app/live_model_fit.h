@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <future>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -59,10 +60,20 @@ class LiveModelFit {
   /// The last published message (verdict empty before the first window).
   [[nodiscard]] const model_fit_t& last() const { return last_; }
 
+  /// The model a window fitted since the last call (nullopt: none new). The
+  /// pipeline hands it to the processor, which compensates with it.
+  struct FittedModel {
+    Model model;
+    std::int64_t samples = 0;
+    double revolutions = 0.0;
+  };
+  [[nodiscard]] std::optional<FittedModel> take_model();
+
  private:
   struct Result {
     model_fit_t message;
     std::string error;  ///< why the window could not be fitted ("" = fitted)
+    std::optional<FittedModel> fitted;
   };
   void start(DiscoveryInput window, const Stamp& stamp);
   void publish_ready(bool wait);
@@ -78,6 +89,7 @@ class LiveModelFit {
   model_fit_t last_{};
   std::uint32_t since_poll_ = 0;
   Counters counters_;
+  std::optional<FittedModel> pending_model_;
 };
 
 }  // namespace resolver

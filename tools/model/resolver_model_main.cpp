@@ -28,6 +28,7 @@
 #include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -113,6 +114,7 @@ int run(int argc, char** argv) {
                "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json\n"
                "  resolver-model report build/demo/demo.log --html demo.html"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
   std::vector<std::string> effects_args;
   std::string config_path;
@@ -125,6 +127,17 @@ int run(int argc, char** argv) {
                     "comma-separated catalog effects of the model (default amplitude_imbalance); fittable: " + fittable)
         ->delimiter(',');
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
+  };
+  std::string direction = "both";
+  bool moving_only = false;
+  auto add_slicing = [&](CLI::App* sub) {
+    sub->add_option("--direction", direction,
+                    "fit only the samples moving this way: forward, backward or both (default both); the others are "
+                    "counted as excluded")
+        ->check(CLI::IsMember({"forward", "backward", "both"}));
+    sub->add_flag("--moving-only", moving_only,
+                  "leave standstill samples out of everything, the noise floor too (default: they give the floor "
+                  "and never enter a fit)");
   };
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config_path,
@@ -147,6 +160,9 @@ int run(int argc, char** argv) {
   add_config(fit);
   add_config(explain);
   add_config(report);
+  add_slicing(fit);
+  add_slicing(explain);
+  add_slicing(report);
   CLI11_PARSE(app, argc, argv);
 
   const bool do_explain = explain->parsed();
@@ -161,6 +177,11 @@ int run(int argc, char** argv) {
       samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config);
     }
     resolver::DiscoveryOptions options;
+    options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
+    options.prepare.direction = direction == "forward"    ? resolver::DirectionFilter::kForward
+                                : direction == "backward" ? resolver::DirectionFilter::kBackward
+                                                          : resolver::DirectionFilter::kBoth;
+    options.prepare.moving_only = moving_only;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
     resolver::Explanation ex;
     {

@@ -169,17 +169,22 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
   }
   if (log.reference) {
     for (int k : top_orders(fit.harmonics_mech, se, 1, 3)) {
+      if (k % log.p_r == 0) continue;  // order k of theta_m is order k / p_r of theta: already in the list
       dict.push_back(harmonic_term("sin", k, "theta_m"));
       dict.push_back(harmonic_term("cos", k, "theta_m"));
     }
     if (!fit.harmonics.empty() && fit.harmonics.front().amplitude > kSignificance * se) dict.emplace_back("1");
   }
-  const int top = theta_orders.empty() ? 0 : theta_orders.front();
+  // A modulation (by time or speed) of the resolver's most common error, 2 theta,
+  // and of the residual's strongest order: a drift of alpha averages out of the
+  // residual's harmonics but not out of t*sin(2 theta).
+  std::vector<int> modulated_orders{2};
+  if (!theta_orders.empty() && theta_orders.front() != 2) modulated_orders.push_back(theta_orders.front());
   auto modulated = [&](const std::string& by) {
     dict.push_back(by);
-    if (top > 0) {
-      dict.push_back(by + "*" + harmonic_term("sin", top, "theta"));
-      dict.push_back(by + "*" + harmonic_term("cos", top, "theta"));
+    for (int k : modulated_orders) {
+      dict.push_back(by + "*" + harmonic_term("sin", k, "theta"));
+      dict.push_back(by + "*" + harmonic_term("cos", k, "theta"));
     }
   };
   if (fit.time_bins.size() > 1) {
@@ -215,10 +220,16 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
     out = fit_prepared(log, refs, o);
   };
   ModelFit all;
-  try {
-    fit_with(dict, all);
-  } catch (const std::invalid_argument&) {
-    return "";
+  // Terms the log cannot separate (from each other or the model) are dropped from
+  // the end of the list, the least specific first, until the fit is possible.
+  for (;;) {
+    try {
+      fit_with(dict, all);
+      break;
+    } catch (const std::invalid_argument& e) {
+      dict.pop_back();
+      if (dict.empty()) return "";
+    }
   }
   std::vector<std::string> kept;
   for (std::size_t i = 0; i < dict.size(); ++i) {

@@ -32,8 +32,8 @@ ModelTerm parse_one(std::string_view ref, const CustomEffects* customs) {
   const Effect* e = find_effect(name);
   if (e == nullptr && customs != nullptr) e = customs->find(name);
   if (e == nullptr) {
-    throw std::invalid_argument(fmt::format("effect '{}' is not in the effect catalog or the config's "
-                                            "[[model.custom]] blocks; fittable effects: {}",
+    throw std::invalid_argument(fmt::format("'{}' is not a fittable catalog effect or a [[model.custom]] name; one "
+                                            "of: {}",
                                             name, fittable_names(customs)));
   }
   if (!e->fittable()) {
