@@ -66,14 +66,16 @@ class Profile:
         return n + sum(1 for (_, b, _), (c, _, _) in zip(segs, segs[1:]) if b * c < 0)
 
 
-OUT_AND_BACK = "0:1,60:3,0:1,-60:3,0:1"
+# Short logs (the matrix runs ~200 cases): 3 mechanical revolutions each way, 0.5 s
+# holds (1000 standstill samples each for the noise floor).
+OUT_AND_BACK = "0:0.5,120:1.5,0:0.5,-120:1.5,0:0.5"
 PROFILES = {p.name: p for p in [
-    Profile("const", "200:5", 3, "the default bench: constant 200 r/min"),
+    Profile("const", "200:3", 3, "the default bench: constant 200 r/min"),
     Profile("oab3", OUT_AND_BACK, 3, "out and back with standstills, p_r = 3"),
     Profile("oab1", OUT_AND_BACK, 1, "out and back with standstills, a 1X resolver"),
     Profile("steps", "100:1.5,300:1.5,600:1.5", 3, "speed steps"),
-    Profile("ramps", "0:0.5,0-600:2,600:1,600-0:2,0:0.5", 3, "ramps from and to standstill"),
-    Profile("reversals", "120:1.5,120--120:0.5,-120:1.5,-120-120:0.5,120:1.5,60:1,-60:1", 3,
+    Profile("ramps", "0:0.25,0-600:1.5,600:0.5,600-0:1.5,0:0.25", 3, "ramps from and to standstill"),
+    Profile("reversals", "120:1,120--120:0.5,-120:1,-120-120:0.5,120:1,60:0.5,-60:0.5", 3,
             "reversals through ramps and one step reversal"),
     # The tracking loop needs a wide speed range (its filtering grows with speed) and
     # ramps, not steps: a step kicks a type-II loop into a transient.
