@@ -1,11 +1,14 @@
 """The hidden-effect matrix (issues 13 and 14): which effect, at what size, on which profiles,
 and where the physics makes two effects indistinguishable.
 
-Sizes: every hidden effect is 10-200x the position noise floor (~2.6e-5 rad: 16-bit R/D
+Sizes: every hidden effect is at least 10x the position noise floor (~2.6e-5 rad: 16-bit R/D
 rounding 2 pi / 2^16 / sqrt 12 = 2.8e-5 rad and sin/cos noise 2 counts / 26000 = 7.7e-5 of the
-amplitude), so it is named with a wide margin, while the cross terms with the 0.3 %
-amplitude imbalance every log carries (second order, alpha x size <= 0.003 x 0.002 =
-6e-6 rad) stay far below the floor, so the refit can reach it.
+amplitude), so it is named with a wide margin, while the cross terms of the winding effects
+with the 0.3 % amplitude imbalance every log carries (second order, alpha x size <= 0.003 x
+0.002 = 6e-6 rad) stay far below the floor, so the refit can reach it. The motion effects
+are large on purpose (mounting offset 0.05 rad, delay 0.5 ms = up to 0.09 rad at 600 r/min,
+backlash 6e-3 rad), as on real benches: they turn the frame in which the resolver's own
+errors appear by that much, and a model must carry that.
 """
 from dataclasses import dataclass, field
 

@@ -14,9 +14,9 @@ imbalance, noise and the hidden effect; then
   2. `explain --effects amplitude_imbalance,<first candidate>` says `explained` with every
      signal's residual, fitted and held back, <= 1.5x its noise floor (issue 4's limit).
 
-Controls: spikes on top of a fitted model are never `explained`; drifting alpha stays
-`unexplained`, and its `suggested_custom` block, appended to a config, brings the residual
-to the floor.
+Controls: alpha alone is `explained` with nothing proposed on every profile; spikes on
+top of a fitted model are never `explained`; drifting alpha stays `unexplained`, and its
+`suggested_custom` block, appended to a config, brings the residual to the floor.
 
 Checks known to fail are listed with their reason in matrix.XFAIL; they are printed at the
 end and do not fail the test, but an entry whose checks all pass (XPASS) does, so it goes.
@@ -42,6 +42,7 @@ BENCHGEN = os.path.join(REPO, "tests", "independent", "benchgen.py")
 SYSTEM_PYTHON = "/usr/bin/python3"  # benchgen needs Debian's numpy and python-can
 LIMIT = 1.5  # issue 4: "explained" means every residual <= 1.5x its noise floor
 SEED = "7"
+SAMPLE_RATE_HZ = 2000.0  # both generators' default
 # Standstill detection: a hold's first and last samples may be taken as moving (the speed
 # is estimated from differences across a few samples). At the 2 kHz sample rate 10
 # samples = 5 ms per hold edge; a real misclassification (noise counted as motion, issue
@@ -98,8 +99,8 @@ def generate(generator, bin_dir, log, profile, args):
         cmd = [os.path.join(bin_dir, "resolver-sim")] + common
         # resolver-sim's chain has an R/D loop (omega_n = 3000 rad/s) unless told otherwise;
         # benchgen's converter is ideal unless given one. Only the tracking_loop case hides
-        # a loop: a speed step kicks it into a transient of ~delta omega / omega_n (6e-3 rad
-        # for 0 -> 60 r/min at p_r = 3), a second hidden effect.
+        # a loop: a speed step kicks it into a transient of ~delta omega / omega_n (1.3e-2 rad
+        # for 0 -> 120 r/min at p_r = 3), a second hidden effect.
         if not any(a.startswith("tracking_loop") for a in args):
             cmd += ["-e", "tracking_loop:omega_n=0"]
     else:
@@ -176,7 +177,7 @@ def hidden_case(check, bin_dir, log, hidden, profile, config):
     first, _ = explain(bin_dir, log, config=config)
     best = first_candidate(first)
     print(f"  default model: verdict {first['verdict']}, first {describe(best)}")
-    check_covers(check, first, profile, 2000.0)
+    check_covers(check, first, profile, SAMPLE_RATE_HZ)
     twins, why = hidden.twins.get(profile.name, ((), ""))
     if why:
         print(f"  twins: {hidden.refs[0]} ~ {', '.join(twins)}: {why}")
@@ -213,6 +214,8 @@ def hidden_case(check, bin_dir, log, hidden, profile, config):
         explicit, err = explain(bin_dir, log, ["amplitude_imbalance", hidden.refs[0]], config, allow_fail=True)
         if check("explicit_runs", explicit is not None,
                  f"explain --effects amplitude_imbalance,{hidden.refs[0]} runs ({err})"):
+            # The same model on the same log is the same deterministic fit: equal to
+            # rounding (1e-9 rad is 4 orders below the floor).
             check("explicit_same", abs(explicit["residual_rms_rad"] - after["residual_rms_rad"]) <= 1e-9,
                   f"{hidden.refs[0]} and {ref} give the same fit ({explicit['residual_rms_rad']:.4g} vs "
                   f"{after['residual_rms_rad']:.4g} rad)")
@@ -274,8 +277,8 @@ def control_case(check, bin_dir, log, case, config, work):
     pe = next(s for s in after["signals"] if s["signal"] == "position_error")
     before = next(s for s in first["signals"] if s["signal"] == "position_error")
     check("custom_refit", pe["rms"] <= LIMIT * pe["floor"],
-          f"custom refit: position error {before['rms'] / before['floor']:.2f}x -> {pe['rms'] / pe['floor']:.2f}x floor "
-          f"<= {LIMIT}")
+          f"custom refit: position error {before['rms'] / before['floor']:.2f}x -> "
+          f"{pe['rms'] / pe['floor']:.2f}x floor <= {LIMIT}")
 
 
 def cases_of(case):
@@ -325,13 +328,14 @@ def main():
         print(f"  ({time.monotonic() - t0:.1f} s)")
         failures += check.failures
         xfails += check.xfails
-    xpasses = [f"{', '.join(XFAIL[i][0])}: {XFAIL[i][1]}" for i, (n, bad) in sorted(ledger.items()) if bad == 0]
+    xpasses = [f"{', '.join(XFAIL[i][0])}: {XFAIL[i][1]}" for i, (_, bad) in sorted(ledger.items()) if bad == 0]
     if xfails:
         print(f"\nXFAIL ({len(xfails)}: expected failures, each with its reason):")
         for x in xfails:
             print("  " + x)
     if xpasses:
-        print(f"\nXPASS ({len(xpasses)}: every check of these XFAIL entries passed; remove them from matrix.XFAIL):")
+        print(f"\nXPASS ({len(xpasses)}: every check of these XFAIL entries passed; remove them from "
+              "matrix.XFAIL):")
         for x in xpasses:
             print("  " + x)
     if failures:
