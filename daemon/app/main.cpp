@@ -15,6 +15,7 @@
 #include "daemon/app/run_report.h"
 #include "daemon/app/stop_flag.h"
 #include "daemon/service/calibration_store.h"
+#include "daemon/service/table_file.h"
 #include "daemon/service/sd_notify.h"
 #include "daemon/service/program_version.h"
 
@@ -59,6 +60,11 @@ static int run(int argc, char** argv) {
                  "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
   app.add_option("--report", report_path, "also write the end-of-run report as JSON to this file");
   app.add_flag("--quiet", quiet, "no progress lines on stderr");
+  std::string calibration_file;
+  app.add_option("--calibration", calibration_file,
+                 "compensate with a table exported by 'resolver-model export LOG --format csv' instead of the live "
+                 "estimate (the estimator still runs and publishes)")
+      ->check(CLI::ExistingFile);
   std::string state_dir;
   app.add_option("--state-dir", state_dir,
                  "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
@@ -88,6 +94,17 @@ static int run(int argc, char** argv) {
     return 2;
   }
 
+  if (!calibration_file.empty()) {
+    try {
+      CalibrationTable table = read_table_csv(calibration_file);
+      std::cerr << "resolverd: compensating with the table " << calibration_file << " (" << table.correction.size()
+                << " points, p_r " << table.p_r << ", interpolation error " << table.interpolation_error << " rad)\n";
+      pipeline->use_table(std::move(table));
+    } catch (const std::exception& e) {
+      std::cerr << "resolverd: " << e.what() << "\n";
+      return 2;
+    }
+  }
   if (!state_dir.empty()) {
     const LoadResult loaded = load_calibration(state_dir);
     if (loaded.status == LoadResult::Status::kLoaded) {

@@ -207,7 +207,7 @@ void Pipeline::on_sample(const BenchSample& sample) {
   const SampleInput in = to_input(sample, sample_time(sample));
   const SampleOutput out = processor_.process(in);
   if (model_fit_) feed_model_fit(in, sample);
-  summary_.add(out, processor_);
+  summary_.add(out, processor_, in.t);
   if (!out.has_angle) return;
 
   const bool angle_due = sample.index % config_.angle_decimation == 0;

@@ -72,6 +72,10 @@ class Pipeline {
   void tick(std::int64_t now_us);
   /// Compensate with a persisted alpha until the estimator converges.
   void seed_alpha(double alpha) { processor_.seed_alpha(alpha); }
+  /// Compensate with a persisted or loaded model until the live fit has one.
+  void seed_model(Model model) { processor_.set_model(std::move(model), 0, 0.0); }
+  /// Compensate with an exported table (resolverd --calibration).
+  void use_table(CalibrationTable table) { processor_.set_table(std::move(table)); }
   /// Cumulative frames dropped by the kernel (SO_RXQ_OVFL), for health_t.
   void set_kernel_drops(std::int64_t drops) { kernel_drops_ = drops; }
 

@@ -88,12 +88,30 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
       out << fmt::format("             {:<28} = {:+.6e} +- {:.2e}\n", prm.name, prm.value, prm.std_error);
     }
   }
-  if (s.eps_raw.n > 1) {
-    out << fmt::format("  position   error vs reference, RMS about the mean: raw {:.3f} arcmin -> compensated {:.3f} arcmin ({:+.1f} dB)\n",
-                       rad_to_arcmin(s.eps_raw.stddev()), rad_to_arcmin(s.eps_comp.stddev()),
-                       ratio_db(s.eps_raw.stddev(), s.eps_comp.stddev()));
+  out << fmt::format("  samples    {} with an angle over {:.3f} s, {} moving, {} at standstill, {} with a reference\n",
+                     s.samples, s.t_last - s.t_first, s.moving, s.samples - s.moving, s.with_reference);
+  if (s.raw_all.stats.n > 1) {
+    auto line = [&](const char* what, const ErrorStats& e) {
+      out << fmt::format("             {:<40} {:>8} samples, {:.3f}-{:.3f} s: RMS {:.3f} arcmin (mean {:+.3f}, about the "
+                         "mean {:.3f})\n",
+                         what, e.stats.n, e.t_first - s.t_first, e.t_last - s.t_first, rad_to_arcmin(e.rms()),
+                         rad_to_arcmin(e.stats.mean), rad_to_arcmin(e.stats.stddev()));
+    };
+    out << fmt::format("  position   error vs reference [arcmin of the resolver angle; / {} for mechanical]:\n", pc.p_r);
+    line("raw, every sample with a reference", s.raw_all);
+    line("raw, moving samples", s.raw_moving);
+    if (s.compared_comp.stats.n > 1) {
+      line("raw, moving, while compensated", s.compared_raw);
+      line("compensated, the same samples", s.compared_comp);
+      out << fmt::format("             compensation: RMS {:.3f} -> {:.3f} arcmin ({:+.1f} dB) over the moving samples "
+                         "since it started\n",
+                         rad_to_arcmin(s.compared_raw.rms()), rad_to_arcmin(s.compared_comp.rms()),
+                         ratio_db(s.compared_raw.rms(), s.compared_comp.rms()));
+    } else {
+      out << "             not compensated: no model fitted yet (or compensation disabled)\n";
+    }
   } else {
-    out << "  position   no reference angle (or no converged estimate): error vs reference not measured\n";
+    out << "  position   no reference angle in the log: error vs reference not measured\n";
   }
   if (s.have_ripple) {
     const RippleSet& r = s.ripple;
@@ -159,8 +177,20 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
                      json_number(model.params[i].value), json_number(model.params[i].std_error));
   }
   j += "},";
-  j += fmt::format("\"eps_rms_raw_rad\":{},\"eps_rms_comp_rad\":{},", json_number(s.eps_raw.stddev()),
-                   json_number(s.eps_comp.stddev()));
+  auto stats_json = [&](const ErrorStats& e) {
+    return fmt::format("{{\"samples\":{},\"t_first_s\":{},\"t_last_s\":{},\"rms_rad\":{},\"mean_rad\":{},"
+                       "\"std_rad\":{}}}",
+                       e.stats.n, json_number(e.t_first - s.t_first), json_number(e.t_last - s.t_first),
+                       json_number(e.rms()), json_number(e.stats.value_or_nan()), json_number(e.stats.stddev()));
+  };
+  j += fmt::format("\"samples_with_angle\":{},\"samples_moving\":{},\"samples_with_reference\":{},\"span_s\":{},",
+                   s.samples, s.moving, s.with_reference, json_number(s.t_last - s.t_first));
+  j += "\"position_error\":{\"units\":\"rad, resolver electrical\",\"raw_all\":" + stats_json(s.raw_all) +
+       ",\"raw_moving\":" + stats_json(s.raw_moving) + ",\"compensated_moving\":" + stats_json(s.compared_comp) +
+       ",\"raw_same_samples\":" + stats_json(s.compared_raw) + "},";
+  // The compensated figure against the raw one over the same samples (RMS including the mean).
+  j += fmt::format("\"eps_rms_raw_rad\":{},\"eps_rms_comp_rad\":{},", json_number(s.compared_raw.rms()),
+                   json_number(s.compared_comp.rms()));
   const RippleSet& r = s.ripple;
   auto arr = [&s](const std::array<double, 3>& a, bool valid) {
     if (!s.have_ripple || !valid) return std::string("null");

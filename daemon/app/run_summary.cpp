@@ -2,12 +2,22 @@
 
 namespace resolver {
 
-void RunSummary::add(const SampleOutput& out, const SampleProcessor& proc) {
-  if (!out.has_angle || !proc.compensating()) return;
+void RunSummary::add(const SampleOutput& out, const SampleProcessor& proc, double t) {
+  if (!out.has_angle) return;
+  if (samples == 0) t_first = t;
+  t_last = t;
+  ++samples;
+  moving += out.moving ? 1 : 0;
   if (!std::isnan(out.eps_ref)) {
-    eps_raw.add(out.eps_ref);
-    eps_comp.add(wrap_pi(out.eps_ref - out.eps_hat));
+    ++with_reference;
+    raw_all.add(out.eps_ref, t);
+    if (out.moving) raw_moving.add(out.eps_ref, t);
+    if (out.moving && proc.compensating()) {
+      compared_raw.add(out.eps_ref, t);
+      compared_comp.add(wrap_pi(out.eps_ref - out.eps_hat), t);
+    }
   }
+  if (!proc.compensating()) return;
   if (out.ripple_updated()) {
     ripple = proc.ripple();
     have_ripple = ripple.raw_valid && ripple.comp_valid;

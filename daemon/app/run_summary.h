@@ -29,21 +29,41 @@ struct RunningStats {
   [[nodiscard]] double value_or_nan() const { return n > 0 ? mean : std::numeric_limits<double>::quiet_NaN(); }
 };
 
+/// One error statistic and what it covers.
+struct ErrorStats {
+  RunningStats stats;           ///< [rad, resolver electrical]
+  double sum_squares = 0.0;     ///< for the RMS including the mean
+  double t_first = 0.0, t_last = 0.0;  ///< [s] sample time of the first and last sample counted
+  void add(double eps, double t) {
+    if (stats.n == 0) t_first = t;
+    t_last = t;
+    stats.add(eps);
+    sum_squares += eps * eps;
+  }
+  /// RMS including the mean [rad] (NaN when empty).
+  [[nodiscard]] double rms() const {
+    return stats.n > 0 ? std::sqrt(sum_squares / static_cast<double>(stats.n)) : std::numeric_limits<double>::quiet_NaN();
+  }
+};
+
 struct RunSummary {
-  // Position error against the reference, once compensation is active [rad].
-  // The mean is removed: a constant offset between reference and resolver
-  // zero (mounting) is not an error the amplitude-imbalance model addresses.
-  RunningStats eps_raw;
-  RunningStats eps_comp;
+  // Position error against the reference [rad, resolver electrical], over every
+  // sample with a reference (the whole log) and over the moving ones; and, once the
+  // compensation is active, raw and compensated side by side over the same samples.
+  // RMS includes the mean (a mounting offset is an error too); the mean and the
+  // spread about it are reported beside it.
+  ErrorStats raw_all, raw_moving;
+  ErrorStats compared_raw, compared_comp;  ///< moving samples since compensation started
+  std::int64_t samples = 0, moving = 0, with_reference = 0;
+  double t_first = 0.0, t_last = 0.0;
   // Ripple amplitudes [A] at the end of the run (coherent average over the
   // processor's last ripple_revolutions electrical revolutions), taken only
   // once the estimator has converged, so "compensated" is compensated.
   RippleSet ripple;
   bool have_ripple = false;
 
-  /// Accumulates one processed sample (only after the estimator converged,
-  /// so "compensated" means compensated with a converged estimate).
-  void add(const SampleOutput& out, const SampleProcessor& proc);
+  /// Accumulates one processed sample at time t [s].
+  void add(const SampleOutput& out, const SampleProcessor& proc, double t);
 };
 
 }  // namespace resolver

@@ -25,6 +25,12 @@
 #include <vector>
 
 #include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/model/calibration_table.h"
+#include "daemon/service/table_file.h"
+
+#include <ctime>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
@@ -106,6 +112,28 @@ int write_report(const resolver::LogSamples& samples, const std::string& log, co
   return 0;
 }
 
+/// `export`: fit, tabulate, write; one summary line on stderr.
+int write_export(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
+                 const resolver::DiscoveryOptions& options, const std::string& format, int points,
+                 const std::string& out) {
+  const resolver::ModelFit fit = resolver::fit_model(samples.input, effects, options);
+  const resolver::CalibrationTable table = resolver::tabulate(fit.model, points);
+  char date[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  const resolver::TableOrigin origin{log, date, "resolver-model"};
+  const std::string text = format == "json"       ? resolver::format_table_json(table, origin)
+                           : format == "c-header" ? resolver::format_table_c_header(table, origin)
+                                                  : resolver::format_table_csv(table, origin);
+  if (out.empty()) std::cout << text;
+  else resolver::write_text_file(out, text);
+  std::cerr << "resolver-model: exported " << points << " points of " << fmt::format("{}", fmt::join(fit.effects, ", "))
+            << " (position-error residual " << fit.residual_rms_rad << " rad, " << fit.residual_rms_rad / fit.noise_floor_rad
+            << "x floor; interpolation error " << table.interpolation_error << " rad)" << (out.empty() ? "" : " to " + out)
+            << "\n";
+  return 0;
+}
+
 int run(int argc, char** argv) {
   CLI::App app{"resolver-model: compare the effect model with a log, see where it fails, name the missing effect.\n"
                "Examples:\n"
@@ -163,6 +191,20 @@ int run(int argc, char** argv) {
   add_slicing(fit);
   add_slicing(explain);
   add_slicing(report);
+  CLI::App* exporter = app.add_subcommand(
+      "export", "fit the model and write what a drive firmware loads: a correction table over one mechanical "
+                "revolution with its harmonic coefficients (resolverd --calibration reads the CSV)");
+  std::string export_format = "csv", export_out;
+  int export_points = 1024;
+  exporter->add_option("LOG", log, "the log to fit (as for fit)")->required();
+  exporter->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)")->delimiter(',');
+  exporter->add_option("--format", export_format, "csv (default), json or c-header")
+      ->check(CLI::IsMember({"csv", "json", "c-header"}));
+  exporter->add_option("--points", export_points, "table points over one mechanical revolution (default 1024)")
+      ->check(CLI::Range(8, 1 << 20));
+  exporter->add_option("--out", export_out, "file to write (default: standard output)");
+  add_config(exporter);
+  add_slicing(exporter);
   CLI11_PARSE(app, argc, argv);
 
   const bool do_explain = explain->parsed();
@@ -183,6 +225,7 @@ int run(int argc, char** argv) {
                                                           : resolver::DirectionFilter::kBoth;
     options.prepare.moving_only = moving_only;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
+    if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
     resolver::Explanation ex;
     {
       ProgressBar bar("fitting");

@@ -12,19 +12,25 @@ bool ModelWindow::add(const Sample& sample, int p_r, int p) {
   input_.p_r = p_r;
   input_.p = p;
   input_.samples.push_back(sample);
-  if (sample.has_rd) {
-    last_angle_ = unwrap_.update(sample.theta_rd);
+  // Revolutions travelled, either way: a whole turn from the last counted one
+  // (out-and-back sweeps count both ways; jitter at a standstill counts nothing).
+  const bool angle = sample.has_rd || sample.has_sincos;
+  if (angle) {
+    const double a = unwrap_.update(sample.has_rd ? sample.theta_rd : std::atan2(sample.sin, sample.cos));
     if (!have_angle_) {
-      first_angle_ = last_angle_;
+      anchor_ = a;
       have_angle_ = true;
     }
+    while (std::abs(a - anchor_) >= kTwoPi) {
+      anchor_ += a > anchor_ ? kTwoPi : -kTwoPi;
+      ++turns_;
+    }
+    partial_ = std::abs(a - anchor_) / kTwoPi;
   }
   return revolutions() >= config_.revolutions || input_.samples.size() >= config_.max_samples;
 }
 
-double ModelWindow::revolutions() const {
-  return have_angle_ ? std::abs(last_angle_ - first_angle_) / kTwoPi : 0.0;
-}
+double ModelWindow::revolutions() const { return static_cast<double>(turns_) + partial_; }
 
 DiscoveryInput ModelWindow::take() {
   DiscoveryInput out = std::move(input_);
@@ -32,7 +38,9 @@ DiscoveryInput ModelWindow::take() {
   input_.samples.reserve(out.samples.size());
   unwrap_ = AngleUnwrapper{};
   have_angle_ = false;
-  first_angle_ = last_angle_ = 0.0;
+  anchor_ = 0.0;
+  turns_ = 0;
+  partial_ = 0.0;
   return out;
 }
 

@@ -31,7 +31,7 @@ class ModelWindow {
   [[nodiscard]] DiscoveryInput take();
 
   [[nodiscard]] std::size_t size() const { return input_.samples.size(); }
-  /// [rev] resolver electrical revolutions covered so far.
+  /// [rev] resolver electrical revolutions travelled so far, either way.
   [[nodiscard]] double revolutions() const;
 
  private:
@@ -39,8 +39,9 @@ class ModelWindow {
   DiscoveryInput input_;
   AngleUnwrapper unwrap_;
   bool have_angle_ = false;
-  double first_angle_ = 0.0;  ///< [rad] unwrapped R/D angle of the window's first sample
-  double last_angle_ = 0.0;
+  double anchor_ = 0.0;  ///< [rad] unwrapped angle where the last counted turn ended
+  std::int64_t turns_ = 0;
+  double partial_ = 0.0;  ///< [rev] of the turn in progress
 };
 
 }  // namespace resolver

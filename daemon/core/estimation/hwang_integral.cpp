@@ -21,10 +21,15 @@ std::optional<HwangRevolution> HwangIntegralEstimator::update(double t, double t
     return std::nullopt;
   }
 
-  if (index != s.rev_index) {
-    // Crossed the level between the previous sample and this one. Moving up
-    // the level is index*2pi, moving down it is (index+1)*2pi.
-    const double level = (index > s.rev_index ? static_cast<double>(index) : static_cast<double>(index + 1)) * kTwoPi;
+  // Crossed the level between the previous sample and this one. Moving up the
+  // level is index*2pi, moving down it is (index+1)*2pi. Noise at a standstill
+  // that jitters back and forth across the level it started from is not a
+  // revolution: a revolution ends only at a level 2pi away from its start.
+  const double crossed = (index > s.rev_index ? static_cast<double>(index) : static_cast<double>(index + 1)) * kTwoPi;
+  if (index != s.rev_index && s.have_start && crossed == s.start_level) {
+    s.rev_index = index;
+  } else if (index != s.rev_index) {
+    const double level = crossed;
     const double dtheta = theta - s.last_theta;
     const double frac = dtheta != 0.0 ? (level - s.last_theta) / dtheta : 0.0;
     const double t_cross = s.last_t + frac * (t - s.last_t);

@@ -88,13 +88,14 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
       if (in.has_ref) fourier_.add(p_r * in.theta_m_ref, theta_meas);
       break;
   }
-  // The other estimators solve once per resolver electrical revolution.
-  const auto rev = static_cast<std::int64_t>(std::floor(rd_unwrap_.continuous / kTwoPi));
+  // The other estimators solve once per resolver electrical revolution: a
+  // revolution is 2pi of travel from the last one's end (noise jittering across
+  // a level at a standstill is not one).
   if (!rev_started_) {
     rev_started_ = true;
-    rev_index_ = rev;
-  } else if (rev != rev_index_) {
-    rev_index_ = rev;
+    rev_anchor_ = rd_unwrap_.continuous;
+  } else if (std::abs(rd_unwrap_.continuous - rev_anchor_) >= kTwoPi) {
+    rev_anchor_ += rd_unwrap_.continuous > rev_anchor_ ? kTwoPi : -kTwoPi;
     ++revolutions_;
     if (config_.method == EstimatorMethod::kSinCosLeastSquares) {
       sincos_fit_ = sincos_ls_.solve();
@@ -105,10 +106,33 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
     }
   }
 
+  // Motion gate: travel over the last kTravelSpan samples against the noise of the
+  // angle's second differences (sigma = 1.2533 mean|d2| / sqrt 6 for Gaussian noise).
+  {
+    const double cont = rd_unwrap_.continuous;
+    const std::size_t cap = kTravelSpan + 1;
+    if (recent_n_ >= 2) {
+      const double a = recent_[(recent_n_ - 1) % cap], b = recent_[(recent_n_ - 2) % cap];
+      const double d2 = std::abs(cont - 2.0 * a + b);
+      second_diff_ema_ += (d2 - second_diff_ema_) * (recent_n_ < 64 ? 1.0 / static_cast<double>(recent_n_) : 1.0 / 64.0);
+    }
+    recent_[recent_n_ % cap] = cont;
+    ++recent_n_;
+    if (recent_n_ > kTravelSpan) {
+      const double travel = std::abs(cont - recent_[(recent_n_ - 1 - kTravelSpan) % cap]);
+      const double sigma = std::max(1.2533 * second_diff_ema_ / std::sqrt(6.0), 1e-9);
+      if (moving_ && travel < 3.0 * sigma) moving_ = false;
+      else if (!moving_ && travel > 6.0 * sigma) moving_ = true;
+    }
+    out.moving = moving_;
+  }
   const double omega = speed_.update(in.t, theta_meas);
   out.speed_mech = omega / p_r;
   // Compensation (DESIGN 3 sign): theta_c = theta_rd + eps_hat.
-  if (config_.method == EstimatorMethod::kModel) {
+  if (table_ && config_.compensate) {
+    out.theta_comp = table_->correct(theta_meas, omega, in.has_ref ? wrap_2pi(in.theta_m_ref) : kNaN);
+    out.eps_hat = wrap_pi(out.theta_comp - theta_meas);
+  } else if (config_.method == EstimatorMethod::kModel) {
     if (config_.compensate && model_set_) {
       const bool signal = config_.domain == CompensationDomain::kSignal && in.has_sincos;
       out.theta_comp = compensator_.correct(signal ? out.theta_sincos : theta_meas, in.t, omega, 0.0, signal);
@@ -178,6 +202,7 @@ void SampleProcessor::set_model(Model model, std::int64_t samples, double revolu
 
 bool SampleProcessor::compensating() const {
   if (!config_.compensate) return false;
+  if (table_) return true;
   switch (config_.method) {
     case EstimatorMethod::kModel: return model_set_ && compensator_.active();
     case EstimatorMethod::kHwangIntegral: return active_alpha_ != 0.0;

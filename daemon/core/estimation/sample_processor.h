@@ -25,6 +25,7 @@
 #include "daemon/core/estimation/sincos_least_squares.h"
 #include "daemon/core/estimation/revolution_ripple.h"
 #include "daemon/core/estimation/speed_estimator.h"
+#include "daemon/core/model/calibration_table.h"
 #include "daemon/core/model/compensator.h"
 
 namespace resolver {
@@ -86,6 +87,9 @@ struct RippleSet {
 
 struct SampleOutput {
   bool has_angle = false;
+  /// The rotor moves (hysteresis on the travel over the last 10 samples against the
+  /// angle's sample noise: 6 sigma to start, 3 sigma to stop; motion.h's rule, streaming).
+  bool moving = false;
   double theta_rd = 0.0;       ///< [rad] wrapped
   double theta_sincos = 0.0;   ///< [rad] wrapped; NaN without sin/cos
   double theta_comp = 0.0;     ///< [rad] wrapped
@@ -133,6 +137,9 @@ class SampleProcessor {
   /// Method kModel: compensate with `model` from now on (a live window's fit, or a
   /// persisted calibration at start). `samples`, `revolutions`: what it was fitted on.
   void set_model(Model model, std::int64_t samples, double revolutions);
+  /// resolverd --calibration: compensate with an exported table from now on
+  /// (instead of the estimator's own result; the estimator still runs and publishes).
+  void set_table(CalibrationTable table) { table_.emplace(std::move(table)); }
   /// The model compensating now (empty before the first fit).
   [[nodiscard]] const Model& model() const { return compensator_.model(); }
   /// Hwang's integral runs beside every method, as the seed's baseline for reports.
@@ -147,7 +154,7 @@ class SampleProcessor {
   AngleErrorFourier fourier_;
   std::optional<SinCosFit> sincos_fit_;
   std::optional<AngleErrorFit> fourier_fit_;
-  std::int64_t rev_index_ = 0;
+  double rev_anchor_ = 0.0;  ///< [rad] unwrapped angle where the current revolution started
   std::int64_t revolutions_ = 0;
   bool rev_started_ = false;
   std::int64_t samples_ = 0;
@@ -155,9 +162,16 @@ class SampleProcessor {
   AngleUnwrapper rd_unwrap_;
   AngleUnwrapper ref_unwrap_;
   RevolutionRipple ripple_raw_, ripple_comp_, ripple_ref_;
+  // Motion gate (SampleOutput::moving).
+  static constexpr std::size_t kTravelSpan = 10;
+  double recent_[kTravelSpan + 1] = {};
+  std::size_t recent_n_ = 0;
+  double second_diff_ema_ = 0.0;  ///< [rad] running mean |second difference| of the angle
+  bool moving_ = false;
   RippleSet ripple_;
   double active_alpha_ = 0.0;
   Compensator compensator_;
+  std::optional<TableCompensator> table_;
   bool model_set_ = false;
   bool model_updated_ = false;   ///< a new model arrived: estimate_t on the next sample
   std::int64_t model_samples_ = 0;
