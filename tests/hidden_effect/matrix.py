@@ -35,6 +35,9 @@ class Hidden:
     size: float = 0.0     # the hidden parameter's value (for `absorbs`)
     # profile -> references the log DOES tell apart: they must not be in fits_as_well.
     apart: dict = field(default_factory=dict)
+    # profile -> (reference, parameters, why): part of the effect is the default model's
+    # already, so the tool names the rest.
+    part: dict = field(default_factory=dict)
 
 
 def _h(key, spec, refs, params, profiles, twins=None, **kw):
@@ -93,7 +96,11 @@ HIDDEN = {h.key: h for h in [
        {"angle1": (("harmonics(k5)",), K5_K3OPP)}),
     _h("mechanical_harmonics", "mechanical_harmonics:a2=2e-4,b2=-1e-4",
        ["mechanical_harmonics(a2,b2)", "mechanical_harmonics"],
-       ["mechanical_harmonics.a2", "mechanical_harmonics.b2"], MOVING_WINDING),
+       ["mechanical_harmonics.a2", "mechanical_harmonics.b2"], MOVING_WINDING,
+       part={"angle1": ("mechanical_harmonics(b2)", ["mechanical_harmonics.b2"],
+                        "at p_r = 1 the order 2 of theta_m is 2 theta: its sin part a2 puts -a2 sin 2theta on "
+                        "the angle, which the model's alpha takes ((alpha/2) sin 2theta, alpha -> alpha - 2 a2), "
+                        "and without sin/cos nothing tells them apart; the cos part b2 is left to name")}),
     _h("eccentricity", "eccentricity:e=5e-4,phase=1", ["eccentricity"],
        ["eccentricity.e", "eccentricity.phase"], MOVING_WINDING,
        {"angle1": (("offsets",), ECC_OFFSETS_P1)}),
@@ -162,61 +169,9 @@ CONTROLS = {
 # (the physics, not a generator), so the patterns start with "*". The lead removes an
 # entry when the core is fixed; an entry none of whose checks fails is reported as XPASS
 # and fails the test.
-_DELAY_STEPS = ("oab3", "oab1", "steps", "reversals", "angle1")
 XFAIL = [
-    (("*/mounting_offset/*:first_reaches_floor", "*/mounting_offset/*:refit_*"),
-     "tool: mounting_offset does not move the frame in which the winding effects are evaluated. "
-     "The resolver sees theta_m + theta_0/p, so its imbalance ripple (alpha/2) sin 2theta is "
-     "rotated by 2 (p_r/p) theta_0 = 0.1 rad against the reference: (0.003/2) x 0.1 = 1.5e-4 rad "
-     "of cos 2theta (rms 1.06e-4, measured 1.07e-4 = 3.9-4.3x the floor at p_r = 3, 1.6x at "
-     "p_r = 1 where the rotation is 2 theta_0 / 3) that the refit leaves, on both generators. "
-     "Without alpha the same log refits to 0.88x; with a spurious quadrature beta = 2.9e-4 to 0.99x. "
-     "(delay shifts the winding frame by omega d and has no such remainder at constant speed)"),
-    (tuple(f"*/delay/{p}:{c}" for p in _DELAY_STEPS for c in ("first_reaches_floor", "refit_*")),
-     "tool: delay's contribution is omega d - accel d^2/2 with omega, accel from a local "
-     "quadratic fit over a window of samples (discovery/motion.cpp); across a speed step the "
-     "window smears omega, so the few samples near every step are wrong by up to "
-     "delta omega x d (0.031 rad for 100 -> 300 r/min at p_r = 3). Residual after the refit "
-     "(sim / benchgen): steps 13.3x / 12.4x, oab3 11.0x / 10.3x, reversals 5.4x / 5.1x, "
-     "angle1 3.9x, oab1 3.5x the floor, concentrated in the time windows with a step (steps: "
-     "16x and 25x there, 1.0x elsewhere); the smooth ramps pass. theta_ref(t) - "
-     "theta_ref(t - d), interpolated from the reference angle, is exact for any motion"),
-    (("*/delay/const:first_reaches_floor",),
-     "tool: ranking's alike() (ranking.cpp) calls candidates indistinguishable when their "
-     "weighted RSS differ by less than a share of the GAIN; a 0.031 rad effect makes the gain "
-     "so large that mounting_offset (7.25e-5 rad, 2.6x the floor, because of the winding frame "
-     "above) and delay (2.96e-5, 1.05x) are 'alike', and the simpler mounting_offset is named "
-     "first although only delay reaches the floor"),
-    (tuple(f"*/backlash/{p}:first_reaches_floor" for p in ("oab3", "oab1", "angle1", "reversals")),
-     "tool: backlash's h is not flagged nonlinear (ParamInfo), so rank_candidates never refits "
-     "it; its linearised column at h = 0 has no take-up, and the candidate shows 3.1e-4 rad "
-     "(oab3, 11x) or 6.1e-4 (reversals, 23x) while `explain --effects amplitude_imbalance,"
-     "backlash` reaches 1.10x / 1.16x. On the out-and-back profiles alike() then names delay "
-     "(oab3 10.7x, oab1 and angle1 4x) first with backlash in fits_as_well"),
-    (("*/mechanical_harmonics/angle1:refit_runs",),
-     "tool: the ranking proposes mechanical_harmonics(a2,b2) at p_r = 1 without sin/cos, but "
-     "its a2 (sin 2theta_m = sin 2theta) is amplitude imbalance; explain --effects then refuses "
-     "the model it proposed ('not separable'). The candidate test should use the same "
-     "separability test (and propose mechanical_harmonics(b2), or say alpha absorbs a2)"),
-    (("*/mechanical_harmonics/const:explicit_runs",),
-     "tool: `--effects amplitude_imbalance,mechanical_harmonics(a2,b2)` is split at every comma "
-     "(CLI11 ->delimiter(',') and split_effects() in resolver_model_main.cpp) into "
-     "'mechanical_harmonics(a2' and 'b2)', although model_spec.h's split_effect_list() splits only "
-     "outside parentheses; and the config's [model] effects accepts bare names only "
-     "(daemon_config.cpp: \"'harmonics(k5)' is not a fittable catalog effect\"), so no "
-     "multi-parameter reference can be refitted by hand"),
-    (("*/control_outliers/*:verdict",),
-     "tool: outliers on the sin/cos signal are counted (18, largest 0.114) and kept out of the "
-     "fit, but neither the verdict nor where_it_fails uses them: the log is 'explained' with "
-     "10 spikes worth 45x the sin/cos floor. Position-error outliers do make it 'unexplained' "
-     "(control_outliers_rd)"),
-    (("*/control_alpha_drift/const:custom_refit",),
-     "tool: the suggested block is on signal = \"position_error\" (terms cos(theta), "
-     "t*sin(2*theta)), but a drifting alpha is a gain of the cos envelope: besides the angle "
-     "it changes the sin/cos radius by (r t / 2)(1 + cos 2theta), which no position_error term "
-     "can describe, so the joint fit over position and sin/cos compromises (5 s at 6e-4/s: "
-     "alpha 0.00345, c = 2.3e-4/s instead of 0.003 and 3e-4) and stays at 3.1x (sin/cos 5.9x). "
-     "The block signal = \"cos\", terms = [\"t*cos(theta)\"] refits to 0.99x on both, alpha "
-     "0.0029994, c = 5.97e-4 (truth 6e-4). On the angle-only map (no sin/cos) the suggested "
-     "block refits to 1.00x: suggest_custom should also try the envelopes' signals"),
+    # Expected failures, each with its named reason. None is open: the ones this matrix
+    # found (mounting offset's winding frame, delay across speed steps, ranking's
+    # alike(), backlash's take-up, the model-reference split, sin/cos outliers, the
+    # drift's suggested block) are fixed; a new one goes here with the command that shows it.
 ]

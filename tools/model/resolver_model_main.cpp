@@ -27,6 +27,7 @@
 
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
+#include "daemon/core/model/model_spec.h"
 #include "daemon/service/table_file.h"
 #include "tools/model/export_data.h"
 
@@ -79,17 +80,12 @@ class ProgressBar {
   bool shown_ = false;
 };
 
+/// The effect references of every --effects argument, split at the commas outside
+/// parentheses ("amplitude_imbalance,harmonics(k3,k5)" is two references).
 std::vector<std::string> split_effects(const std::vector<std::string>& args) {
   std::vector<std::string> out;
   for (const auto& a : args) {
-    std::size_t b = 0;
-    while (b <= a.size()) {
-      const std::size_t e = a.find(',', b);
-      const std::string name = a.substr(b, e == std::string::npos ? std::string::npos : e - b);
-      if (!name.empty()) out.push_back(name);
-      if (e == std::string::npos) break;
-      b = e + 1;
-    }
+    for (auto& one : resolver::split_effect_list(a)) out.push_back(std::move(one));
   }
   return out;
 }
@@ -155,8 +151,9 @@ int run(int argc, char** argv) {
   auto add_common = [&](CLI::App* sub) {
     sub->add_option("LOG", log, "candump -l log of the default bench layout")->required();
     sub->add_option("--effects", effects_args,
-                    "comma-separated catalog effects of the model (default amplitude_imbalance); fittable: " + fittable)
-        ->delimiter(',');
+                    "the model: comma-separated effect references, an effect by name (its default parameters) or "
+                    "with a parameter list, e.g. amplitude_imbalance,harmonics(k5,k3_opp),delay; catalog effects or "
+                    "the config's [[model.custom]] names (default amplitude_imbalance); fittable: " + fittable);
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
   };
   std::string direction = "both";
@@ -185,7 +182,7 @@ int run(int argc, char** argv) {
   std::string html_out;
   int max_steps = 6;
   report->add_option("LOG", log, "candump -l log of the default bench layout")->required();
-  report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)")->delimiter(',');
+  report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)");
   report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
   report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
   CLI::App* export_data = app.add_subcommand(
@@ -193,7 +190,7 @@ int run(int argc, char** argv) {
                      "parameters with units: CSV (MATLAB readtable, pandas) and/or MATLAB .mat");
   std::string csv_out, mat_out;
   export_data->add_option("LOG", log, "candump -l log of the default bench layout")->required();
-  export_data->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)")->delimiter(',');
+  export_data->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
   export_data->add_option("--csv", csv_out, "CSV of the samples [one header line, units in the column names]; the "
                                             "parameters go to OUT's stem + .params.csv");
   export_data->add_option("--mat", mat_out, "MATLAB MAT-5 file: structs samples, units, descriptions, params, info");
@@ -210,7 +207,7 @@ int run(int argc, char** argv) {
   std::string export_format = "csv", export_out;
   int export_points = 1024;
   exporter->add_option("LOG", log, "the log to fit (as for fit)")->required();
-  exporter->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)")->delimiter(',');
+  exporter->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
   exporter->add_option("--format", export_format, "csv (default), json or c-header")
       ->check(CLI::IsMember({"csv", "json", "c-header"}));
   exporter->add_option("--points", export_points, "table points over one mechanical revolution (default 1024)")

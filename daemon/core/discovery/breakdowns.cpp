@@ -71,8 +71,10 @@ struct Bin {
 }  // namespace
 
 ResidualPass residual_pass(const Design& design, const PreparedLog& log, const GroupFloors& floors,
-                           std::span<const int> score_columns, const DiscoveryOptions& options) {
+                           std::span<const int> score_columns, const DiscoveryOptions& options,
+                           const NuisanceValues& nuisance) {
   ResidualPass out;
+  const double sa_offset = nuisance.sa, sr_offset = nuisance.sr, d_offset = nuisance.d, q_offset = nuisance.q;
   const int order = std::max(1, options.max_report_order);
   const int hk = 2 * order + 1;
   NormalEquations h_theta(hk), h_mech(hk), h_d(hk), h_q(hk);
@@ -130,12 +132,28 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
       recent.clear();
       continue;
     }
-    design.evaluate(r, basis, pred, jac);
+    design.evaluate(log.rows, i, basis, pred, jac);
     const bool has_pos = position_rd ? r.has(FitRow::kHasRd) : r.has(FitRow::kHasSc);
-    const double res_pos = position_rd ? r.y_rd - pred.rd : r.y_sa - pred.sa;
+    const double res_pos = position_rd ? r.y_rd - pred.rd - nuisance.rd : r.y_sa - pred.sa - sa_offset;
     if (has_pos) {
       out.rss_position_with_outliers += res_pos * res_pos;
       ++out.n_position_with_outliers;
+    }
+    if (r.has(FitRow::kHasRd)) {
+      out.rss_with_outliers[0] += (r.y_rd - pred.rd) * (r.y_rd - pred.rd);
+      ++out.n_with_outliers[0];
+    }
+    if (r.has(FitRow::kHasSc)) {
+      // The sin/cos angle and radius about the fit's amplitude (nuisance gain left in:
+      // it is small against a spike); two rows, as the fit counts them.
+      const double ea = r.y_sa - pred.sa - sa_offset, er = r.y_sr - pred.sr - sr_offset;
+      out.rss_with_outliers[1] += ea * ea + er * er;
+      out.n_with_outliers[1] += 2;
+    }
+    if (r.has(FitRow::kHasCur) && log.currents) {
+      const double ed = r.y_d - pred.d - d_offset, eq = r.y_q - pred.q - q_offset;
+      out.rss_with_outliers[2] += ed * ed + eq * eq;
+      out.n_with_outliers[2] += 2;
     }
     if (r.has(FitRow::kOutlier)) {
       recent.clear();
@@ -169,9 +187,10 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
       }
     }
     if (r.has(FitRow::kHasCur) && log.currents) {
+      // About the operating point, so order 0 is a residual, not the mean current.
       harmonic_row(r.sig.theta_e, order, hx);
-      h_d.add(hx, r.y_d - pred.d);
-      h_q.add(hx, r.y_q - pred.q);
+      h_d.add(hx, r.y_d - pred.d - d_offset);
+      h_q.add(hx, r.y_q - pred.q - q_offset);
     }
     // Robust standard errors: the weighted score of the row on the model's columns.
     if (sk > 0) {

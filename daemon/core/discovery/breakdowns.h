@@ -27,14 +27,23 @@ struct ResidualPass {
   std::int64_t n_position = 0;
   double rss_position_with_outliers = 0.0;
   std::int64_t n_position_with_outliers = 0;
+  /// Per signal group (rd, sin/cos, dq), the residual including the outlier samples.
+  double rss_with_outliers[3] = {0.0, 0.0, 0.0};
+  std::int64_t n_with_outliers[3] = {0, 0, 0};
   /// Sum over revolution blocks of g g', g = the block's weighted score J'W r on `score_columns`.
   Eigen::MatrixXd score_outer;
   int blocks = 0;
 };
 
+/// The fitted nuisance constants (design.h): what the residual is measured about.
+struct NuisanceValues {
+  double rd = 0.0, sa = 0.0, sr = 0.0, d = 0.0, q = 0.0;
+};
+
 /// Runs the pass. `design` holds the fitted model (no candidates); `score_columns`
 /// are the columns whose robust covariance is wanted (nuisance + model).
 [[nodiscard]] ResidualPass residual_pass(const Design& design, const PreparedLog& log, const GroupFloors& floors,
-                                         std::span<const int> score_columns, const DiscoveryOptions& options);
+                                         std::span<const int> score_columns, const DiscoveryOptions& options,
+                                         const NuisanceValues& nuisance);
 
 }  // namespace resolver

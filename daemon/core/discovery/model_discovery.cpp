@@ -141,8 +141,21 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   accumulate(raw, log.rows, floors, raw_stats);
   ++f.passes;
   const StepSolution raw_sol = solve_step(raw_stats.all, floors);
+  // The nuisance constants at the solution (the last step solved them from zero).
+  NuisanceValues nv;
+  for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
+    const double v = fr.last.dz[static_cast<Eigen::Index>(j)];
+    switch (d.nuisances()[j]) {
+      case Nuisance::kRdConstant: nv.rd = v; break;
+      case Nuisance::kSaConstant: nv.sa = v; break;
+      case Nuisance::kScGain: nv.sr = v; break;
+      case Nuisance::kIdConstant: nv.d = v; break;
+      case Nuisance::kIqConstant: nv.q = v; break;
+    }
+    f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])), v, kNaN, ""});
+  }
   // One pass at the solution: breakdowns, whiteness, robust scores, series.
-  const ResidualPass pass = residual_pass(d, log, floors, cols, options);
+  const ResidualPass pass = residual_pass(d, log, floors, cols, options, nv);
   ++f.passes;
   const StepSolution& s = fr.last;
   // Standard errors: from the revolution-to-revolution spread of the scores when the
@@ -177,6 +190,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
     r.raw_rms = rms(raw_sol.rss[g], raw_sol.n[g]);
     r.held_back_rms = held_back_rms(fr.stats, floors, cols, static_cast<Group>(g));
     r.rows = s.n[g];
+    r.rms_with_outliers = rms(pass.rss_with_outliers[g], pass.n_with_outliers[g]);
     f.signals.push_back(r);
   }
   if (!log.rd && log.sincos) {
@@ -218,8 +232,8 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   for (const SignalResidual& r : f.signals) {
     if (r.rms > options.explained_ratio * r.floor) ok = false;
     if (std::isfinite(r.held_back_rms) && r.held_back_rms > options.explained_ratio * r.floor) ok = false;
+    if (!f.outliers.empty() && r.rms_with_outliers > options.explained_ratio * r.floor) ok = false;
   }
-  if (!f.outliers.empty() && f.rms_with_outliers_rad > options.explained_ratio * f.noise_floor_rad) ok = false;
   f.explained = ok;
   if (!f.robust_errors) {
     f.notes.push_back(fmt::format("standard errors are formal (only {} revolutions: the revolution-to-revolution "
@@ -252,8 +266,10 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
   ex.not_evaluated = std::move(ranking.not_evaluated);
   ex.fit.passes += ranking.passes;
   if (options.progress) options.progress(0.8);
-  const bool outliers_matter =
-      !ex.fit.outliers.empty() && ex.fit.rms_with_outliers_rad > options.explained_ratio * ex.fit.noise_floor_rad;
+  bool outliers_matter = false;
+  for (const SignalResidual& r : ex.fit.signals) {
+    outliers_matter = outliers_matter || (!ex.fit.outliers.empty() && r.rms_with_outliers > options.explained_ratio * r.floor);
+  }
   if (ex.fit.explained) {
     for (Candidate& c : ex.candidates) c.proposed = false;
     ex.verdict = Verdict::kExplained;
@@ -271,10 +287,12 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     std::int64_t count = 0;
     for (const OutlierSignal& o : ex.fit.outliers) count += o.count;
     ex.verdict = Verdict::kUnexplained;
+    double worst = 0.0;
+    for (const SignalResidual& r : ex.fit.signals) worst = std::max(worst, r.rms_with_outliers / r.floor);
     ex.summary = fmt::format("unexplained: {} impulsive samples (outliers) carry the residual to {}x the floor; "
                              "without them the model explains the log. Find their source (EMI, bit errors) before "
                              "trusting a fit; they are kept out of this one.",
-                             count, num(ex.fit.rms_with_outliers_rad / ex.fit.noise_floor_rad, "%.1f"));
+                             count, num(worst, "%.1f"));
     return ex;
   }
   const Candidate* best = ex.candidates.empty() || !ex.candidates.front().proposed ? nullptr : &ex.candidates.front();
@@ -333,8 +351,14 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     if (!ex.fit.signals.empty() && ex.fit.signals.front().rms > options.explained_ratio * ex.fit.noise_floor_rad) {
       ex.suggested_custom = suggest_custom(log, ex.fit, options);
       if (!ex.suggested_custom.empty()) {
-        ex.summary += " A [[model.custom]] block that describes it is suggested (paste it into the config and add "
-                      "its name to [model] effects).";
+        std::string names;
+        for (std::size_t at = ex.suggested_custom.find("name = \""); at != std::string::npos;
+             at = ex.suggested_custom.find("name = \"", at + 1)) {
+          const std::size_t b = at + 8, e = ex.suggested_custom.find('"', b);
+          names += (names.empty() ? "" : ", ") + ex.suggested_custom.substr(b, e - b);
+        }
+        ex.summary += " [[model.custom]] blocks that describe it are suggested: paste them into the config and add " +
+                      names + " to [model] effects.";
       }
     }
   }

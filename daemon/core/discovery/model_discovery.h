@@ -72,6 +72,7 @@ struct SignalResidual {
   double floor = 0.0;        ///< noise floor
   double raw_rms = 0.0;      ///< rms with only the nuisance fitted
   double held_back_rms = 0.0;  ///< cross-validated: fitted on one fold, evaluated on the other (NaN: no folds)
+  double rms_with_outliers = 0.0;  ///< including the outlier samples the fit left out
   std::int64_t rows = 0;
 };
 
@@ -152,6 +153,7 @@ struct SampleAccount {
 struct ModelFit {
   std::vector<std::string> effects;          ///< the model's effect references
   std::vector<ParamValue> params;            ///< fitted parameters (no nuisance)
+  std::vector<ParamValue> nuisance;          ///< the nuisance constants (operating point, amplitude, offsets)
   Model model;                               ///< the fitted model (values, standard errors)
   std::vector<SignalResidual> signals;
   double residual_rms_rad = 0.0;             ///< position-error residual [rad]

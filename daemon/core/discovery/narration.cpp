@@ -10,6 +10,7 @@
 #include "daemon/core/angles.h"
 #include "daemon/core/discovery/fit_support.h"
 #include "daemon/core/model/custom_effect.h"
+#include "daemon/core/model/least_squares.h"
 
 namespace resolver {
 
@@ -72,11 +73,14 @@ std::vector<std::string> describe_failure(const PreparedLog& log, const ModelFit
   for (const OutlierSignal& o : fit.outliers) {
     std::string times;
     for (double t : o.times) times += (times.empty() ? "" : ", ") + num(t, "%.4g");
+    double with = 0.0;
+    for (const SignalResidual& s : fit.signals) {
+      if (s.signal == o.signal || (o.signal == "sin_cos" && s.signal == "sin_cos")) with = s.rms_with_outliers / s.floor;
+    }
     out.push_back(fmt::format("outliers: {} impulsive samples on {} (largest {}{}, at {} s{}): kept out of the fit "
                               "and the floor; the residual including them is {}x the floor",
                               o.count, o.signal, num(o.largest), unit_of(o.signal, o.largest), times,
-                              o.count > static_cast<std::int64_t>(o.times.size()) ? ", ..." : "",
-                              num(fit.rms_with_outliers_rad / std::max(fit.noise_floor_rad, 1e-300), "%.1f")));
+                              o.count > static_cast<std::int64_t>(o.times.size()) ? ", ..." : "", num(with, "%.1f")));
   }
   for (const SignalResidual& s : fit.signals) {
     if (s.rms > ratio * s.floor) {
@@ -207,47 +211,103 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
   }
   if (fit.directions.size() == 2 && log.reference) dict.emplace_back("sign(omega)");
   if (dict.empty()) return "";
-  // Fit the dictionary with the model; keep the significant terms; fit them again.
-  auto fit_with = [&](const std::vector<std::string>& terms, ModelFit& out) {
-    CustomEffectSpec spec{name, "position_error", terms, "suggested by resolver-model explain", "suggestion"};
-    const CustomEffects customs({spec});
-    DiscoveryOptions o = options;
-    o.customs = &customs;
-    o.series_points = 0;
-    o.progress = {};
-    std::vector<std::string> refs = fit.model.spec().references();
-    refs.push_back(name);
-    out = fit_prepared(log, refs, o);
+  // The envelopes: a time- or speed-varying gain or phase of the fundamental (a
+  // drifting alpha is a gain of the cos channel: t*cos(theta) on cos) that no
+  // position-error term describes, when the sin/cos signal fails too.
+  struct Block {
+    std::string name, signal;
+    std::vector<std::string> terms;
   };
-  ModelFit all;
-  // Terms the log cannot separate (from each other or the model) are dropped from
-  // the end of the list, the least specific first, until the fit is possible.
+  std::vector<Block> blocks{{name, "position_error", dict}};
+  bool sincos_fails = false;
+  for (const SignalResidual& r : fit.signals) {
+    if (r.signal == "sin_cos" && r.rms > options.explained_ratio * r.floor) sincos_fails = true;
+  }
+  if (sincos_fails && log.sincos) {
+    std::vector<std::string> by;
+    for (const std::string& d : dict) {
+      if (d == "t" || d == "omega") by.push_back(d);
+    }
+    // The cos channel against the sin channel: its gain and its phase (a common
+    // gain is the amplitude, a common rotation a position error: covered already).
+    Block env{name + "_cos", "cos", {}};
+    for (const std::string& m : by) {
+      env.terms.push_back(m + "*cos(theta)");
+      env.terms.push_back(m + "*sin(theta)");
+    }
+    if (!env.terms.empty()) blocks.push_back(std::move(env));
+  }
+  // Forward selection on one pass of sufficient statistics: the model's columns
+  // plus every dictionary term's, accumulated once; then, term by term, the one
+  // that lowers the weighted residual most joins, while it lowers the BIC by more
+  // than 10 (Kass & Raftery: very strong evidence). Collinear terms (a cos-gain drift
+  // is also t sin 2theta in the angle) never both join.
+  std::vector<CustomEffectSpec> specs;
+  for (const Block& bl : blocks) {
+    if (!bl.terms.empty()) specs.push_back({bl.name, bl.signal, bl.terms, "suggested by resolver-model explain", "suggestion"});
+  }
+  const CustomEffects customs(specs);
+  Design d = fit.model.design(nuisances_for(log));
+  const std::size_t first = d.terms().size();
+  for (const auto& c : customs.all()) {
+    std::vector<int> all_params;
+    for (int i = 0; i < static_cast<int>(c->params().size()); ++i) all_params.push_back(i);
+    d.add_candidate(ModelTerm{c.get(), all_params});
+  }
+  const GroupFloors floors = fit.floors.floors();
+  PassStatistics stats(d.columns());
+  accumulate(d, log.rows, floors, stats);
+  std::vector<int> chosen = model_columns(d);
+  StepSolution current = solve_step(stats.all, floors, chosen);
+  if (!current.ok) return "";
+  std::vector<std::vector<bool>> keep(customs.all().size());
+  for (std::size_t bi = 0; bi < customs.all().size(); ++bi) keep[bi].assign(customs.all()[bi]->params().size(), false);
   for (;;) {
-    try {
-      fit_with(dict, all);
-      break;
-    } catch (const std::invalid_argument& e) {
-      dict.pop_back();
-      if (dict.empty()) return "";
+    int best_col = -1;
+    std::size_t best_block = 0, best_term = 0;
+    StepSolution best;
+    for (std::size_t bi = 0; bi < customs.all().size(); ++bi) {
+      const std::vector<int> cols = term_columns(d, first + bi);
+      for (std::size_t ti = 0; ti < cols.size(); ++ti) {
+        if (keep[bi][ti]) continue;
+        std::vector<int> with = chosen;
+        with.push_back(cols[ti]);
+        const StepSolution s = solve_step(stats.all, floors, with);
+        if (!s.ok) continue;
+        if (best_col < 0 || s.rss_w < best.rss_w) {
+          best_col = cols[ti];
+          best_block = bi;
+          best_term = ti;
+          best = s;
+        }
+      }
     }
+    if (best_col < 0 || bic_of(current) - bic_of(best) <= 10.0) break;
+    chosen.push_back(best_col);
+    keep[best_block][best_term] = true;
+    current = best;
   }
-  std::vector<std::string> kept;
-  for (std::size_t i = 0; i < dict.size(); ++i) {
-    const std::string pname = name + ".c" + std::to_string(i + 1);
-    for (const ParamValue& p : all.params) {
-      if (p.name == pname && std::abs(p.value) > kSignificance * p.std_error) kept.push_back(dict[i]);
+  for (std::size_t bi = 0; bi < blocks.size() && bi < keep.size(); ++bi) {
+    std::vector<std::string> kept;
+    for (std::size_t ti = 0; ti < blocks[bi].terms.size(); ++ti) {
+      if (keep[bi][ti]) kept.push_back(blocks[bi].terms[ti]);
     }
+    blocks[bi].terms = kept;
   }
-  if (kept.empty()) return "";
-  std::string toml = fmt::format(
-      "[[model.custom]]\n"
-      "name = \"{}\"\n"
-      "signal = \"position_error\"\n"
-      "description = \"residual of {} described by resolver-model explain\"\n"
-      "terms = [",
-      name, fmt::join(fit.effects, " + "));
-  for (std::size_t i = 0; i < kept.size(); ++i) toml += (i == 0 ? "\"" : ", \"") + kept[i] + "\"";
-  toml += "]\n";
+  std::string toml;
+  for (const Block& bl : blocks) {
+    const std::vector<std::string>& kept = bl.terms;
+    if (kept.empty()) continue;
+    toml += fmt::format(
+        "{}[[model.custom]]\n"
+        "name = \"{}\"\n"
+        "signal = \"{}\"\n"
+        "description = \"residual of {} described by resolver-model explain\"\n"
+        "terms = [",
+        toml.empty() ? "" : "\n", bl.name, bl.signal, fmt::join(fit.effects, " + "));
+    for (std::size_t i = 0; i < kept.size(); ++i) toml += (i == 0 ? "\"" : ", \"") + kept[i] + "\"";
+    toml += "]\n";
+  }
   return toml;
 }
 

@@ -22,8 +22,8 @@ constexpr int kOrdersTried = 3;
 constexpr double kSignificance = 4.0;
 /// Nonlinear candidates refitted to convergence (the best by their linearised score).
 constexpr int kNonlinearRefits = 2;
-/// Candidates within this BIC of each other, or whose improvements differ by less
-/// than this share, are not told apart by the log (e.g. K_3 and a 6th mechanical
+/// Candidates within this BIC of each other, or whose residuals differ by less than
+/// this share of the smaller, are not told apart by the log (e.g. K_3 and a 6th mechanical
 /// harmonic with p_r = 3: the same 2 theta in the angle, and alpha takes up the
 /// radius; channel delay and quadrature at one speed).
 constexpr double kIndistinguishableBic = 10.0;
@@ -152,7 +152,7 @@ std::vector<ParamValue> candidate_params(const Design& union_design, std::size_t
 
 Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
   Ranking out;
-  const std::vector<ModelTerm> terms = candidate_terms(log, fit, options, out.not_evaluated);
+  std::vector<ModelTerm> terms = candidate_terms(log, fit, options, out.not_evaluated);
   for (const Effect* e : effect_registry()) {
     if (!e->fittable()) {
       out.not_evaluated.push_back(std::string(e->name()) + ": sets the noise floor, not a candidate");
@@ -174,7 +174,29 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     const std::size_t term = first_candidate + i;
     std::vector<int> cols = base_cols;
     for (int c : term_columns(d, term)) cols.push_back(c);
-    const StepSolution s = solve_step(stats.all, floors, cols);
+    StepSolution s = solve_step(stats.all, floors, cols);
+    if (!s.ok && terms[i].params.size() > 1) {
+      // Part of a multi-parameter candidate may be the model's already (a 2 theta_m
+      // order at p_r = 1 without sin/cos: its sin part is alpha's): try each
+      // parameter alone and keep the best that the log separates.
+      StepSolution best_part;
+      std::size_t best_k = 0;
+      const std::vector<int> tcols = term_columns(d, term);
+      for (std::size_t k = 0; k < tcols.size(); ++k) {
+        if (terms[i].effect->params()[static_cast<std::size_t>(terms[i].params[k])].polar != Polar::kNone) continue;
+        std::vector<int> one = base_cols;
+        one.push_back(tcols[k]);
+        const StepSolution part = solve_step(stats.all, floors, one);
+        if (part.ok && (!best_part.ok || part.rss_w < best_part.rss_w)) {
+          best_part = part;
+          best_k = k;
+        }
+      }
+      if (best_part.ok) {
+        s = best_part;
+        terms[i] = ModelTerm{terms[i].effect, {terms[i].params[best_k]}};
+      }
+    }
     if (!s.ok) {
       out.not_evaluated.push_back(terms[i].reference() + ": not separable from the model with the signals in this log" +
                                   (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));
@@ -192,6 +214,12 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     c.proposed = c.bic_drop > options.proposal_bic_drop;
     c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
     c.params = candidate_params(d, term, s);
+    std::erase_if(c.params, [&](const ParamValue& pv) {
+      for (int p : terms[i].params) {
+        if (pv.name == terms[i].param_name(static_cast<std::size_t>(&p - terms[i].params.data()))) return false;
+      }
+      return true;
+    });
     c.reason = reason_of(terms[i], c.params);
     out.candidates.push_back(std::move(c));
     if (options.progress) options.progress(0.5 + 0.3 * static_cast<double>(i + 1) / static_cast<double>(terms.size()));
@@ -238,10 +266,14 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   }
   std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
   // Candidates this log cannot tell apart.
+  // Alike: what they leave differs by less than the BIC's resolution, or by less
+  // than a small share of what the better one leaves (second-order differences of a
+  // large effect); never when only one of them reaches the floor.
   auto alike = [&](const Candidate& a, const Candidate& b) {
-    const double gain = std::max(excess_base - a.weighted_rss, excess_base - b.weighted_rss);
+    if (a.reaches_floor != b.reaches_floor) return false;
+    const double left = std::min(a.weighted_rss, b.weighted_rss);
     return std::abs(a.score - b.score) < kIndistinguishableBic ||
-           (gain > 0.0 && std::abs(a.weighted_rss - b.weighted_rss) < kIndistinguishableShare * gain);
+           std::abs(a.weighted_rss - b.weighted_rss) < kIndistinguishableShare * left;
   };
   for (Candidate& c : out.candidates) {
     if (!c.proposed) continue;

@@ -11,8 +11,14 @@ namespace {
 
 constexpr std::array kParams{
     ParamInfo{.name = "h", .unit = "[rad]", .description = "width of the play between reference and resolver (mechanical rad)",
-              .min = 0.0, .max = 0.5},
+              .min = 0.0, .max = 0.5, .nonlinear = true},
 };
+
+/// [rad, mechanical] the play's lag in the direction of motion: h/2 once taken up,
+/// running from -h/2 to +h/2 over the take-up after a reversal.
+double eps_m(const SignatureRow& row, double h) {
+  return row.since_reversal < h ? row.since_reversal - 0.5 * h : 0.5 * h;
+}
 
 class BacklashEffect final : public BasicEffect {
  public:
@@ -42,6 +48,10 @@ class BacklashEffect final : public BasicEffect {
   // Steady motion: eps = p_r (h/2) direction. During the take-up after a reversal
   // (travel D < h from the turning point) the resolver stands still: eps_m runs
   // from +h/2 to -h/2 of the new direction, eps = p_r direction (D - h/2).
+  [[nodiscard]] bool shapes_basis() const override { return true; }
+  void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
+    t.shift -= static_cast<double>(row.p_r) * row.direction * eps_m(row, v[0]);
+  }
   void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignatureColumns& out) const override {
     const double k = 0.5 * static_cast<double>(row.p_r) * row.direction;
     const bool taking_up = row.since_reversal < v[0];
@@ -49,9 +59,7 @@ class BacklashEffect final : public BasicEffect {
   }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
-    const double h = v[0];
-    const double eps_m = row.since_reversal < h ? row.since_reversal - 0.5 * h : 0.5 * h;
-    const double eps = static_cast<double>(row.p_r) * row.direction * eps_m;
+    const double eps = static_cast<double>(row.p_r) * row.direction * eps_m(row, v[0]);
     out += shift_column(eps, -eps);
   }
 };

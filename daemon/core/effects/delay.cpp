@@ -25,13 +25,16 @@ class DelayEffect final : public BasicEffect {
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   [[nodiscard]] double resolver_time_shift(Values v) const override { return v[0]; }
-  void configure_basis(Values v, BasisTransform& t) const override { t.delay = v[0]; }
+  void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override { t.delay = v[0]; }
+  [[nodiscard]] bool shapes_basis() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
-  void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
+  void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
+    // theta(t) - theta(t - d): from the fit's rows when it has them (exact across a
+    // speed step), else omega d - accel d^2 / 2.
     const double d = v[0];
-    out.rd += row.omega * d - 0.5 * row.accel * d * d;
+    out.rd += d != 0.0 ? row.theta - row.theta_at(row.t - d) : 0.0;
     // The envelopes carry the late angle exactly: a rotation, radius unchanged.
-    out.sa += row.theta - b.env_angle();
+    out.sa += d != 0.0 ? row.theta - row.theta_at(row.t - d) : 0.0;
   }
 };
 

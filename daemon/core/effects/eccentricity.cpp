@@ -69,6 +69,10 @@ class EccentricityEffect final : public BasicEffect {
     out.col(1) = shift_column(-pr * b.rd_mech_cos(1), pr * b.env_mech_cos(1));
   }
   [[nodiscard]] bool linear_in_params() const override { return false; }
+  [[nodiscard]] bool shapes_basis() const override { return true; }
+  void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
+    t.shift += static_cast<double>(row.p_r) * v[0] * std::sin(row.theta_m + v[1]);
+  }
   void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double x = v[0] * std::cos(v[1]), y = v[0] * std::sin(v[1]);
     const double pr = row.p_r;

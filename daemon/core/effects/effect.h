@@ -218,9 +218,15 @@ class Effect {
   /// prediction it adds). Default: sum over parameters of column x value, right
   /// for effects whose signature is linear in their parameters.
   virtual void contribution(const SignatureRow& row, const AngleBasis& basis, Values v, SignalValues& out) const;
-  /// Nonlinear converter-stage effects set the transform every other effect's
-  /// angle harmonics go through (tracking loop: H(j k omega); delay: theta - omega d).
-  virtual void configure_basis(Values /*v*/, BasisTransform& /*t*/) const {}
+  /// Effects that move or filter the angle the resolver's errors are functions of
+  /// set the transform every other effect's harmonics go through (tracking loop:
+  /// H(j k omega); delay: theta(t - d); mounting offset, backlash, eccentricity,
+  /// mechanical harmonics: the seen angle's shift). Per row: a shift may vary.
+  virtual void configure_basis(const SignatureRow& /*row*/, Values /*v*/, BasisTransform& /*t*/) const {}
+  /// True when configure_basis does something: the model's prediction is then not
+  /// linear in this effect's parameters even if its own columns are (Gauss-Newton
+  /// iterates).
+  [[nodiscard]] virtual bool shapes_basis() const { return false; }
 };
 
 /// The self-description every effect has, as data.

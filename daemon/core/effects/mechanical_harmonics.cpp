@@ -30,6 +30,16 @@ constexpr std::array<ParamInfo, 2 * kMaxMechanicalOrder> make_params() {
 }
 constexpr auto kParams = make_params();
 
+double seen_mech(Values v, double theta_m) {
+  double out = theta_m;
+  for (std::size_t i = 0; i + 1 < v.size(); i += 2) {
+    if (v[i] == 0.0 && v[i + 1] == 0.0) continue;
+    const double n = static_cast<double>(i / 2 + 1);
+    out += v[i] * std::sin(n * theta_m) + v[i + 1] * std::cos(n * theta_m);
+  }
+  return out;
+}
+
 class MechanicalHarmonicsEffect final : public BasicEffect {
  public:
   MechanicalHarmonicsEffect()
@@ -56,13 +66,11 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
   }
   [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double /*omega_m*/, MotionState& /*state*/,
                                        bool /*commit*/) const override {
-    double out = theta_m;
-    for (std::size_t i = 0; i + 1 < v.size(); i += 2) {
-      if (v[i] == 0.0 && v[i + 1] == 0.0) continue;
-      const double n = static_cast<double>(i / 2 + 1);
-      out += v[i] * std::sin(n * theta_m) + v[i + 1] * std::cos(n * theta_m);
-    }
-    return out;
+    return seen_mech(v, theta_m);
+  }
+  [[nodiscard]] bool shapes_basis() const override { return true; }
+  void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
+    t.shift += static_cast<double>(row.p_r) * (seen_mech(v, row.theta_m) - row.theta_m);
   }
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
     const double pr = row.p_r;

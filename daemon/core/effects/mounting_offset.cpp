@@ -60,6 +60,11 @@ class MountingOffsetEffect final : public BasicEffect {
     return mounting_offset_resolver_shift(MountingOffset{v[0]}, p_r, p);
   }
   [[nodiscard]] double drive_frame_offset(Values v) const override { return v[0]; }
+  // The windings' errors turn with the seen angle (signature.h's BasisTransform::shift).
+  [[nodiscard]] bool shapes_basis() const override { return true; }
+  void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
+    t.shift += static_cast<double>(row.p_r) / static_cast<double>(row.p) * v[0];
+  }
   // The dq currents against the reference show the offset only as a steady
   // current, which the operating point (the fit's DC i_d, i_q) absorbs: no dq column.
   void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {

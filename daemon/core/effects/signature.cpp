@@ -29,8 +29,9 @@ void AngleBasis::set(const SignatureRow& row, const BasisTransform& transform) {
   row_ = row;
   transform_ = transform;
   const double d = transform.delay;
-  env_.reset(row.theta - row.omega * d);
-  mech_.reset(row.theta_m - row.omega / static_cast<double>(row.p_r) * d);
+  const double late = d != 0.0 ? row.theta_at(row.t - d) : row.theta;
+  env_.reset(late + transform.shift);
+  mech_.reset(row.theta_m + (late - row.theta) / static_cast<double>(row.p_r));
 }
 
 double AngleBasis::loop_gain(double w) const {

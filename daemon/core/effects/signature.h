@@ -30,6 +30,17 @@
 
 namespace resolver {
 
+/// The true angle at earlier times: the fit's rows around the current one (a
+/// delay needs theta(t - d) exactly, also across a speed step). Valid only while
+/// the row is being evaluated.
+struct AngleHistory {
+  const void* context = nullptr;
+  /// [rad] the true resolver angle at time t [s] (interpolated between rows), or NaN
+  /// when t is before the rows the context holds.
+  double (*angle_at)(const void* context, std::size_t index, double t) = nullptr;
+  std::size_t index = 0;
+};
+
 /// One sample as the signatures see it (true angles from the reference, or the
 /// speed-smoothed ideal angle without one).
 struct SignatureRow {
@@ -47,6 +58,19 @@ struct SignatureRow {
   double i_q0 = 0.0;       ///< [A] mean measured q current
   int p_r = 1;             ///< resolver pole pairs
   int p = 1;               ///< motor pole pairs
+  AngleHistory history;    ///< earlier true angles (none: extrapolate with omega, accel)
+
+  /// [rad] the true resolver angle at time `t_at` [s] <= t: from the history when it
+  /// reaches back that far, else extrapolated theta - omega dt - accel dt^2 / 2... with
+  /// dt = t - t_at (exact at constant acceleration).
+  [[nodiscard]] double theta_at(double t_at) const {
+    if (history.angle_at != nullptr) {
+      const double v = history.angle_at(history.context, history.index, t_at);
+      if (v == v) return v;  // not NaN
+    }
+    const double dt = t - t_at;
+    return theta - omega * dt + 0.5 * accel * dt * dt;
+  }
 };
 
 /// The five signals' values (a prediction or one column).
@@ -82,11 +106,16 @@ class SignatureColumns {
   std::span<SignalValues> cols_;
 };
 
-/// The converter-stage transform the nonlinear effects set.
+/// The transform the effects that move the resolver's angle or filter it set on
+/// every other effect's harmonics (configure_basis).
 struct BasisTransform {
   double omega_n = 0.0;  ///< [rad/s] tracking loop; 0 = ideal converter (no filtering)
   double zeta = 0.7;     ///< [1]
   double delay = 0.0;    ///< [s] the resolver signals are those of t - delay
+  /// [rad, resolver electrical] the angle the resolver sees is the true one plus this
+  /// (mounting offset, backlash, eccentricity, mechanical harmonics): the windings'
+  /// errors are functions of the seen angle, so their harmonics turn with it.
+  double shift = 0.0;
 };
 
 /// Harmonics of the true angles as each signal sees them (see the header comment).
@@ -109,7 +138,7 @@ class AngleBasis {
   /// sin / cos (n theta_m') of the mechanical angle the envelopes carry.
   [[nodiscard]] double env_mech_sin(int n) const;
   [[nodiscard]] double env_mech_cos(int n) const;
-  /// [rad] the envelopes' resolver angle theta - omega d and mechanical angle theta_m - omega_m d.
+  /// [rad] the envelopes' resolver angle theta(t - d) + shift and mechanical angle theta_m(t - d).
   [[nodiscard]] double env_angle() const { return env_.angle; }
   [[nodiscard]] double env_mech_angle() const { return mech_.angle; }
   /// The closed loop's gain and phase at angular frequency w [rad/s] (1, 0 without a loop).

@@ -86,7 +86,8 @@ class TrackingLoopEffect final : public BasicEffect {
     spec.omega_n = v[0];
     spec.zeta = v[1];
   }
-  void configure_basis(Values v, BasisTransform& t) const override {
+  [[nodiscard]] bool shapes_basis() const override { return true; }
+  void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override {
     t.omega_n = v[0];
     t.zeta = v[1];
   }

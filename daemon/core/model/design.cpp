@@ -110,6 +110,7 @@ std::vector<std::string> Design::column_names() const {
 bool Design::nonlinear() const {
   for (const DesignTerm& t : terms_) {
     if (t.candidate) continue;
+    if (t.effect->shapes_basis()) return true;
     for (int p : t.params) {
       if (t.effect->params()[static_cast<std::size_t>(p)].nonlinear) return true;
     }
@@ -167,24 +168,35 @@ std::vector<double> Design::values_with(std::size_t term, int column_in_term, do
   std::vector<double> v = t.values;
   const auto p = static_cast<std::size_t>(t.params[static_cast<std::size_t>(column_in_term)]);
   const ParamInfo& info = t.effect->params()[p];
+  if (info.polar != Polar::kNone) {
+    // A polar pair moves along its Cartesian coordinate (x for the amplitude's
+    // column, y for the phase's), as its columns are defined (effect.h).
+    const std::size_t amp = info.polar == Polar::kAmplitude ? p : p - 1;
+    double x = v[amp] * std::cos(v[amp + 1]), y = v[amp] * std::sin(v[amp + 1]);
+    (info.polar == Polar::kAmplitude ? x : y) += dz;
+    v[amp] = std::hypot(x, y);
+    v[amp + 1] = std::atan2(y, x);
+    return v;
+  }
   v[p] = from_internal(info, to_internal(info, v[p]) + dz);
   return v;
 }
 
-BasisTransform Design::transform(std::size_t extra_term, const std::vector<double>* extra_values) const {
+BasisTransform Design::transform(const SignatureRow& row, std::size_t extra_term,
+                                 const std::vector<double>* extra_values) const {
   BasisTransform tr;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = extra_values != nullptr && i == extra_term;
     if (t.candidate && !override) continue;
-    t.effect->configure_basis(override ? *extra_values : t.values, tr);
+    t.effect->configure_basis(row, override ? *extra_values : t.values, tr);
   }
   return tr;
 }
 
 SignalValues Design::predict_with(const SignatureRow& row, AngleBasis& basis, std::size_t override_term,
                                   const std::vector<double>* override_values) const {
-  basis.set(row, transform(override_term, override_values));
+  basis.set(row, transform(row, override_term, override_values));
   SignalValues pred;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
@@ -215,10 +227,53 @@ SignalValues Design::predict(const FitRow& row, AngleBasis& basis) const {
   return predict_with(row.sig, basis, terms_.size(), nullptr);
 }
 
-void Design::evaluate(const FitRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const {
+namespace {
+
+struct RowsHistory {
+  std::span<const FitRow> rows;
+};
+
+/// theta at time t from the rows before `index` (linear between two rows; NaN
+/// before the first row or across a gap of more than 3 row spacings).
+double history_angle(const void* context, std::size_t index, double t) {
+  const auto& rows = static_cast<const RowsHistory*>(context)->rows;
+  if (index >= rows.size()) return std::nan("");
+  std::size_t k = index;
+  while (k > 0 && rows[k].sig.t > t) {
+    const double gap = rows[k].sig.t - rows[k - 1].sig.t;
+    if (k < index && gap > 3.0 * (rows[k + 1].sig.t - rows[k].sig.t)) return std::nan("");
+    --k;
+  }
+  if (rows[k].sig.t > t) return std::nan("");
+  if (k == index) return rows[k].sig.theta;
+  const FitRow& a = rows[k];
+  const FitRow& b = rows[k + 1];
+  const double f = (t - a.sig.t) / (b.sig.t - a.sig.t);
+  return a.sig.theta + f * (b.sig.theta - a.sig.theta);
+}
+
+}  // namespace
+
+SignalValues Design::predict(std::span<const FitRow> rows, std::size_t i, AngleBasis& basis) const {
+  const RowsHistory h{rows};
+  SignatureRow row = rows[i].sig;
+  row.history = AngleHistory{&h, &history_angle, i};
+  return predict_with(row, basis, terms_.size(), nullptr);
+}
+
+void Design::evaluate(std::span<const FitRow> rows, std::size_t i, AngleBasis& basis, SignalValues& prediction,
+                      RowJacobian& jac) const {
+  const RowsHistory h{rows};
+  SignatureRow row = rows[i].sig;
+  row.history = AngleHistory{&h, &history_angle, i};
+  evaluate_row(row, basis, prediction, jac);
+}
+
+void Design::evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValues& prediction,
+                          RowJacobian& jac) const {
   if (jac.rd.size() != columns_) jac.resize(columns_);
   jac.set_zero();
-  prediction = predict_with(row.sig, basis, terms_.size(), nullptr);
+  prediction = predict_with(row, basis, terms_.size(), nullptr);
   int col = 0;
   for (Nuisance n : nuisances_) {
     switch (n) {
@@ -236,15 +291,18 @@ void Design::evaluate(const FitRow& row, AngleBasis& basis, SignalValues& predic
     const auto ps = t.effect->params();
     SignatureColumns cols(std::span<SignalValues>(scratch_.data(), ps.size()));
     cols.clear();
-    t.effect->signature(row.sig, basis, t.values, cols);
+    t.effect->signature(row, basis, t.values, cols);
     for (std::size_t k = 0; k < t.params.size(); ++k, ++col) {
       const auto p = static_cast<std::size_t>(t.params[k]);
       SignalValues c = cols.col(p);
-      if (ps[p].nonlinear) {
-        const double z = to_internal(ps[p], t.values[p]);
+      // Numeric through the whole prediction when the parameter is nonlinear or its
+      // effect moves the basis (a mounting offset turns every winding error with the
+      // seen angle: a cross term its own column does not carry).
+      if (ps[p].nonlinear || t.effect->shapes_basis()) {
+        const double z = ps[p].polar != Polar::kNone ? 0.0 : to_internal(ps[p], t.values[p]);
         const double h = fd_step(ps[p], z);
         const std::vector<double> moved = values_with(i, static_cast<int>(k), h);
-        const SignalValues shifted_pred = predict_with(row.sig, shifted, i, &moved);
+        const SignalValues shifted_pred = predict_with(row, shifted, i, &moved);
         c = SignalValues{.rd = (shifted_pred.rd - prediction.rd) / h, .sa = (shifted_pred.sa - prediction.sa) / h,
                          .sr = (shifted_pred.sr - prediction.sr) / h, .d = (shifted_pred.d - prediction.d) / h,
                          .q = (shifted_pred.q - prediction.q) / h};

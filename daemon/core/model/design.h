@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -63,7 +64,8 @@ class Design {
   [[nodiscard]] std::vector<std::string> column_names() const;
   /// First column of term i.
   [[nodiscard]] int term_column(std::size_t i) const { return term_first_[i]; }
-  /// True when a model (not candidate) parameter is nonlinear.
+  /// True when a model (not candidate) parameter is nonlinear or a model term
+  /// shapes the basis (Gauss-Newton then iterates).
   [[nodiscard]] bool nonlinear() const;
 
   /// The internal coordinates of the fitted parameters (nuisance entries 0).
@@ -76,15 +78,24 @@ class Design {
 
   /// Evaluates one row: the prediction of every signal (model terms) and the
   /// Jacobian rows of every column. `basis` is scratch.
-  void evaluate(const FitRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const;
+  void evaluate(const FitRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const {
+    evaluate_row(row.sig, basis, prediction, jac);
+  }
+  /// The same for rows[i], with the earlier rows as the angle's history (a delay
+  /// reads theta(t - d) from them: exact across speed steps).
+  void evaluate(std::span<const FitRow> rows, std::size_t i, AngleBasis& basis, SignalValues& prediction,
+                RowJacobian& jac) const;
   /// The prediction only (compensation, residual series).
   [[nodiscard]] SignalValues predict(const FitRow& row, AngleBasis& basis) const;
+  [[nodiscard]] SignalValues predict(std::span<const FitRow> rows, std::size_t i, AngleBasis& basis) const;
 
  private:
-  [[nodiscard]] BasisTransform transform(std::size_t extra_term, const std::vector<double>* extra_values) const;
+  [[nodiscard]] BasisTransform transform(const SignatureRow& row, std::size_t extra_term,
+                                         const std::vector<double>* extra_values) const;
   [[nodiscard]] SignalValues predict_with(const SignatureRow& row, AngleBasis& basis, std::size_t override_term,
                                           const std::vector<double>* override_values) const;
   void rebuild();
+  void evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const;
 
   std::vector<Nuisance> nuisances_;
   std::vector<DesignTerm> terms_;

@@ -5,6 +5,12 @@
 
 namespace resolver {
 
+namespace {
+/// Smallest eigenvalue of the unit-diagonal normal matrix a fit accepts: for two
+/// columns it is 1 - |correlation|; 1e-5 is a correlation of 0.99999.
+constexpr double kCollinear = 1e-5;
+}  // namespace
+
 PassStatistics::PassStatistics(int columns) {
   for (int g = 0; g < kGroups; ++g) {
     all.emplace_back(columns);
@@ -34,14 +40,15 @@ void accumulate(const Design& design, std::span<const FitRow> rows, const GroupF
   RowJacobian jac;
   jac.resize(design.columns());
   const bool use_rd = floors.rd > 0.0, use_sc = floors.sc > 0.0, use_cur = floors.cur > 0.0;
-  for (const FitRow& r : rows) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const FitRow& r = rows[i];
     if (!r.fitted()) continue;
-    design.evaluate(r, basis, pred, jac);
+    design.evaluate(rows, i, basis, pred, jac);
     const bool b = r.has(FitRow::kFoldB);
     auto add = [&](Group g, const Eigen::VectorXd& x, double y) {
-      const auto i = static_cast<std::size_t>(g);
-      out.all[i].add(x, y);
-      if (!b) out.fold_a[i].add(x, y);
+      const auto k = static_cast<std::size_t>(g);
+      out.all[k].add(x, y);
+      if (!b) out.fold_a[k].add(x, y);
     };
     if (use_rd && r.has(FitRow::kHasRd)) add(Group::kRd, jac.rd, r.y_rd - pred.rd);
     if (use_sc && r.has(FitRow::kHasSc)) {
@@ -94,6 +101,11 @@ StepSolution solve_step(const std::vector<NormalEquations>& groups, const GroupF
     Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(ms);
     cod.setThreshold(1e-9);
     if (cod.rank() < k) return out;
+    // Nearly collinear columns (a column explained to 1 - 1e-5 by the others: e.g.
+    // alpha's 2 theta and a mechanical order 2 at p_r = 1 without sin/cos, apart from
+    // alpha's own 1e-3 series terms) would give a fit the data does not support.
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(ms, Eigen::EigenvaluesOnly);
+    if (eig.eigenvalues().minCoeff() < kCollinear) return out;
     if (lambda > 0.0) ms.diagonal().array() += lambda;
     const Eigen::MatrixXd ms_inv = ms.inverse();
     step = inv.asDiagonal() * (ms_inv * (inv.asDiagonal() * b));

@@ -211,7 +211,7 @@ SignalValues model_prediction(const ChainValues& values, const Bench& b, int i) 
   const SignatureRow r = row_at(b, i);
   BasisTransform t;
   for (const Effect* e : effect_registry()) {
-    if (values.active(*e)) e->configure_basis(values.of(*e), t);
+    if (values.active(*e)) e->configure_basis(r, values.of(*e), t);
   }
   AngleBasis basis;
   basis.set(r, t);
