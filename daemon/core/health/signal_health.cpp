@@ -397,9 +397,9 @@ std::string SignalHealthSummary::describe() const {
   std::string out;
   for (const Fault& f : faults) {
     if (f.samples == 0) continue;
-    out += fmt::format("{}{} {:.1f} % of the log ({} sample(s), {} episode(s), t = {:.3f} .. {:.3f} s{})",
-                       out.empty() ? "" : "; ", fault_name(f.fault), 100.0 * f.share, f.samples, f.episodes, f.first_t,
-                       f.last_t, f.active_at_end ? ", still at the end" : "");
+    out += fmt::format("{}{} {:.1f} % of the log ({} sample(s), {} episode(s), {:.3f} .. {:.3f} s into it{})",
+                       out.empty() ? "" : "; ", fault_name(f.fault), 100.0 * f.share, f.samples, f.episodes,
+                       f.first_t - t_first, f.last_t - t_first, f.active_at_end ? ", still at the end" : "");
   }
   return out.empty() ? std::string("no signal fault") : out;
 }

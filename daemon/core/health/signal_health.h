@@ -257,7 +257,7 @@ struct SignalHealthSummary {
   [[nodiscard]] const Fault& fault(SignalFault f) const { return faults[static_cast<std::size_t>(f)]; }
   /// The faults that held for at least `min_share` of the log (0.2 = a fifth).
   [[nodiscard]] std::vector<SignalFault> holding(double min_share) const;
-  /// One line: "loss_of_signal 100.0 % of the log (20000 sample(s), 1 episode(s), t = ...)"
+  /// One line: "loss_of_signal 100.0 % of the log (20000 sample(s), 1 episode(s), 0.000 .. 9.999 s into it)"
   /// for each fault seen, or "no signal fault".
   [[nodiscard]] std::string describe() const;
 };
