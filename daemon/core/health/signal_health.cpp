@@ -53,41 +53,43 @@ void RunningMedian::add(double v) {
   ring_[next_] = v;
   next_ = (next_ + 1) % kSize;
   count_ = std::min(count_ + 1, kSize);
-  ++stale_;
-}
-
-void RunningMedian::refresh() {
-  // Fresh while young (every value counts) and every kRefreshEvery additions after.
-  if (computed_ && stale_ == 0) return;
-  if (computed_ && count_ >= kSize && stale_ < kRefreshEvery) return;
-  std::array<double, kSize> tmp{};
-  std::copy_n(ring_.begin(), count_, tmp.begin());
-  const auto end = tmp.begin() + static_cast<std::ptrdiff_t>(count_);
-  const auto mid = tmp.begin() + static_cast<std::ptrdiff_t>(count_ / 2);
-  std::nth_element(tmp.begin(), mid, end);
-  median_ = *mid;
-  for (auto it = tmp.begin(); it != end; ++it) *it = std::abs(*it - median_);
-  std::nth_element(tmp.begin(), mid, end);
-  sigma_ = kMadToSigma * *mid;
-  stale_ = 0;
-  computed_ = true;
+  if (median_age_ != kNever) ++median_age_;
+  if (sigma_age_ != kNever) ++sigma_age_;
 }
 
 double RunningMedian::median() {
-  refresh();
+  if (stale(median_age_)) {
+    std::copy_n(ring_.begin(), count_, scratch_.begin());
+    const auto mid = scratch_.begin() + static_cast<std::ptrdiff_t>(count_ / 2);
+    std::nth_element(scratch_.begin(), mid, scratch_.begin() + static_cast<std::ptrdiff_t>(count_));
+    median_ = *mid;
+    median_age_ = 0;
+  }
   return median_;
 }
 
 double RunningMedian::robust_sigma() {
-  refresh();
+  if (stale(sigma_age_)) {
+    const double med = median();
+    for (std::size_t i = 0; i < count_; ++i) scratch_[i] = std::abs(ring_[i] - med);
+    const auto mid = scratch_.begin() + static_cast<std::ptrdiff_t>(count_ / 2);
+    std::nth_element(scratch_.begin(), mid, scratch_.begin() + static_cast<std::ptrdiff_t>(count_));
+    sigma_ = kMadToSigma * *mid;
+    sigma_age_ = 0;
+  }
   return sigma_;
 }
 
 SignalHealthMonitor::SignalHealthMonitor(const SignalHealthConfig& config, int p_r, double sample_rate_hz)
     : config_(config), p_r_(p_r), sample_rate_hz_(sample_rate_hz) {}
 
+namespace {
+/// sqrt(s^2 + c^2): signal values are far from overflow, so std::hypot's care is not needed (and costs).
+double radius(const Sample& s) { return std::sqrt(s.sin * s.sin + s.cos * s.cos); }
+}  // namespace
+
 bool SignalHealthMonitor::sincos_lost(const Sample& s) const {
-  return s.has_sincos && std::hypot(s.sin, s.cos) < config_.loss_of_signal_fraction * config_.full_scale;
+  return s.has_sincos && radius(s) < config_.loss_of_signal_fraction * config_.full_scale;
 }
 
 AmplitudeStats SignalHealthMonitor::take_amplitude_window() {
@@ -216,7 +218,7 @@ void SignalHealthMonitor::add(const Sample& s) {
   bool sincos_usable = false;
   double sincos_angle = 0.0;
   if (s.has_sincos) {
-    const double r = std::hypot(s.sin, s.cos);
+    const double r = radius(s);
     amplitude_window_.add(r);
     amplitude_total_.add(r);
     block_.r_all.add(r);
@@ -273,7 +275,7 @@ void SignalHealthMonitor::set_fault(SignalFault f, bool present, std::int64_t sa
 }
 
 void SignalHealthMonitor::evaluate_block() {
-  const Block& b = block_;
+  Block& b = block_;
   const double fs = config_.full_scale;
   const double t0 = b.t_first;
   const std::int64_t i0 = b.index_first;
@@ -326,8 +328,7 @@ void SignalHealthMonitor::evaluate_block() {
   }
 
   if (!b.steps.empty()) {
-    std::vector<double> steps = b.steps;
-    const double step = median_of(steps);
+    const double step = median_of(b.steps);
     const double over = config_.overspeed_rad_per_sample;
     std::string speed;
     if (sample_rate_hz_ > 0.0 && p_r_ > 0) {
@@ -350,7 +351,10 @@ void SignalHealthMonitor::evaluate_block() {
                           "the estimators to learn from)",
                           hz, config_.stopped_below_hz));
   }
+  std::vector<double> steps = std::move(block_.steps);  // keeps its capacity: no allocation per block
+  steps.clear();
   block_ = Block{};
+  block_.steps = std::move(steps);
 }
 
 SignalHealthSummary summarize(const SignalHealthMonitor& monitor, std::vector<SignalFaultEvent> events, double t_first,

@@ -122,18 +122,18 @@ struct AmplitudeStats {
   }
 };
 
-/// Median and median absolute deviation of the last kSize values. Both are
-/// recomputed after every kRefreshEvery additions (a selection over the ring),
-/// so they lag the newest values by at most that many: the cost per sample is
-/// a few dozen comparisons, not a sort.
+/// Median and median absolute deviation of the last kSize values. Each is
+/// recomputed (a selection over the ring) only when asked for and at most once
+/// per kRefreshEvery additions once the ring is full, so it lags the newest
+/// values by up to that many: a few comparisons per sample, not a sort.
 class RunningMedian {
  public:
   static constexpr std::size_t kSize = 128;
-  static constexpr std::size_t kRefreshEvery = 8;
+  static constexpr std::size_t kRefreshEvery = 32;
   void add(double v);
   void clear() {
-    count_ = next_ = stale_ = 0;
-    computed_ = false;
+    count_ = next_ = 0;
+    median_age_ = sigma_age_ = kNever;
   }
   [[nodiscard]] std::size_t size() const { return count_; }
   /// Needs size() > 0.
@@ -142,12 +142,16 @@ class RunningMedian {
   [[nodiscard]] double robust_sigma();
 
  private:
-  void refresh();
+  static constexpr std::size_t kNever = ~std::size_t{0};
+  [[nodiscard]] bool stale(std::size_t age) const {
+    return age == kNever || (age > 0 && (count_ < kSize || age >= kRefreshEvery));
+  }
   std::array<double, kSize> ring_{};
+  std::array<double, kSize> scratch_{};
   std::size_t count_ = 0;
   std::size_t next_ = 0;
-  std::size_t stale_ = 0;  ///< additions since the last refresh (0 = fresh)
-  bool computed_ = false;
+  std::size_t median_age_ = kNever;  ///< additions since median_ was computed
+  std::size_t sigma_age_ = kNever;
   double median_ = 0.0;
   double sigma_ = 0.0;
 };
