@@ -12,7 +12,7 @@ namespace resolver {
 namespace {
 
 /// The payload bits a signal occupies, by DBC bit number (bit k of byte b = 8b + k).
-using PayloadBits = std::bitset<8 * 64>;
+using PayloadBits = std::bitset<std::size_t{8} * 64>;
 
 PayloadBits bits_of(const dbc::Signal& sig) {
   PayloadBits bits;

@@ -361,35 +361,33 @@ class LcmLogsOtherToolsCanUse(unittest.TestCase):
 
 
 class SighupInReplay(unittest.TestCase):
-    def test_reload_switches_the_estimator(self):
+    def replay_and_reload(self, name, before, after, lcm):
+        """Paced replay of a 2 s log with config text `before`; 0.8 s in, the file becomes
+        `after` and resolverd gets SIGHUP. Returns stderr once it ran to the end (exit 0)."""
         log = sim_log("clean_200rpm.log", "--rpm", "200", "--duration", "2")
-        cfg, lcmlog = work("sighup.toml"), work("sighup.lcmlog")
+        cfg = work(name + ".toml")
         with open(cfg, "w") as f:
-            f.write('[estimator]\nmethod = "hwang_integral"\n')
-        proc = spawn(resolverd("--replay", log, "--once", "--config", cfg, "--quiet", "--lcm", f"file://{lcmlog}?mode=w"))
+            f.write(before)
+        proc = spawn(resolverd("--replay", log, "--once", "--config", cfg, "--quiet", "--lcm", lcm))
         time.sleep(0.8)
         with open(cfg, "w") as f:
-            f.write('[estimator]\nmethod = "sincos_least_squares"\n')
+            f.write(after)
         proc.send_signal(signal.SIGHUP)
-        out, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=60)
         self.assertEqual(proc.returncode, 0, err)
-        self.assertIn("resolverd: config reloaded from " + cfg, err)
+        return err
+
+    def test_reload_switches_the_estimator(self):
+        lcmlog = work("sighup.lcmlog")
+        err = self.replay_and_reload("sighup", '[estimator]\nmethod = "hwang_integral"\n',
+                                     '[estimator]\nmethod = "sincos_least_squares"\n', f"file://{lcmlog}?mode=w")
+        self.assertIn("resolverd: config reloaded from " + work("sighup.toml"), err)
         methods = [m["method"] for m in echo_messages(lcmlog, "--channel", "RESOLVER_ESTIMATE")]
         self.assertIn("hwang_integral", methods)
         self.assertEqual(methods[-1], "sincos_least_squares", "the reloaded config runs to the end")
 
     def test_bad_config_on_reload_keeps_the_running_one(self):
-        log = sim_log("clean_200rpm.log", "--rpm", "200", "--duration", "2")
-        cfg = work("sighup_bad.toml")
-        with open(cfg, "w") as f:
-            f.write("[bench]\np_r = 3\n")
-        proc = spawn(resolverd("--replay", log, "--once", "--config", cfg, "--quiet", "--lcm", "memq://"))
-        time.sleep(0.8)
-        with open(cfg, "w") as f:
-            f.write("[bench]\npole_pairs = 3\n")
-        proc.send_signal(signal.SIGHUP)
-        _, err = proc.communicate(timeout=60)
-        self.assertEqual(proc.returncode, 0, err)
+        err = self.replay_and_reload("sighup_bad", "[bench]\np_r = 3\n", "[bench]\npole_pairs = 3\n", "memq://")
         self.assertIn("reload failed, keeping the running config", err)
         self.assertIn("unknown key 'pole_pairs' in [bench]", err)
 
