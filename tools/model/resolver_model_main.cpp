@@ -29,6 +29,7 @@
 #include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -120,6 +121,7 @@ int run(int argc, char** argv) {
                "  resolver-model report build/demo/demo.log --html demo.html"};
   app.footer(resolver::exit_code::kHelpText);
   app.require_subcommand(1);
+  app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
   std::vector<std::string> effects_args;
   std::string config_path;
