@@ -18,6 +18,9 @@ constexpr std::size_t kMinHistory = RunningMedian::kSize / 2;
 constexpr int kLevelChangeRun = 8;
 /// Steps across more lost samples than this are not used for speed or prediction.
 constexpr std::int64_t kMaxStepGap = 8;
+/// Fewest angle steps in a block that decide stopped and overspeed (a tenth of a
+/// block at 2 kHz; a median of fewer says little).
+constexpr std::size_t kMinSpeedSteps = 20;
 /// 1.4826 MAD = sigma for Gaussian data.
 constexpr double kMadToSigma = 1.4826;
 
@@ -174,12 +177,10 @@ void SignalHealthMonitor::add_speed(const Sample& s, bool sincos_usable, double 
   if (same_source && gap >= 1 && gap <= kMaxStepGap) {
     double step = wrap_pi(angle - last_angle_);
     if (source == 1) step *= static_cast<double>(p_r_);  // mechanical -> resolver electrical
-    if (!block_.travel_started) {
-      block_.travel_started = true;
-      block_.travel_t0 = last_angle_t_;
-    }
     block_.travel += step;
-    block_.travel_t1 = s.t;
+    // The counter is the clock between two samples: gap / rate, not the difference of
+    // their t, which jumps where the sample clock re-anchors after a stall.
+    block_.travel_time += sample_rate_hz_ > 0.0 ? static_cast<double>(gap) / sample_rate_hz_ : s.t - last_angle_t_;
     block_.steps.push_back(std::abs(step) / static_cast<double>(gap));
     block_.steps_from_reference = source == 1;
   }
@@ -327,7 +328,10 @@ void SignalHealthMonitor::evaluate_block() {
                           b.outliers, config_.outlier_sigmas));
   }
 
-  if (!b.steps.empty()) {
+  // Speed needs a few steps: a block that kept only a handful (samples lost, the speed
+  // source missing) says nothing about stop or overspeed and leaves both as they were.
+  const bool speed_known = b.steps.size() >= kMinSpeedSteps;
+  if (speed_known) {
     const double step = median_of(b.steps);
     const double over = config_.overspeed_rad_per_sample;
     std::string speed;
@@ -343,9 +347,8 @@ void SignalHealthMonitor::evaluate_block() {
                                                  : "; without a reference angle a speed near the sample rate aliases "
                                                    "and may read slow"));
   }
-  const double span = b.travel_t1 - b.travel_t0;
-  if (b.travel_started && span > 0.0) {
-    const double hz = std::abs(b.travel) / span / kTwoPi;
+  if (speed_known && b.travel_time > 0.0) {
+    const double hz = std::abs(b.travel) / b.travel_time / kTwoPi;
     set_fault(SignalFault::kStopped, hz < config_.stopped_below_hz, b.n, t0, i0,
               fmt::format("resolver electrical speed {:.3g} Hz, below {:g} Hz: the motor stands still (nothing for "
                           "the estimators to learn from)",

@@ -194,9 +194,8 @@ class SignalHealthMonitor {
     AmplitudeStats r_clean;      ///< without outliers (the DOS swing must not be a spike)
     std::int64_t lot_checked = 0, lot_beyond = 0;
     double lot_worst = 0.0;      ///< [rad]
-    bool travel_started = false;
     double travel = 0.0;         ///< [rad] electrical, summed wrapped steps
-    double travel_t0 = 0.0, travel_t1 = 0.0;  ///< [s]
+    double travel_time = 0.0;    ///< [s] the time those steps span
     std::vector<double> steps;   ///< |electrical step| [rad per sample]
     bool steps_from_reference = false;
     std::int64_t clipped = 0, outliers = 0;

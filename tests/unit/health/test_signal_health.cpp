@@ -195,6 +195,34 @@ TEST(SignalHealth, StoppedMotor) {
   EXPECT_EQ(run(slow).fault(SignalFault::kStopped).samples, 0);
 }
 
+TEST(SignalHealth, StallsAndLostSamplesDoNotFakeAStop) {
+  // A loaded live reader: the sample clock re-anchors after stalls (t jumps 90 ms
+  // forward every 50 samples while the counter goes on by one), and bursts of samples
+  // are lost (gaps of 20 indices). The motor turns at 200 r/min all along.
+  auto samples = make_samples(Bench{});
+  std::vector<Sample> damaged;
+  double shift = 0.0;
+  for (const Sample& x : samples) {
+    if (x.index % 100 >= 40 && x.index % 100 < 60) continue;  // lost
+    if (x.index % 50 == 0) shift += 0.09;
+    Sample y = x;
+    y.t += shift;
+    damaged.push_back(y);
+  }
+  const SignalHealthSummary s = summarize_signal_health(damaged, {}, kPr, kRate);
+  EXPECT_EQ(s.fault(SignalFault::kStopped).samples, 0) << s.describe();
+  EXPECT_EQ(s.fault(SignalFault::kOverspeed).samples, 0) << s.describe();
+  // Control: the same damage on a stopped motor is still a stop.
+  Bench stopped;
+  stopped.rpm = 0.0;
+  std::vector<Sample> still;
+  for (const Sample& x : make_samples(stopped)) {
+    if (x.index % 100 >= 40 && x.index % 100 < 60) continue;
+    still.push_back(x);
+  }
+  EXPECT_GT(summarize_signal_health(still, {}, kPr, kRate).fault(SignalFault::kStopped).share, 0.9);
+}
+
 TEST(SignalHealth, OverspeedBeforeAliasingAndWithAnAliasedAngle) {
   // Line pi/4 rad per sample = 5000 r/min at 2 kHz with p_r = 3.
   Bench below;
