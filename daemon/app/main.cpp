@@ -27,7 +27,9 @@ namespace {
 
 constexpr const char* kDescription = R"(resolverd: reads resolver sin/cos, R/D angle and phase currents from CAN,
 estimates the resolver's amplitude imbalance (Hwang et al. 2009 integral method),
-compensates the angle and publishes angle_t, dq_t, estimate_t and health_t on LCM.
+compensates the angle and publishes angle_t, dq_t, estimate_t and health_t (with the
+signal faults: loss of signal, degradation, loss of tracking, clipping, stop, overspeed,
+outliers) on LCM.
 
 Examples:
   # offline, as fast as possible, then print a report and exit
@@ -36,7 +38,6 @@ Examples:
   resolverd --replay demo.log
   # live from SocketCAN
   resolverd --can can0 --config /etc/resolverd/resolverd.toml
-
   # four times the log's speed: lcm-logger keeps up where --fast would make it drop
   resolverd --replay demo.log --once --rate 4
 
