@@ -33,7 +33,8 @@
 //   [layout.signals]           # role = "MESSAGE.signal"
 //   sin = "RESOLVER_SAMPLE.sin"
 //   [estimator]
-//   method = "hwang_integral"  # or "sincos_least_squares", "fourier_reference"
+//   method = "model"           # the [model] fitted live (default); or the seed "hwang_integral",
+//                              # "sincos_least_squares", "fourier_reference"
 //   min_revolutions = 3        # hwang_integral
 //   max_speed_change = 0.02    # hwang_integral
 //   forgetting = 1.0           # sincos_least_squares / fourier_reference: 1 = all data
@@ -47,6 +48,11 @@
 //   effects = ["amplitude_imbalance"]   # the active model; SIGHUP reloads it
 //   window_revolutions = 16    # resolver electrical revolutions per window
 //   candidates = true          # also rank the catalog effects not in the model
+//   [[model.custom]]           # effects users add without recompiling (custom_effect.h)
+//   name = "slow_drift"
+//   signal = "position_error"  # position_error | rd_angle | sin | cos | i_d | i_q
+//   terms = ["t", "t*sin(2*theta)"]
+//   description = "alpha warming up"
 //   [health]                   # signal faults (daemon/core/health/signal_health.h says where each default is from)
 //   full_scale = 0             # [counts] |sin|,|cos| the ADC reaches; 0 = the DBC signal's range
 //   loss_of_signal_fraction = 0.05     # LOS: amplitude below this share of full scale
@@ -65,7 +71,10 @@
 #include <string>
 #include <vector>
 
+#include <memory>
+
 #include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/core/model/custom_effect.h"
 #include "daemon/core/health/signal_health.h"
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/signal_map.h"
@@ -112,7 +121,12 @@ struct BenchDefaults {
 /// Live model discovery (DESIGN 7): the active effect list and its window.
 struct ModelFitOptions {
   bool enabled = true;
+  /// The active model: effect references (daemon/core/model/model_spec.h), catalog
+  /// effects or [[model.custom]] names, e.g. ["amplitude_imbalance", "harmonics(k5)"].
   std::vector<std::string> effects{"amplitude_imbalance"};  ///< the seed's model
+  /// [[model.custom]] blocks as written, and compiled (shared: models point into them).
+  std::vector<CustomEffectSpec> custom;
+  std::shared_ptr<const CustomEffects> customs;
   double window_revolutions = 16.0;  ///< resolver electrical revolutions per model_fit_t
   bool candidates = true;            ///< rank the missing catalog effects (explain) or only fit
 };
@@ -129,8 +143,8 @@ struct DaemonConfig {
   std::string dbc_path;  ///< "" = proto/resolver_bench.dbc, compiled into the binary
   SignalMap signal_map = SignalMap::bench_default();
   int max_counter_delta = 8;
-  std::string estimator_method = "hwang_integral";
-  EstimatorMethod method = EstimatorMethod::kHwangIntegral;
+  std::string estimator_method = "model";
+  EstimatorMethod method = EstimatorMethod::kModel;
   HwangIntegralConfig hwang;
   SinCosLsConfig sincos;
   AngleFourierConfig fourier;

@@ -167,7 +167,20 @@ void Pipeline::tick(std::int64_t now_us) {
 
 void Pipeline::finish() {
   intake_.flush();
-  if (model_fit_) model_fit_->finish();
+  if (model_fit_) {
+    model_fit_->finish();
+    if (auto fitted = model_fit_->take_model()) {
+      processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+      // No sample follows to carry it: publish the final estimate now.
+      if (processor_.config().method == EstimatorMethod::kModel) {
+        BenchSample last;
+        last.timestamp_us = last_frame_us_;
+        last.index = last_sample_index_;
+        last.counter = last_counter_;
+        publish_estimate(last_frame_us_, last);
+      }
+    }
+  }
   signal_health_.finish();
   publish_health(last_frame_us_);
 }
@@ -250,7 +263,7 @@ void Pipeline::on_sample(const BenchSample& sample) {
 }
 
 void Pipeline::feed_model_fit(const SampleInput& in, const BenchSample& sample) {
-  DiscoverySample d;
+  Sample d;
   d.t = in.t;
   d.has_rd = in.has_rd;
   d.theta_rd = in.theta_rd;
@@ -265,6 +278,9 @@ void Pipeline::feed_model_fit(const SampleInput& in, const BenchSample& sample) 
   d.i_c = in.i_c;
   const ProcessorConfig& pc = processor_.config();
   model_fit_->add(d, pc.p_r, pc.p, {sample.timestamp_us, sample.index, sample.counter});
+  if (auto fitted = model_fit_->take_model()) {
+    processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+  }
 }
 
 void Pipeline::publish_estimate(std::int64_t utime, const BenchSample& sample) {

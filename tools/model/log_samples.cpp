@@ -20,7 +20,7 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
                      FrameIntake::Callbacks{
                          [&](const BenchSample& s) {
                            if (first_us < 0) first_us = s.timestamp_us;
-                           DiscoverySample d;
+                           Sample d;
                            d.t = static_cast<double>(s.timestamp_us - first_us) * 1e-6;
                            d.has_rd = s.has(Role::kRdAngle);
                            d.theta_rd = s.get(Role::kRdAngle);
