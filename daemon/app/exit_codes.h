@@ -12,7 +12,6 @@
 // option, ...) never leave a program: parse_command_line() maps them.
 #pragma once
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -48,12 +47,11 @@ inline constexpr const char* kHelpText =
   return std::nullopt;
 }
 
-/// nullopt when `path` can be opened for reading, else "cannot read <option> <path>: <strerror>".
+/// nullopt when `path` exists and may be read, else "cannot read <option> <path>: <strerror>".
+/// access(2), not open(2): opening a FIFO would briefly be its reader and let a
+/// waiting writer write into a pipe nobody reads.
 [[nodiscard]] inline std::optional<std::string> unreadable(const std::string& option, const std::string& path) {
-  // O_NONBLOCK: a FIFO must not block the check (its reader opens it again).
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) return "cannot read " + option + " " + path + ": " + std::strerror(errno);
-  ::close(fd);
+  if (::access(path.c_str(), R_OK) != 0) return "cannot read " + option + " " + path + ": " + std::strerror(errno);
   return std::nullopt;
 }
 

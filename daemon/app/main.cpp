@@ -95,6 +95,10 @@ static int run(int argc, char** argv) {
                  "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
                  "saved at exit when the estimate has converged");
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
+  // From here a SIGTERM is a request the run loop honours (it finds the flag set at
+  // its first look), not the default death by signal, however early it comes.
+  StopFlags flags;
+  install_signal_handlers(flags);
   if (replay_path.empty() && can_iface.empty()) {
     std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
     return exit_code::kUsage;
@@ -160,8 +164,6 @@ static int run(int argc, char** argv) {
   SdNotifier notifier = SdNotifier::from_environment();
   if (!notifier.last_error().empty()) std::cerr << "resolverd: " << notifier.last_error() << "\n";
 
-  StopFlags flags;
-  install_signal_handlers(flags);
   RunInfo info;
   // SIGHUP: a new config replaces the pipeline only if it is valid (live and replay).
   auto reload = [&]() {
