@@ -171,6 +171,58 @@ void read_model_section(const toml::table& t, ModelFitOptions& m, const std::str
   }
 }
 
+void read_health_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "health",
+             {"full_scale", "loss_of_signal_fraction", "degradation_low_fraction", "degradation_high_fraction",
+              "degradation_mismatch", "loss_of_tracking_deg", "overspeed_rad_per_sample", "stopped_below_hz",
+              "outlier_sigmas", "block_s"},
+             s);
+  SignalHealthConfig& h = c.health;
+  double full_scale = 0.0;
+  read(t, "full_scale", full_scale, s, "health");
+  if (!(full_scale >= 0.0) || !std::isfinite(full_scale)) {
+    throw ConfigError(s + ": [health] full_scale must be a finite number >= 0 (0 = from the DBC signal's range)");
+  }
+  if (full_scale > 0.0) {
+    h.full_scale = full_scale;
+    h.clip_margin = 0.5;  // half a count: a config full scale is in counts
+    c.health_full_scale_set = true;
+  }
+  double lot_deg = rad_to_deg(h.loss_of_tracking_rad);
+  read(t, "loss_of_signal_fraction", h.loss_of_signal_fraction, s, "health");
+  read(t, "degradation_low_fraction", h.degradation_low_fraction, s, "health");
+  read(t, "degradation_high_fraction", h.degradation_high_fraction, s, "health");
+  read(t, "degradation_mismatch", h.degradation_mismatch, s, "health");
+  read(t, "loss_of_tracking_deg", lot_deg, s, "health");
+  read(t, "overspeed_rad_per_sample", h.overspeed_rad_per_sample, s, "health");
+  read(t, "stopped_below_hz", h.stopped_below_hz, s, "health");
+  read(t, "outlier_sigmas", h.outlier_sigmas, s, "health");
+  read(t, "block_s", h.block_s, s, "health");
+  // Written so NaN fails every check (NaN compares false).
+  auto in = [&s](double v, double lo, double hi, const char* key, const char* what) {
+    if (!(v > lo && v <= hi)) {
+      throw ConfigError(s + ": [health] " + key + " must be " + what + ", got " + std::to_string(v));
+    }
+  };
+  in(h.loss_of_signal_fraction, 0.0, 1.0, "loss_of_signal_fraction", "in (0, 1] (a share of full scale)");
+  in(h.degradation_low_fraction, 0.0, 1.0, "degradation_low_fraction", "in (0, 1] (a share of full scale)");
+  in(h.degradation_high_fraction, 0.0, 2.0, "degradation_high_fraction", "in (0, 2] (a share of full scale)");
+  if (!(h.loss_of_signal_fraction <= h.degradation_low_fraction &&
+        h.degradation_low_fraction < h.degradation_high_fraction)) {
+    throw ConfigError(s + ": [health] needs loss_of_signal_fraction <= degradation_low_fraction < "
+                          "degradation_high_fraction");
+  }
+  in(h.degradation_mismatch, 0.0, 10.0, "degradation_mismatch", "in (0, 10] (a share of the mean amplitude)");
+  in(lot_deg, 0.0, 180.0, "loss_of_tracking_deg", "in (0, 180] degrees (180 = never)");
+  h.loss_of_tracking_rad = lot_deg * kPi / 180.0;
+  in(h.overspeed_rad_per_sample, 0.0, kPi, "overspeed_rad_per_sample", "in (0, pi] (pi per sample aliases)");
+  if (!(h.stopped_below_hz >= 0.0 && std::isfinite(h.stopped_below_hz))) {
+    throw ConfigError(s + ": [health] stopped_below_hz must be a finite number >= 0 (0 = never)");
+  }
+  in(h.outlier_sigmas, 2.0, 1e6, "outlier_sigmas", "above 2 (robust standard deviations)");
+  in(h.block_s, 0.0, 10.0, "block_s", "in (0, 10] seconds");
+}
+
 }  // namespace
 
 DaemonConfig parse_daemon_config(std::string_view text, const std::string& source_name) {
@@ -185,7 +237,8 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   c.source = source_name;
   const std::string& s = source_name;
   check_keys(root, "top level",
-             {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation", "model"}, s);
+             {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation", "model", "health"},
+             s);
 
   auto section = [&root, &s](const char* name) -> const toml::table* {
     const toml::node* n = root.get(name);
@@ -340,6 +393,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     }
   }
   if (const auto* t = section("model")) read_model_section(*t, c.model, s);
+  if (const auto* t = section("health")) read_health_section(*t, c, s);
   if (c.compensation_domain == CompensationDomain::kSignal && c.method != EstimatorMethod::kSinCosLeastSquares) {
     throw ConfigError(s + ": [compensation] domain = \"signal\" needs [estimator] method = \"sincos_least_squares\" "
                           "(only it estimates the sin/cos signal parameters)");

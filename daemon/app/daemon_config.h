@@ -53,6 +53,17 @@
 //   signal = "position_error"  # position_error | rd_angle | sin | cos | i_d | i_q
 //   terms = ["t", "t*sin(2*theta)"]
 //   description = "alpha warming up"
+//   [health]                   # signal faults (daemon/core/health/signal_health.h says where each default is from)
+//   full_scale = 0             # [counts] |sin|,|cos| the ADC reaches; 0 = the DBC signal's range
+//   loss_of_signal_fraction = 0.05     # LOS: amplitude below this share of full scale
+//   degradation_low_fraction = 0.25    # DOS: amplitude below this share ...
+//   degradation_high_fraction = 0.95   # ... or above this one
+//   degradation_mismatch = 0.10        # DOS: amplitude swing over a block beyond this share of its mean
+//   loss_of_tracking_deg = 5.0         # LOT: R/D vs sin/cos angle disagreement
+//   overspeed_rad_per_sample = 0.785   # pi/4 of resolver electrical travel per sample
+//   stopped_below_hz = 0.1             # resolver electrical revolutions per second
+//   outlier_sigmas = 8.0               # robust z-score of an impulsive sample
+//   block_s = 0.1                      # [s] evaluation block of sample time
 #pragma once
 
 #include <optional>
@@ -64,6 +75,7 @@
 
 #include "daemon/core/estimation/hwang_integral.h"
 #include "daemon/core/model/custom_effect.h"
+#include "daemon/core/health/signal_health.h"
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/signal_map.h"
 
@@ -139,6 +151,10 @@ struct DaemonConfig {
   bool compensation_enabled = true;
   CompensationDomain compensation_domain = CompensationDomain::kAngle;
   ModelFitOptions model;
+  /// [health]: signal fault thresholds. health.full_scale applies only when
+  /// health_full_scale_set; otherwise the pipeline takes it from the DBC.
+  SignalHealthConfig health;
+  bool health_full_scale_set = false;
 };
 
 /// Thrown for unreadable or invalid configuration; what() names the file,

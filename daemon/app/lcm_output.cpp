@@ -1,7 +1,5 @@
 #include "daemon/app/lcm_output.h"
 
-#include <time.h>
-
 namespace resolver {
 
 LcmOutput::LcmOutput(const std::string& url, LcmChannels channels) : channels_(std::move(channels)) {
@@ -18,13 +16,5 @@ LcmOutput::LcmOutput(const std::string& url, LcmChannels channels) : channels_(s
 }
 
 bool LcmOutput::flush() { return writer_ ? writer_->flush() : true; }
-
-std::int64_t LcmOutput::now_us() {
-  // The log's event time is when the event was written, as lcm-logger and
-  // liblcm's file provider stamp it (wall clock, us since the epoch).
-  timespec ts{};
-  ::clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
-}
 
 }  // namespace resolver

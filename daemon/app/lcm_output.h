@@ -2,10 +2,17 @@
 // A file:///path?mode=w (or mode=a) URL is written by our own buffered LCM log
 // writer (lcm_log_writer.h: same file format, ~2x faster replays); every other
 // URL (udpm, memq, file with other options) goes through liblcm.
+//
+// Event times in a log we write are bench time: the message's utime (frame
+// time), never the wall clock, so lcm-logplayer replays a --fast replay's log
+// at the bench's own speed. A message older than the previous event (model_fit_t
+// is published a window late) keeps the previous event's time: players and
+// readers expect event times that never go back.
 #pragma once
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <stdexcept>
@@ -51,7 +58,8 @@ class LcmOutput final : public OutputSink {
   void send(const std::string& channel, const T& msg) {
     if (writer_) {
       const int size = msg.getEncodedSize();
-      std::uint8_t* data = writer_->begin_event(channel, static_cast<std::size_t>(size), now_us());
+      last_event_us_ = std::max(last_event_us_, static_cast<std::int64_t>(msg.utime));
+      std::uint8_t* data = writer_->begin_event(channel, static_cast<std::size_t>(size), last_event_us_);
       if (msg.encode(data, 0, size) != size) ++failures_;  // cannot happen for our own types; counted anyway
       else ++published_;
       return;
@@ -62,13 +70,13 @@ class LcmOutput final : public OutputSink {
       ++published_;
     }
   }
-  static std::int64_t now_us();
 
   std::unique_ptr<lcm::LCM> lcm_;
   std::unique_ptr<LcmLogWriter> writer_;
   LcmChannels channels_;
   std::uint64_t failures_ = 0;
   std::uint64_t published_ = 0;
+  std::int64_t last_event_us_ = 0;  ///< [us] event time of the last logged message
 };
 
 }  // namespace resolver

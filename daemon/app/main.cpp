@@ -4,12 +4,17 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cerrno>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <string_view>
 
 #include "daemon/app/daemon_config.h"
+#include "daemon/app/exit_codes.h"
 #include "daemon/app/lcm_output.h"
 #include "daemon/app/live_runner.h"
 #include "daemon/app/pipeline.h"
@@ -25,7 +30,9 @@ namespace {
 
 constexpr const char* kDescription = R"(resolverd: reads resolver sin/cos, R/D angle and phase currents from CAN,
 estimates the resolver's amplitude imbalance (Hwang et al. 2009 integral method),
-compensates the angle and publishes angle_t, dq_t, estimate_t and health_t on LCM.
+compensates the angle and publishes angle_t, dq_t, estimate_t and health_t (with the
+signal faults: loss of signal, degradation, loss of tracking, clipping, stop, overspeed,
+outliers) on LCM.
 
 Examples:
   # offline, as fast as possible, then print a report and exit
@@ -34,11 +41,17 @@ Examples:
   resolverd --replay demo.log
   # live from SocketCAN
   resolverd --can can0 --config /etc/resolverd/resolverd.toml
+  # four times the log's speed: lcm-logger keeps up where --fast would make it drop
+  resolverd --replay demo.log --once --rate 4
 
 Watch the output with: resolver-echo --lcm 'udpm://239.255.76.67:7667?ttl=0' --count 10   (or lcm-spy, lcm-logger)
 Channels (configurable in [channels]): RESOLVER_ANGLE, RESOLVER_DQ, RESOLVER_ESTIMATE,
-RESOLVER_MODEL_FIT, RESOLVER_HEALTH. Signals: SIGTERM/SIGINT exit cleanly (with --replay,
-after printing the report), SIGHUP reloads the config (a bad config keeps the old one).
+RESOLVER_MODEL_FIT, RESOLVER_HEALTH. A file:///PATH?mode=w log is stamped with bench time
+(each message's utime), so lcm-logplayer plays it at the bench's speed whatever --fast did.
+On udpm, --fast publishes as fast as the CPU allows and listeners (lcm-logger, lcm-spy) drop
+what their socket buffers cannot hold: use --rate X, or write a file:// log.
+Signals: SIGTERM/SIGINT end it within a second on any input (the report is printed);
+SIGHUP reloads the config, live and in replay (a bad config keeps the old one).
 )";
 
 using resolver::Calibration;
@@ -81,6 +94,16 @@ void describe_model(const Model& model, Calibration& cal) {
   }
 }
 
+/// True when `url` (or LCM's default, "" = $LCM_DEFAULT_URL else udpm) is UDP multicast.
+bool is_udpm(const std::string& url) {
+  std::string_view u = url;
+  if (u.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    u = env != nullptr ? std::string_view(env) : std::string_view("udpm://");
+  }
+  return u.empty() || u.substr(0, 7) == "udpm://";
+}
+
 }  // namespace
 
 static int run(int argc, char** argv) {
@@ -90,13 +113,21 @@ static int run(int argc, char** argv) {
   std::string config_path, replay_path, can_iface, report_path;
   std::optional<std::string> lcm_url;
   bool once = false, fast = false, quiet = false;
-  app.add_option("--config", config_path, "TOML config file (see README; every key optional)")->check(CLI::ExistingFile);
-  auto* replay = app.add_option("--replay", replay_path, "replay a candump -l log file instead of reading CAN")
-                     ->check(CLI::ExistingFile);
+  double rate = 1.0;
+  app.footer(exit_code::kHelpText);
+  app.add_option("--config", config_path, "TOML config file (see README; every key optional)");
+  auto* replay = app.add_option("--replay", replay_path, "replay a candump -l log file instead of reading CAN");
   auto* can = app.add_option("--can", can_iface, "read live frames from this SocketCAN interface (can0, vcan0)");
   replay->excludes(can);
   app.add_flag("--once", once, "with --replay: stop at the end of the log (default: loop it)")->needs(replay);
-  app.add_flag("--fast", fast, "with --replay: as fast as possible instead of the log's timing")->needs(replay);
+  auto* fast_opt =
+      app.add_flag("--fast", fast, "with --replay: as fast as possible instead of the log's timing")->needs(replay);
+  app.add_option("--rate", rate,
+                 "with --replay: play at RATE times the log's own speed (default 1 = real time); "
+                 "paces udpm for listeners that drop at --fast")
+      ->needs(replay)
+      ->excludes(fast_opt)
+      ->check(CLI::PositiveNumber);
   app.add_option("--lcm", lcm_url,
                  "LCM URL, overrides the config (default: LCM's udpm multicast; "
                  "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
@@ -111,10 +142,21 @@ static int run(int argc, char** argv) {
   app.add_option("--state-dir", state_dir,
                  "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
                  "saved at exit when the estimate has converged");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
+  // From here a SIGTERM is a request the run loop honours (it finds the flag set at
+  // its first look), not the default death by signal, however early it comes.
+  StopFlags flags;
+  install_signal_handlers(flags);
   if (replay_path.empty() && can_iface.empty()) {
     std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
-    return 2;
+    return exit_code::kUsage;
+  }
+  for (const auto& [option, path] : {std::pair{"--config", config_path}, std::pair{"--replay", replay_path}}) {
+    if (path.empty()) continue;
+    if (auto problem = exit_code::unreadable(option, path)) {
+      std::cerr << "resolverd: " << *problem << "\n";
+      return exit_code::kIo;
+    }
   }
 
   DaemonConfig config;
@@ -122,18 +164,35 @@ static int run(int argc, char** argv) {
     if (!config_path.empty()) config = load_daemon_config(config_path);
   } catch (const ConfigError& e) {
     std::cerr << "resolverd: " << e.what() << "\n";
-    return 2;
+    return exit_code::kUsage;
   }
   if (lcm_url) config.lcm_url = *lcm_url;
+  if (!config.dbc_path.empty()) {
+    if (auto problem = exit_code::unreadable("[layout] dbc", config.dbc_path)) {
+      std::cerr << "resolverd: " << config_path << ": " << *problem << "\n";
+      return exit_code::kIo;
+    }
+  }
 
   std::unique_ptr<LcmOutput> output;
   std::unique_ptr<Pipeline> pipeline;
   try {
     output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
+  } catch (const std::exception& e) {
+    std::cerr << "resolverd: " << e.what() << "\n";
+    return exit_code::kIo;
+  }
+  try {
     pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty());
   } catch (const std::exception& e) {
     std::cerr << "resolverd: " << e.what() << "\n";
-    return 2;
+    return exit_code::kUsage;
+  }
+  if (fast && is_udpm(config.lcm_url)) {
+    std::cerr << "resolverd: --fast on udpm publishes as fast as the CPU allows (hundreds of thousands of messages/s); "
+                 "listeners such as lcm-logger and lcm-spy drop what their socket buffers cannot hold. "
+                 "To keep every message: pace it with --rate X (X times real time) instead of --fast, "
+                 "or write a log with --lcm 'file:///PATH.lcmlog?mode=w' (stamped with bench time)\n";
   }
 
   if (!calibration_file.empty()) {
@@ -144,7 +203,7 @@ static int run(int argc, char** argv) {
       pipeline->use_table(std::move(table));
     } catch (const std::exception& e) {
       std::cerr << "resolverd: " << e.what() << "\n";
-      return 2;
+      return exit_code::kUsage;
     }
   }
   if (!state_dir.empty()) {
@@ -175,44 +234,44 @@ static int run(int argc, char** argv) {
   SdNotifier notifier = SdNotifier::from_environment();
   if (!notifier.last_error().empty()) std::cerr << "resolverd: " << notifier.last_error() << "\n";
 
-  StopFlags flags;
-  install_signal_handlers(flags);
   RunInfo info;
+  // SIGHUP: a new config replaces the pipeline only if it is valid (live and replay).
+  auto reload = [&]() {
+    notifier.reloading();
+    try {
+      DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
+      if (lcm_url) fresh.lcm_url = *lcm_url;
+      auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr, !can_iface.empty());
+      pipeline->finish();
+      pipeline = std::move(rebuilt);
+      config = fresh;
+      std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path) << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "resolverd: reload failed, keeping the running config: " << e.what() << "\n";
+    }
+    notifier.ready();
+  };
   try {
     if (!replay_path.empty()) {
       ReplayOptions ro;
       ro.path = replay_path;
       ro.fast = fast;
       ro.once = once;
+      ro.rate = rate;
       ro.progress = !quiet;
-      const ReplayResult rr = run_replay(ro, *pipeline, flags, std::cerr);
+      const ReplayResult rr = run_replay(ro, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
       info.source = replay_path;
       info.wall_seconds = rr.wall_seconds;
     } else {
-      auto reload = [&]() {
-        // SIGHUP: a new config replaces the pipeline only if it is valid.
-        notifier.reloading();
-        try {
-          DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
-          if (lcm_url) fresh.lcm_url = *lcm_url;
-          auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr, true);
-          pipeline->finish();
-          pipeline = std::move(rebuilt);
-          config = fresh;
-          std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path) << "\n";
-        } catch (const std::exception& e) {
-          std::cerr << "resolverd: reload failed, keeping the running config: " << e.what() << "\n";
-        }
-        notifier.ready();
-      };
       const auto live_start = std::chrono::steady_clock::now();
       run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes, config.can.wake_auto, config.can.wake_ids}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
       info.source = can_iface;
       info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }
   } catch (const std::exception& e) {
+    // Opening or reading the input failed (the log vanished, a read error).
     std::cerr << "resolverd: " << e.what() << "\n";
-    return 1;
+    return exit_code::kIo;
   }
 
   print_run_report(std::cout, *pipeline, info);
@@ -231,21 +290,30 @@ static int run(int argc, char** argv) {
       std::cerr << "resolverd: calibration saved to " << calibration_path(state_dir) << "\n";
     }
   }
+  int code = exit_code::kDone;
   (void)output->flush();
   if (output->publish_failures() > 0) {
     std::cerr << "resolverd: " << output->publish_failures() << " LCM publish calls failed";
     if (!output->write_error().empty()) std::cerr << " (" << output->write_error() << ")";
     std::cerr << "\n";
+    if (!output->write_error().empty()) code = exit_code::kIo;  // the LCM log file is incomplete
   }
   if (!report_path.empty()) {
     std::ofstream out(report_path);
     out << run_report_json(*pipeline, info);
+    out.close();
     if (!out) {
-      std::cerr << "resolverd: cannot write report " << report_path << "\n";
-      return 1;
+      std::cerr << "resolverd: cannot write report " << report_path << ": " << std::strerror(errno) << "\n";
+      return exit_code::kIo;
     }
   }
-  return 0;
+  if (code == exit_code::kDone && !replay_path.empty() && pipeline->samples() == 0) {
+    std::cerr << "resolverd: " << replay_path << ": no sample decoded ("
+              << pipeline->intake().stats().frames_seen << " frames seen); nothing was estimated or published "
+                 "from it (exit code 1)\n";
+    code = exit_code::kNoUsableData;
+  }
+  return code;
 }
 
 int main(int argc, char** argv) {
@@ -257,5 +325,5 @@ int main(int argc, char** argv) {
   } catch (...) {
     std::cerr << "resolverd: unexpected non-standard exception\n";
   }
-  return 1;
+  return resolver::exit_code::kInternal;
 }

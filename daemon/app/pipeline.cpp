@@ -47,6 +47,8 @@ ProcessorConfig processor_config(const DaemonConfig& c) {
 SampleInput to_input(const BenchSample& s, double t) {
   SampleInput in;
   in.t = t;
+  in.index = s.index;
+  in.utime = s.timestamp_us;
   in.has_rd = s.has(Role::kRdAngle);
   in.theta_rd = s.get(Role::kRdAngle);
   in.has_sincos = s.has(Role::kSin) && s.has(Role::kCos);
@@ -79,7 +81,11 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
       processor_(processor_config(config)),
       sample_rate_hz_(config.bench.sample_rate_hz),
       model_fit_(config.model.enabled ? std::make_unique<LiveModelFit>(config.model, sink, diagnostics, realtime)
-                                      : nullptr) {}
+                                      : nullptr),
+      signal_health_(health_config_for(config, intake_.decoder()), config.bench.p_r, config.bench.sample_rate_hz,
+                     diagnostics) {
+  for (const std::string& w : intake_.decoder().warnings()) diagnostics << "resolverd: warning: " << w << "\n";
+}
 
 double Pipeline::sample_time(const BenchSample& sample) {
   const double frame_t = static_cast<double>(sample.timestamp_us) * 1e-6;
@@ -175,6 +181,7 @@ void Pipeline::finish() {
       }
     }
   }
+  signal_health_.finish();
   publish_health(last_frame_us_);
 }
 
@@ -189,6 +196,7 @@ void Pipeline::on_bench_info(const BenchInfo& info) {
   if (info.sample_rate_hz > 0.0 && info.sample_rate_hz != sample_rate_hz_) {
     sample_rate_hz_ = info.sample_rate_hz;
     anchored_ = false;
+    signal_health_.set_sample_rate(info.sample_rate_hz);
   }
   if (info.p_r != pc.p_r || info.p != pc.p) {
     if (bench_info_seen_ || samples_ > 0) {
@@ -196,6 +204,7 @@ void Pipeline::on_bench_info(const BenchInfo& info) {
                                                  ", p=" + std::to_string(info.p) + ": estimation restarts");
     }
     processor_.set_pole_pairs(info.p_r, info.p);
+    signal_health_.set_pole_pairs(info.p_r);
   }
   bench_info_seen_ = true;
 }
@@ -206,6 +215,7 @@ void Pipeline::on_sample(const BenchSample& sample) {
   last_counter_ = sample.counter;
   const SampleInput in = to_input(sample, sample_time(sample));
   const SampleOutput out = processor_.process(in);
+  signal_health_.add(in);
   if (model_fit_) feed_model_fit(in, sample);
   summary_.add(out, processor_, in.t);
   if (!out.has_angle) return;
@@ -217,7 +227,8 @@ void Pipeline::on_sample(const BenchSample& sample) {
     a.sample_index = sample.index;
     a.counter = sample.counter;
     a.theta_rd = out.theta_rd;
-    a.theta_sincos = out.theta_sincos;
+    // No amplitude, no angle: atan2 of noise published as an angle would be believed.
+    a.theta_sincos = signal_health_.sincos_lost(in) ? kNaN : out.theta_sincos;
     a.theta_comp = out.theta_comp;
     a.theta_ref = out.theta_ref;
     a.speed_mech_rad_s = out.speed_mech;
@@ -313,6 +324,7 @@ void Pipeline::publish_health(std::int64_t utime) {
   h.latency_p50_us = latency_window_.percentile(0.50);
   h.latency_p99_us = latency_window_.percentile(0.99);
   h.latency_max_us = latency_window_.max();
+  signal_health_.fill(h);
   sink_.publish(h);
   latency_window_.clear();
   health_window_start_us_ = utime;

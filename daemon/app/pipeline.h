@@ -34,6 +34,7 @@
 #include "daemon/app/output_sink.h"
 #include "daemon/app/problem_log.h"
 #include "daemon/app/run_summary.h"
+#include "daemon/app/signal_health_log.h"
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/frame_intake.h"
 
@@ -91,6 +92,8 @@ class Pipeline {
   void set_wake_ids(std::vector<std::uint32_t> ids) { wake_ids_ = std::move(ids); }
   /// nullptr when [model] enabled = false.
   [[nodiscard]] const LiveModelFit* model_fit() const { return model_fit_.get(); }
+  /// Signal faults (LOS, DOS, LOT, ...) and the sin/cos amplitude.
+  [[nodiscard]] const SignalHealthLog& signal_health() const { return signal_health_; }
 
  private:
   void on_sample(const BenchSample& sample);
@@ -127,6 +130,7 @@ class Pipeline {
   double sample_time(const BenchSample& sample);
   std::int64_t kernel_drops_ = 0;
   std::unique_ptr<LiveModelFit> model_fit_;
+  SignalHealthLog signal_health_;
 };
 
 }  // namespace resolver

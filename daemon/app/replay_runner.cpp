@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -14,26 +15,56 @@ namespace resolver {
 namespace {
 using Clock = std::chrono::steady_clock;
 constexpr auto kProgressEvery = std::chrono::seconds(2);
+/// Longest uninterrupted sleep of paced replay: SIGTERM is seen within this.
+constexpr auto kSleepSlice = std::chrono::milliseconds(50);
+/// [us] gap between two passes of a loop when the log has one frame.
+constexpr std::int64_t kDefaultLoopGapUs = 1000;
+
+/// Sleeps until `until` in slices; false when a stop or reload request came first.
+bool sleep_until_or_signal(Clock::time_point until, const StopFlags& flags) {
+  for (;;) {
+    if (flags.stop.load(std::memory_order_relaxed) || flags.reload.load(std::memory_order_relaxed)) return false;
+    const auto now = Clock::now();
+    if (now >= until) return true;
+    std::this_thread::sleep_for(std::min<Clock::duration>(until - now, kSleepSlice));
+  }
+}
 }  // namespace
 
 ReplayResult run_replay(const ReplayOptions& options, Pipeline& pipeline, StopFlags& flags, std::ostream& err) {
+  return run_replay(options, [&pipeline]() -> Pipeline& { return pipeline; }, [] {}, flags, err);
+}
+
+ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeline&()>& current,
+                        const std::function<void()>& on_reload, StopFlags& flags, std::ostream& err) {
   ReplayResult result;
   const auto wall_start = Clock::now();
   const bool tty = isatty(STDERR_FILENO) != 0;
   auto next_progress = wall_start + kProgressEvery;
   bool printed_progress = false;
+  const double rate = options.rate > 0.0 ? options.rate : 1.0;
+  // Loop passes: pass k's frame times are shifted by k * loop_span_us.
+  std::int64_t loop_span_us = 0;
+  std::int64_t offset_us = 0;
 
   while (!flags.stop.load()) {
     CandumpReader reader(options.path);
+    reader.set_stop_flag(&flags.stop);
     ++result.passes;
-    if (result.passes > 1) pipeline.restart_sequence();
+    if (result.passes > 1) {
+      current().restart_sequence();
+      offset_us += loop_span_us;
+    }
     CanFrame frame;
     bool have_t0 = false;
     std::int64_t log_t0 = 0;
     Clock::time_point wall_t0;
+    std::int64_t first_us = 0, max_us = 0, pass_frames = 0;
     while (!flags.stop.load()) {
+      if (flags.reload.load(std::memory_order_relaxed) && flags.reload.exchange(false)) on_reload();
       const auto status = reader.next(frame);
       if (status == CandumpReader::Status::kEnd) break;
+      Pipeline& pipeline = current();
       if (status == CandumpReader::Status::kBadLine) {
         ++result.bad_lines;
         const LogLineProblem& pr = reader.problem();
@@ -41,22 +72,32 @@ ReplayResult run_replay(const ReplayOptions& options, Pipeline& pipeline, StopFl
                                                                 pr.column, pr.message));
         continue;
       }
+      if (pass_frames++ == 0) first_us = max_us = frame.timestamp_us;
+      max_us = std::max(max_us, frame.timestamp_us);
       if (!options.fast) {
         if (!have_t0) {
           have_t0 = true;
           log_t0 = frame.timestamp_us;
           wall_t0 = Clock::now();
         }
-        std::this_thread::sleep_until(wall_t0 + std::chrono::microseconds(frame.timestamp_us - log_t0));
+        const auto due = wall_t0 + std::chrono::microseconds(static_cast<std::int64_t>(
+                                       static_cast<double>(frame.timestamp_us - log_t0) / rate));
+        // A reload request interrupts the wait; it is served before the next frame.
+        while (!sleep_until_or_signal(due, flags) && !flags.stop.load()) {
+          if (flags.reload.exchange(false)) on_reload();
+        }
+        if (flags.stop.load()) break;
       }
+      frame.timestamp_us += offset_us;
       ++result.frames;
       // Paced replay times every frame, like live input. Fast replay times one
       // frame in kReplayLatencyEvery: the percentiles stay representative and
       // the other frames skip the clock read.
+      Pipeline& target = current();
       if (!options.fast || result.frames % kReplayLatencyEvery == 1) {
-        pipeline.feed(frame, reader.line_number(), Clock::now());
+        target.feed(frame, reader.line_number(), Clock::now());
       } else {
-        pipeline.feed_untimed(frame, reader.line_number());
+        target.feed_untimed(frame, reader.line_number());
       }
       if (options.progress && (result.frames & 0xFFFU) == 0) {
         const auto now = Clock::now();
@@ -73,10 +114,19 @@ ReplayResult run_replay(const ReplayOptions& options, Pipeline& pipeline, StopFl
         }
       }
     }
-    if (options.once) break;
+    if (options.once || reader.stopped()) break;
+    if (pass_frames == 0) {
+      // Nothing to loop over: an empty (or all-bad) log would spin here forever.
+      err << "resolverd: " << options.path << " has no frames to loop over; stopping after one pass\n";
+      break;
+    }
+    if (loop_span_us == 0) {
+      const std::int64_t interval = pass_frames > 1 ? (max_us - first_us) / (pass_frames - 1) : kDefaultLoopGapUs;
+      loop_span_us = max_us - first_us + std::max<std::int64_t>(interval, 1);
+    }
   }
   if (printed_progress && tty) err << "\n";
-  pipeline.finish();
+  current().finish();
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   return result;
 }

@@ -51,6 +51,45 @@ void print_completing_frames(std::ostream& out, const CompletingFrames& c) {
   out << fmt::format("; live, [can] wake_ids = [0x{:X}] wakes the daemon once per sample\n", c.at(top).first);
 }
 
+/// "signal     sin/cos amplitude ... ; faults: ..." and one line per fault seen.
+void print_signal_health(std::ostream& out, const SignalHealthSummary& h, const SignalHealthConfig& c) {
+  if (h.amplitude.n > 0) {
+    out << fmt::format("  signal     sin/cos amplitude {:.1f} (min {:.1f}, max {:.1f}; full scale {:.0f})\n",
+                       h.amplitude.mean(), h.amplitude.min, h.amplitude.max, c.full_scale);
+  } else {
+    out << "  signal     no sin/cos samples\n";
+  }
+  bool any = false;
+  for (const auto& f : h.faults) {
+    if (f.samples == 0) continue;
+    any = true;
+    out << fmt::format("  fault      {:<22} {:5.1f} % of the samples ({}, {} episode(s), {:.3f} .. {:.3f} s into the input{})\n",
+                       fault_name(f.fault), 100.0 * f.share, f.samples, f.episodes, f.first_t - h.t_first,
+                       f.last_t - h.t_first, f.active_at_end ? ", still at the end" : "");
+  }
+  if (!any && h.samples > 0) out << "  fault      none (loss/degradation of signal, tracking, clipping, stop, overspeed, outliers)\n";
+  if (h.fault(SignalFault::kLossOfSignal).samples > 0) {
+    out << "             loss_of_signal: no usable sin/cos (dead excitation or open channels); theta_sincos is NaN there\n";
+  }
+}
+
+std::string signal_health_json(const SignalHealthSummary& h, const SignalHealthConfig& c) {
+  std::string j = fmt::format("\"signal_health\":{{\"samples\":{},\"full_scale\":{},\"sincos_amplitude\":{},"
+                              "\"sincos_amplitude_min\":{},\"sincos_amplitude_max\":{},\"faults\":{{",
+                              h.samples, json_number(c.full_scale), json_number(h.amplitude.mean()),
+                              json_number(h.amplitude.min), json_number(h.amplitude.max));
+  for (std::size_t i = 0; i < h.faults.size(); ++i) {
+    const auto& f = h.faults[i];
+    // first_s / last_s: seconds after the first sample (null: never held).
+    j += fmt::format("{}\"{}\":{{\"samples\":{},\"share\":{},\"episodes\":{},\"first_s\":{},\"last_s\":{},"
+                     "\"active_at_end\":{}}}",
+                     i ? "," : "", fault_name(f.fault), f.samples, json_number(f.share), f.episodes,
+                     json_number(f.first_t - h.t_first), json_number(f.last_t - h.t_first),
+                     f.active_at_end ? "true" : "false");
+  }
+  return j + "}}";
+}
+
 }  // namespace
 
 void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info) {
@@ -72,6 +111,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   }
   const ProcessorConfig& pc = p.processor().config();
   out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
+  print_signal_health(out, p.signal_health().summary(), p.signal_health().monitor().config());
   const ModelEstimate model = p.processor().estimate();
   if (pc.method == EstimatorMethod::kHwangIntegral) {
     out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.2e} (std. error; spread {:.2e} over {} revolutions) {}\n",
@@ -201,6 +241,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
        ",\"i_d_ripple_ref\":" + arr(r.ref.d, r.ref_valid) + ",";
   j += "\"i_q_ripple_raw\":" + arr(r.raw.q, r.raw_valid) + ",\"i_q_ripple_comp\":" + arr(r.comp.q, r.comp_valid) +
        ",\"i_q_ripple_ref\":" + arr(r.ref.q, r.ref_valid);
+  j += "," + signal_health_json(p.signal_health().summary(), p.signal_health().monitor().config());
   if (const LiveModelFit* mf = p.model_fit()) {
     const auto& c = mf->counters();
     const model_fit_t& last = mf->last();

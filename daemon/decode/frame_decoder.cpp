@@ -1,5 +1,6 @@
 #include "daemon/decode/frame_decoder.h"
 
+#include <bitset>
 #include <span>
 #include <stdexcept>
 
@@ -7,6 +8,72 @@
 #include "daemon/decode/crc8_j1850.h"
 
 namespace resolver {
+
+namespace {
+
+/// The payload bits a signal occupies, by DBC bit number (bit k of byte b = 8b + k).
+using PayloadBits = std::bitset<std::size_t{8} * 64>;
+
+PayloadBits bits_of(const dbc::Signal& sig) {
+  PayloadBits bits;
+  const dbc::detail::Span span = dbc::detail::linear_span(sig, std::min(sig.length, 64U));
+  for (std::uint64_t lin = span.first_lin; lin <= span.last_lin && lin < bits.size(); ++lin) {
+    // Intel counts LSB-first within a byte (DBC number = linear), Motorola MSB-first.
+    bits.set(sig.order == dbc::ByteOrder::kBigEndian ? (lin ^ 7U) : lin);
+  }
+  return bits;
+}
+
+/// "16..23" or "7, 12..15": the set bits as ranges.
+std::string describe_bits(const PayloadBits& bits) {
+  std::string out;
+  for (std::size_t b = 0; b < bits.size(); ++b) {
+    if (!bits.test(b)) continue;
+    std::size_t e = b;
+    while (e + 1 < bits.size() && bits.test(e + 1)) ++e;
+    out += (out.empty() ? "" : ", ") + (e == b ? std::to_string(b) : std::to_string(b) + ".." + std::to_string(e));
+    b = e;
+  }
+  return out;
+}
+
+std::string describe_signal(const dbc::Signal& sig, const PayloadBits& bits) {
+  return "'" + sig.name + "' (bits " + describe_bits(bits) + ")";
+}
+
+/// Signals switched by a multiplexor to different values never share a frame.
+bool can_share_a_frame(const dbc::Signal& a, const dbc::Signal& b) {
+  return !(a.multiplexed_by && b.multiplexed_by && *a.multiplexed_by != *b.multiplexed_by);
+}
+
+}  // namespace
+
+void FrameDecoder::check_overlaps(const Slot& slot, const std::function<void(const std::string&)>& problem) {
+  // What resolverd reads from the message: its roles, the counter and the CRC.
+  std::vector<const dbc::Signal*> used;
+  for (const auto& [role, sig] : slot.roles) used.push_back(sig);
+  if (slot.counter != nullptr) used.push_back(slot.counter);
+  if (slot.crc != nullptr) used.push_back(slot.crc);
+  auto is_used = [&used](const dbc::Signal* s) { return std::find(used.begin(), used.end(), s) != used.end(); };
+  const auto& signals = slot.message->signals;
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    const PayloadBits bi = bits_of(signals[i]);
+    for (std::size_t j = i + 1; j < signals.size(); ++j) {
+      if (!can_share_a_frame(signals[i], signals[j])) continue;
+      const PayloadBits bj = bits_of(signals[j]);
+      const PayloadBits both = bi & bj;
+      if (both.none()) continue;
+      const std::string text = "message '" + slot.message->name + "': signals " + describe_signal(signals[i], bi) +
+                               " and " + describe_signal(signals[j], bj) + " overlap in bits " + describe_bits(both);
+      if (is_used(&signals[i]) || is_used(&signals[j])) {
+        // Two quantities decoded from the same bits: every value of one is partly the other.
+        problem(text + "; fix the DBC (start bits and lengths) before using it");
+      } else {
+        warnings_.push_back(text + " (neither is read by resolverd, so decoding is unaffected)");
+      }
+    }
+  }
+}
 
 std::string_view to_string(FrameReject reject) {
   switch (reject) {
@@ -65,6 +132,7 @@ FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const Signal
     slots_[static_cast<std::size_t>(slot_index)].roles.emplace_back(role, sig);
     mapped_roles_ = static_cast<std::uint16_t>(mapped_roles_ | role_bit(role));
   }
+  for (const Slot& slot : slots_) check_overlaps(slot, problem);
   if (!map_.bench_info_message.empty()) {
     bench_info_ = db_->find_message(map_.bench_info_message);
     if (bench_info_ == nullptr) {

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <unordered_map>
@@ -64,7 +65,8 @@ class FrameDecoder {
   };
 
   /// Builds the decoder. Throws std::invalid_argument listing every problem
-  /// (unknown message or signal names, missing counter) in one message.
+  /// (unknown message or signal names, missing counter, a signal it reads
+  /// overlapping another signal of its message) in one message.
   FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map);
 
   /// Decodes one frame. Cannot fail beyond returning kRejected with a reason.
@@ -72,8 +74,14 @@ class FrameDecoder {
 
   [[nodiscard]] const std::vector<Slot>& slots() const { return slots_; }
   [[nodiscard]] std::uint16_t mapped_roles() const { return mapped_roles_; }
+  /// Non-fatal findings: overlapping signals in a mapped message that the decoder
+  /// does not read (a DBC may describe the same bytes twice; decoding is unaffected).
+  [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
+  /// Overlaps in a slot's message: an error when a signal the decoder reads is
+  /// involved (reported through `problem`), else a warning.
+  void check_overlaps(const Slot& slot, const std::function<void(const std::string&)>& problem);
   static std::uint32_t key(std::uint32_t id, bool extended) { return extended ? (id | 0x80000000U) : id; }
 
   std::shared_ptr<const dbc::Database> db_;
@@ -82,6 +90,7 @@ class FrameDecoder {
   std::unordered_map<std::uint32_t, int> slot_by_id_;  ///< key(id) -> slot
   const dbc::Message* bench_info_ = nullptr;
   std::uint16_t mapped_roles_ = 0;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace resolver

@@ -1,6 +1,7 @@
 #include "drivers/candump/candump_reader.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -33,13 +34,19 @@ CandumpReader::CandumpReader(const std::string& path, std::size_t buffer_bytes)
       buffer_bytes_(std::max(buffer_bytes, kMinBufferBytes)),
       // Not zeroed: only bytes read(2) wrote are ever looked at.
       buffer_(std::make_unique_for_overwrite<char[]>(buffer_bytes_)) {
-  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK only for the open: a FIFO without a writer would block it, out of
+  // reach of any stop flag. Reads are blocking again (and polled first, below).
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd_ < 0) {
     throw std::runtime_error(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
   }
+  const int flags = ::fcntl(fd_, F_GETFL);
+  if (flags >= 0) (void)::fcntl(fd_, F_SETFL, flags & ~O_NONBLOCK);
   struct stat st {};
   if (::fstat(fd_, &st) == 0 && S_ISREG(st.st_mode)) {
     total_bytes_ = static_cast<std::uint64_t>(st.st_size);
+  } else {
+    poll_before_read_ = true;
   }
 }
 
@@ -58,7 +65,10 @@ CandumpReader::CandumpReader(CandumpReader&& other) noexcept
       total_bytes_(other.total_bytes_),
       have_previous_(other.have_previous_),
       previous_timestamp_us_(other.previous_timestamp_us_),
-      problem_(std::move(other.problem_)) {
+      problem_(std::move(other.problem_)),
+      stop_(other.stop_),
+      stopped_(other.stopped_),
+      poll_before_read_(other.poll_before_read_) {
   other.begin_ = other.end_ = 0;
   other.eof_ = true;
 }
@@ -79,6 +89,9 @@ CandumpReader& CandumpReader::operator=(CandumpReader&& other) noexcept {
     have_previous_ = other.have_previous_;
     previous_timestamp_us_ = other.previous_timestamp_us_;
     problem_ = std::move(other.problem_);
+    stop_ = other.stop_;
+    stopped_ = other.stopped_;
+    poll_before_read_ = other.poll_before_read_;
     other.begin_ = other.end_ = 0;
     other.eof_ = true;
   }
@@ -90,8 +103,28 @@ void CandumpReader::close_fd() noexcept {
   fd_ = -1;
 }
 
+bool CandumpReader::wait_readable() {
+  for (;;) {
+    if (stop_ != nullptr && stop_->load(std::memory_order_relaxed)) return false;
+    if (!poll_before_read_) return true;
+    pollfd p{fd_, POLLIN, 0};
+    // Linux reports a FIFO whose writer never came as not readable (no POLLHUP
+    // until a writer has been and gone), so this waits for one.
+    const int r = ::poll(&p, 1, stop_ != nullptr ? kStopPollMs : -1);
+    if (r > 0) return true;  // data, end of input or an error: read() tells which
+    if (r < 0 && errno != EINTR) {
+      throw std::runtime_error(fmt::format("cannot wait for input from {}: {}", path_, std::strerror(errno)));
+    }
+  }
+}
+
 void CandumpReader::fill() {
   for (;;) {
+    if (!wait_readable()) {
+      stopped_ = true;
+      eof_ = true;
+      return;
+    }
     const ssize_t n = ::read(fd_, buffer_.get() + end_, buffer_bytes_ - end_);
     if (n > 0) {
       end_ += static_cast<std::size_t>(n);
@@ -126,6 +159,7 @@ bool CandumpReader::take_line(std::string_view& line, std::uint64_t& skipped_len
       begin_ = newline + 1;
       return true;
     }
+    if (stopped_) return false;  // a partial line at a stop is not a bad line
     if (eof_ || fd_ < 0) {
       // The last line may lack its '\n'.
       const std::size_t len = end_ - begin_;

@@ -8,8 +8,16 @@
 // next call continues with the following line, so callers can count problems
 // by to_string(problem().kind). Only I/O failures throw (std::runtime_error).
 // Not thread-safe; one reader per thread.
+//
+// Stopping: with set_stop_flag(), every read checks the flag, and input that
+// is not a regular file (a FIFO with no writer, a device, a terminal) is
+// polled with a kStopPollMs timeout first, so a set flag ends next() (kEnd,
+// stopped() true) within that time on any input: an endless line (/dev/zero)
+// is checked once per buffer, a silent FIFO once per timeout. Opening never
+// blocks (a FIFO without a writer is waited for in the first read).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -28,6 +36,8 @@ class CandumpReader {
   /// [bytes] smallest buffer: a longest accepted line plus room for a whole
   /// next read, so a refill never finds the buffer full.
   static constexpr std::size_t kMinBufferBytes = 2 * (kMaxCandumpLineLength + 1);
+  /// [ms] longest wait for input between two looks at the stop flag.
+  static constexpr int kStopPollMs = 100;
 
   /// Opens `path`. Throws std::runtime_error("cannot open <path>: <strerror>").
   /// `buffer_bytes` is raised to kMinBufferBytes; a small buffer only costs
@@ -58,13 +68,23 @@ class CandumpReader {
   [[nodiscard]] std::uint64_t total_bytes() const { return total_bytes_; }
   [[nodiscard]] const std::string& path() const { return path_; }
 
+  /// From now on, next() returns kEnd soon after `*stop` becomes true (see the file
+  /// comment). nullptr: never stop early (the default). The flag must outlive the reader.
+  void set_stop_flag(const std::atomic<bool>* stop) { stop_ = stop; }
+  /// True when next() ended because the stop flag was set, not at the end of input.
+  [[nodiscard]] bool stopped() const { return stopped_; }
+
  private:
   /// Sets `line` to the next line without its '\n'. Returns false at end of
   /// input. A line longer than the buffer can hold is dropped and reported
   /// through `skipped_len` (its length in bytes) with `line` empty.
   bool take_line(std::string_view& line, std::uint64_t& skipped_len);
-  /// Appends up to the free buffer space from the file; sets eof_ on 0.
+  /// Appends up to the free buffer space from the file; sets eof_ on 0, and
+  /// eof_ and stopped_ when the stop flag is set.
   void fill();
+  /// Waits (kStopPollMs at a time, checking the stop flag) until a read will not
+  /// block. False when the flag was set.
+  bool wait_readable();
   void close_fd() noexcept;
 
   std::string path_;
@@ -80,6 +100,9 @@ class CandumpReader {
   bool have_previous_ = false;
   std::int64_t previous_timestamp_us_ = 0;  // [us] of the last good frame
   LogLineProblem problem_;
+  const std::atomic<bool>* stop_ = nullptr;
+  bool stopped_ = false;
+  bool poll_before_read_ = false;  // not a regular file: a read may block
 };
 
 }  // namespace resolver

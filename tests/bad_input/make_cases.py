@@ -52,28 +52,36 @@ def line(t_us, can_id, data, iface="can0"):
     return "(%d.%06d) %s %03X#%s" % (t_us // 1_000_000, t_us % 1_000_000, iface, can_id, data.hex().upper())
 
 
-def sample_lines(k):
-    """The three frames of control period k (counter k & 0xFF): 30 r/min-ish rotation."""
+def sample_lines(k, samples_per_rev=40.0, amplitude=20000, rd_follows=True):
+    """The three frames of control period k (counter k & 0xFF). Default: 40 samples per
+    resolver electrical revolution (1000 r/min with p_r = 3 at 2 kHz), envelopes of
+    20000 counts, the R/D angle on the true angle. amplitude=0 is a dead excitation
+    (sin = cos = 0); rd_follows=False holds the R/D angle at 0 (a converter without input)."""
     t = T0_US + PERIOD_US * (k + 1)
-    theta = 2 * math.pi * k / 40.0  # resolver electrical angle [rad]
-    sin_c, cos_c = int(20000 * math.sin(theta)), int(20000 * math.cos(theta))
-    rd = int(theta / (2 * math.pi) * 65536) & 0xFFFF
+    theta = 2 * math.pi * k / samples_per_rev  # resolver electrical angle [rad]
+    sin_c, cos_c = int(amplitude * math.sin(theta)), int(amplitude * math.cos(theta))
+    rd = int(wrap(theta) / (2 * math.pi) * 65536) & 0xFFFF if rd_follows else 0
     counter = k & 0xFF
     res = seal(ID_SAMPLE, struct.pack("<BhhH", counter, sin_c, cos_c, rd))
     i_a = int(1000 * math.cos(theta))
     i_b = int(1000 * math.cos(theta - 2 * math.pi / 3))
     i_c = -i_a - i_b
     cur = seal(ID_CURRENTS, struct.pack("<Bhhh", counter, i_a, i_b, i_c))
-    ref = seal(ID_REF, struct.pack("<BIH", counter, int(theta / 3 / (2 * math.pi) * 2**32) & 0xFFFFFFFF, 0))
+    ref = seal(ID_REF, struct.pack("<BIH", counter, int(wrap(theta / 3) / (2 * math.pi) * 2**32) & 0xFFFFFFFF, 0))
     return [line(t, ID_SAMPLE, res), line(t + 1, ID_CURRENTS, cur), line(t + 2, ID_REF, ref)]
 
 
-def clean_log():
-    """List of lines: BENCH_INFO then N_SAMPLES periods (3 lines each)."""
+def wrap(angle):
+    """[rad] into [0, 2pi)."""
+    return angle % (2 * math.pi)
+
+
+def clean_log(n_samples=N_SAMPLES, **kwargs):
+    """List of lines: BENCH_INFO then n_samples periods (3 lines each); kwargs go to sample_lines."""
     info = seal(ID_INFO, struct.pack("<BBBBHB", 1, 3, 4, 16, 2000, 0))
     lines = [line(T0_US, ID_INFO, info)]
-    for k in range(N_SAMPLES):
-        lines.extend(sample_lines(k))
+    for k in range(n_samples):
+        lines.extend(sample_lines(k, **kwargs))
     return lines
 
 
@@ -107,6 +115,20 @@ def log_case(name, lines, reason, count, message, also=None, note=""):
             "expected_count": count, "expected_message_substring": message}
     if also:
         case["also_expected"] = also
+    if note:
+        case["note"] = note
+    cases.append(case)
+
+
+def health_case(name, lines, faults, message, note=""):
+    """A log that decodes cleanly but whose signals are faulty: resolverd must report
+    `faults` ({name: least share of the samples}) in the report's signal_health, no
+    other fault, no reject, and print `message`."""
+    path = os.path.join(CASES, name + ".log")
+    with open(path, "w", encoding="ascii", newline="\n") as f:
+        f.write("\n".join(lines) + "\n")
+    case = {"file": "cases/" + name + ".log", "kind": "health", "expected_reason": None, "expected_count": 0,
+            "expected_message_substring": message, "expected_faults": faults}
     if note:
         case["note"] = note
     cases.append(case)
@@ -216,6 +238,19 @@ def main():
              also={"counter_gap": 1, "frames_lost": 1},
              note="PHASE_CURRENTS' counter also jumps 9 -> 11 (one frame lost)")
 
+    # ---- signal faults (issue 16): the frames are fine, the signals are not
+    health_case("dead_excitation", clean_log(1000, amplitude=0, rd_follows=False), {"loss_of_signal": 1.0},
+                "signal fault loss_of_signal started 0.000 s into the input (sample 0): sin/cos amplitude 0.0",
+                note="sin = cos = 0 for the whole log (a dead excitation or a broken connector), the R/D angle "
+                     "held at 0, the motor turning (reference and currents): loss of signal and nothing else; "
+                     "theta_sincos must be NaN")
+    # 30000 r/min with p_r = 3 at 2 kHz: 0.75 resolver electrical revolutions per sample, beyond what the
+    # sample rate can represent (resolver-sim refuses to write it); the mechanical reference still resolves it.
+    health_case("overspeed_30000rpm", clean_log(1000, samples_per_rev=1 / 0.75), {"overspeed": 1.0},
+                "signal fault overspeed started 0.000 s into the input (sample 0): resolver electrical travel 4.712 "
+                "rad per sample (from the reference angle)",
+                note="30000 r/min: more than pi rad of resolver travel per sample")
+
     # ---- configuration and DBC: resolverd must refuse to start, exit 2, say where and why
     text_case("bad_toml", ".toml", "config", "[bench]\np_r = = 3\n",
               "bad_toml.toml:2:7: TOML syntax error")
@@ -243,6 +278,15 @@ def main():
     with open(os.path.join(CASES, "dbc_signal_past_dlc.toml"), "w", encoding="ascii") as f:
         f.write("[layout]\ndbc = \"cases/dbc_signal_past_dlc.dbc\"\n")
     cases[-1]["config"] = "cases/dbc_signal_past_dlc.toml"
+
+    overlap = bench_dbc.replace("SG_ cos : 24|16@1-", "SG_ cos : 16|16@1-", 1)
+    assert overlap != bench_dbc
+    text_case("dbc_overlapping_signals", ".dbc", "dbc", overlap,
+              "message 'RESOLVER_SAMPLE': signals 'sin' (bits 8..23) and 'cos' (bits 16..31) overlap in bits 16..23",
+              note="RESOLVER_SAMPLE.cos moved onto the upper byte of sin: two quantities from the same bits")
+    with open(os.path.join(CASES, "dbc_overlapping_signals.toml"), "w", encoding="ascii") as f:
+        f.write("[layout]\ndbc = \"cases/dbc_overlapping_signals.dbc\"\n")
+    cases[-1]["config"] = "cases/dbc_overlapping_signals.toml"
 
     with open(os.path.join(HERE, "cases.json"), "w", encoding="ascii") as f:
         json.dump({"comment": "Written by make_cases.py; read by run_bad_inputs.py. Paths are relative to "

@@ -7,6 +7,9 @@ For a log case (kind "log"):
   under expected_reason in R.json "rejects", count nothing else except the
   reasons listed in also_expected (with exactly those counts), and print a line
   "resolverd: ... <expected_message_substring> ... [<reason>]" on stderr.
+For a signal-fault case (kind "health"): the same run must exit 0 with no reject,
+  report every fault of expected_faults in R.json "signal_health" for at least the
+  given share of the samples, report no other fault, and print the message.
 For a config or DBC case (kind "config" / "dbc"):
   resolverd --config CONFIG --replay cases/clean.log ... must refuse to start:
   exit 2 with "resolverd: ...<expected_message_substring>..." on stderr.
@@ -49,7 +52,7 @@ def check_case(case, resolverd, work):
     """Returns a list of failure strings (empty = pass)."""
     kind = case["kind"]
     want = case["expected_message_substring"]
-    if kind == "log":
+    if kind in ("log", "health"):
         args = ["--replay", case["file"]]
         want_rc = 0
     elif kind == "config":
@@ -74,7 +77,7 @@ def check_case(case, resolverd, work):
         failures.append("exit code %d, expected %d (%s)" % (rc, want_rc, where))
 
     lines = [l for l in stderr.splitlines() if l.startswith("resolverd: ")]
-    if kind != "log":
+    if kind not in ("log", "health"):
         # Config/DBC errors may list several problems on indented lines below the "resolverd: " one.
         if not lines:
             failures.append("no 'resolverd: ' line on stderr")
@@ -89,7 +92,7 @@ def check_case(case, resolverd, work):
             if not any(l.endswith(tag) or "'%s'" % case["expected_reason"] in l for l in hits):
                 failures.append("the line with %r does not name the reason %s: %s" % (want, tag, hits[0]))
 
-    if kind == "log":
+    if kind in ("log", "health"):
         if report is None:
             failures.append("no report written")
         else:
@@ -103,6 +106,16 @@ def check_case(case, resolverd, work):
             extra = {r: n for r, n in rejects.items() if r not in expected and n}
             if extra:
                 failures.append("unexpected rejects %s (the damage leaked into other counters)" % extra)
+            faults = report.get("signal_health", {}).get("faults", {})
+            wanted = case.get("expected_faults", {})
+            for name, share in sorted(wanted.items()):
+                got = faults.get(name, {}).get("share", 0)
+                if got < share:
+                    failures.append("signal fault %s held for %.3f of the samples, expected at least %.3f"
+                                    % (name, got, share))
+            others = {n: f["samples"] for n, f in faults.items() if n not in wanted and f["samples"]}
+            if others:
+                failures.append("unexpected signal faults %s" % others)
     if failures:
         tail = "\n".join("      | " + l for l in stderr.splitlines()[-15:])
         failures.append("stderr (last lines):\n" + tail)
@@ -139,7 +152,9 @@ def main():
                 for fl in failures:
                     print("    " + fl)
             else:
-                if case["kind"] != "log":
+                if case["kind"] == "health":
+                    summary = " ".join(sorted(case["expected_faults"]))
+                elif case["kind"] != "log":
                     summary = "refused to start (exit 2)"
                 elif case["expected_reason"]:
                     summary = "%s=%d" % (case["expected_reason"], case["expected_count"])
@@ -147,7 +162,7 @@ def main():
                     summary = "no rejects"
                 print("ok   %-34s %s" % (name, summary))
             if opts.verbose:
-                _, stderr, _, _ = run(resolverd, ["--replay", case["file"]] if case["kind"] == "log" else
+                _, stderr, _, _ = run(resolverd, ["--replay", case["file"]] if case["kind"] in ("log", "health") else
                                       ["--config", case.get("config", case["file"]), "--replay", CLEAN_LOG], work)
                 print("\n".join("      | " + l for l in stderr.splitlines()))
     print("%d of %d bad-input cases passed" % (len(cases) - failed, len(cases)))

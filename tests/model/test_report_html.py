@@ -274,7 +274,7 @@ class ReportHtml(unittest.TestCase):
 
     def test_unwritable_output_names_the_file(self):
         bad = os.path.join(ARGS.work, "no-such-dir", "x.html")
-        p = run([self.model, "report", self.log, "--html", bad], expect_rc=1)
+        p = run([self.model, "report", self.log, "--html", bad], expect_rc=3)  # an I/O error
         self.assertIn(f"cannot write {bad}: No such file or directory", p.stderr)
 
     def test_starting_model_with_the_effect_needs_one_step(self):

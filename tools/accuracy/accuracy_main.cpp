@@ -10,6 +10,7 @@
 #include <exception>
 #include <string>
 
+#include "daemon/app/exit_codes.h"
 #include "tools/accuracy/accuracy_experiments.h"
 #include "daemon/service/program_version.h"
 
@@ -115,13 +116,13 @@ void print_ripple(const std::vector<RippleStudy>& studies) {
 int main(int argc, char** argv) {
   CLI::App app{"resolver-accuracy: estimator bias and spread against the Cramer-Rao bound, convergence and 2x dq "
                "ripple reduction on simulated data with known truth; prints a markdown report."};
-  app.footer(kExamples);
+  app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText);
   app.set_version_flag("--version", resolver::version_line("resolver-accuracy"));
   int seeds = 50;
   bool quick = false;
   app.add_option("--seeds", seeds, "number of simulated logs per configuration (default 50)")->check(CLI::Range(2, 100000));
   app.add_flag("--quick", quick, "10 seeds unless --seeds is given: a smoke run");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
   if (quick && app.get_option("--seeds")->count() == 0) seeds = 10;
 
   try {
@@ -146,7 +147,7 @@ int main(int argc, char** argv) {
     fmt::print("\nRun time {:.1f} s.\n", secs);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "resolver-accuracy: %s\n", e.what());
-    return 1;
+    return resolver::exit_code::kInternal;  // no input to blame: a failed study is a bug
   }
-  return 0;
+  return std::fflush(stdout) == 0 ? resolver::exit_code::kDone : resolver::exit_code::kIo;
 }

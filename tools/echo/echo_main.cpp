@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "daemon/app/exit_codes.h"
 #include "tools/echo/echo_output.h"
 #include "tools/echo/lcm_eventlog_reader.h"
 #include "tools/echo/lcm_fingerprint.h"
@@ -21,9 +22,7 @@
 
 namespace {
 
-constexpr int kExitError = 1;
-constexpr int kExitUsage = 2;
-constexpr int kExitTimeout = 3;
+namespace exit_code = resolver::exit_code;
 
 constexpr const char* kDescription =
     "resolver-echo prints LCM messages as JSON lines, one object per message.\n"
@@ -57,8 +56,10 @@ EXAMPLES
     resolver-echo --list-types
 
 EXIT STATUS
-  0 done; 1 bad input (unreadable or malformed log, bad .lcm file, LCM failure);
-  2 bad command line; 3 --timeout expired before --count messages arrived.)";
+  0 done; 1 the input had no usable data (a malformed or truncated log, --timeout expired
+  before --count messages arrived); 2 usage error (bad option, --type or --channel, a bad
+  .lcm file in --types); 3 I/O error (--log missing or unreadable, LCM cannot start,
+  stdout cannot be written); 70 internal error (a bug).)";
 
 void print_line(const std::string& line) {
   std::fwrite(line.data(), 1, line.size(), stdout);
@@ -83,8 +84,7 @@ int main(int argc, char** argv) {
   std::optional<double> timeout_s;
   bool list_types = false;
 
-  auto* log_opt = app.add_option("--log", log_path, "read this LCM event log (lcm-logger output or file://)")
-                      ->check(CLI::ExistingFile);
+  auto* log_opt = app.add_option("--log", log_path, "read this LCM event log (lcm-logger output or file://)");
   auto* lcm_opt = app.add_option("--lcm", lcm_url, "subscribe live to this LCM URL (udpm://..., memq://...)");
   app.add_flag("--list-types", list_types, "print the known types and their fingerprints, then exit");
   log_opt->excludes(lcm_opt);
@@ -99,21 +99,27 @@ int main(int argc, char** argv) {
                         ->check(CLI::PositiveNumber)->needs(lcm_opt);
   app.add_option("--timeout", timeout_s, "--lcm: exit after SEC seconds (default: never)")
                           ->check(CLI::PositiveNumber)->needs(lcm_opt);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help is a ParseError too; app.exit() prints it and returns 0 for it.
-    return app.exit(e) == 0 ? 0 : kExitUsage;
-  }
+  if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
 
   if (!list_types && log_path.empty() && lcm_url.empty()) {
     std::cerr << "resolver-echo: give --log FILE or --lcm URL (or --list-types); see --help\n";
-    return kExitUsage;
+    return exit_code::kUsage;
+  }
+  if (!log_path.empty()) {
+    if (auto problem = exit_code::unreadable("--log", log_path)) {
+      std::cerr << "resolver-echo: " << *problem << '\n';
+      return exit_code::kIo;
+    }
   }
 
   try {
     resolver::LcmTypeRegistry registry = resolver::LcmTypeRegistry::with_embedded_types();
-    for (const auto& dir : type_dirs) registry.add_directory(dir);
+    try {
+      for (const auto& dir : type_dirs) registry.add_directory(dir);
+    } catch (const resolver::LcmParseError& e) {
+      std::cerr << "resolver-echo: " << e.what() << '\n';
+      return exit_code::kUsage;
+    }
     for (const auto& problem : registry.problems()) std::cerr << "resolver-echo: warning: " << problem << '\n';
 
     if (list_types) {
@@ -130,16 +136,22 @@ int main(int argc, char** argv) {
       if (!short_name_known) {
         std::cerr << fmt::format("resolver-echo: --type {}: no such type; see --list-types or add it with --types\n",
                                  type_name);
-        return kExitError;
+        return exit_code::kUsage;
       }
     }
 
-    const resolver::EchoFilter filter = resolver::make_echo_filter(channel_regex, type_name);
+    resolver::EchoFilter filter;
+    try {
+      filter = resolver::make_echo_filter(channel_regex, type_name);
+    } catch (const std::invalid_argument& e) {
+      std::cerr << "resolver-echo: " << e.what() << '\n';
+      return exit_code::kUsage;
+    }
     const resolver::LcmJsonDecoder decoder(registry);
 
     if (!log_path.empty()) {
       resolver::echo_log_file(log_path, decoder, filter, limit, print_line);
-      return std::fflush(stdout) == 0 ? 0 : kExitError;
+      return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;
     }
 
     lcm::LCM lcm(lcm_url);
@@ -152,21 +164,21 @@ int main(int argc, char** argv) {
     const auto result = live.run(count, timeout);
     if (!result.error.empty()) {
       std::cerr << "resolver-echo: --lcm " << lcm_url << ": " << result.error << '\n';
-      return kExitError;
+      return exit_code::kIo;
     }
     if (count && result.emitted < *count) {
       std::cerr << fmt::format("resolver-echo: --timeout {} s expired after {} of --count {} messages\n", *timeout_s,
                                result.emitted, *count);
-      return kExitTimeout;
+      return exit_code::kNoUsableData;
     }
-    return 0;
+    return exit_code::kDone;
   } catch (const resolver::EventLogError& e) {
+    // A malformed or truncated log (the file itself was readable: checked above).
     std::fflush(stdout);
     std::cerr << "resolver-echo: " << e.what() << '\n';
-  } catch (const resolver::LcmParseError& e) {
-    std::cerr << "resolver-echo: " << e.what() << '\n';
+    return exit_code::kNoUsableData;
   } catch (const std::exception& e) {
     std::cerr << "resolver-echo: " << e.what() << '\n';
   }
-  return kExitError;
+  return exit_code::kInternal;
 }

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/app/exit_codes.h"
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
 #include "daemon/core/model/model_spec.h"
@@ -104,7 +105,12 @@ int write_report(const resolver::LogSamples& samples, const std::string& log, co
     });
   }
   const std::string page = resolver::format_model_html(run, samples, log, options.explained_ratio);
-  resolver::write_text_file(html_out, page);
+  try {
+    resolver::write_text_file(html_out, page);
+  } catch (const std::runtime_error& e) {
+    std::cerr << "resolver-model: " << e.what() << "\n";
+    return resolver::exit_code::kIo;
+  }
   std::cout << resolver::summarize_discovery(run) << "\n"
             << "wrote " << html_out << " (" << (page.size() + 512) / 1024 << " KiB)\n";
   return 0;
@@ -140,6 +146,7 @@ int run(int argc, char** argv) {
                "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json\n"
                "  resolver-model report build/demo/demo.log --html demo.html\n"
                "  resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat"};
+  app.footer(resolver::exit_code::kHelpText);
   app.require_subcommand(1);
   app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
@@ -170,8 +177,7 @@ int run(int argc, char** argv) {
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config_path,
                     "resolverd config (TOML): its [layout] DBC and signals decode the log, [bench] p_r/p apply "
-                    "without BENCH_INFO, [model] effects is the model when --effects is not given")
-        ->check(CLI::ExistingFile);
+                    "without BENCH_INFO, [model] effects is the model when --effects is not given");
   };
   CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
@@ -216,12 +222,19 @@ int run(int argc, char** argv) {
   add_config(exporter);
   add_slicing(exporter);
   add_slicing(export_data);
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
+  for (const auto& [option, path] : {std::pair{"LOG", log}, std::pair{"--config", config_path}}) {
+    if (path.empty()) continue;
+    if (auto problem = resolver::exit_code::unreadable(option, path)) {
+      std::cerr << "resolver-model: " << *problem << "\n";
+      return resolver::exit_code::kIo;
+    }
+  }
 
   const bool do_explain = explain->parsed();
   if (export_data->parsed() && csv_out.empty() && mat_out.empty()) {
     std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
-    return 2;
+    return resolver::exit_code::kUsage;
   }
   try {
     resolver::DaemonConfig config;
@@ -258,9 +271,13 @@ int run(int argc, char** argv) {
     std::cout << (json ? resolver::format_model_json(ex, do_explain, notes)
                        : resolver::format_model_text(ex, do_explain, notes));
     return 0;
-  } catch (const std::exception& e) {
+  } catch (const resolver::ConfigError& e) {
     std::cerr << "resolver-model: " << e.what() << "\n";
-    return 1;
+    return resolver::exit_code::kUsage;
+  } catch (const std::exception& e) {
+    // Too few samples, nothing decoded: the log had nothing usable to fit.
+    std::cerr << "resolver-model: " << e.what() << "\n";
+    return resolver::exit_code::kNoUsableData;
   }
 }
 
@@ -271,6 +288,6 @@ int main(int argc, char** argv) {
     return run(argc, argv);
   } catch (const std::exception& e) {  // e.g. out of memory while building the command line
     std::cerr << "resolver-model: " << e.what() << "\n";
-    return 1;
+    return resolver::exit_code::kInternal;
   }
 }

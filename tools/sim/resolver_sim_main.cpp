@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "daemon/app/exit_codes.h"
 #include "daemon/core/effects/chain_values.h"
 #include "drivers/candump/candump_writer.h"
 #include "tools/sim/bench_simulator.h"
@@ -70,9 +71,44 @@ struct Options {
   bool list_effects = false;
 };
 
-[[noreturn]] void fail(const std::string& message) {
+[[noreturn]] void fail(const std::string& message, int code = resolver::exit_code::kUsage) {
   fmt::print(stderr, "resolver-sim: {}\n", message);
-  std::exit(2);
+  std::exit(code);
+}
+
+/// [rad per sample] the resolver electrical angle's travel per sample at which it
+/// aliases: beyond pi a sampled angle cannot tell the speed from a slower (or
+/// backwards) one, so the log would silently show another bench.
+constexpr double kAliasingTravel = resolver::kPi;
+/// [rad per sample] resolverd's overspeed line (daemon/core/health/signal_health.h:
+/// the catalog's 4th harmonic of theta reaches Nyquist there).
+constexpr double kOverspeedTravel = resolver::kPi / 4.0;
+
+/// Refuses a speed the sample rate cannot represent (exit 2, naming the limit and the
+/// options); warns above resolverd's overspeed line.
+void check_speed(const SimConfig& c, bool profile) {
+  double rpm = 0.0;
+  for (const resolver::SpeedSegment& seg : c.profile) {
+    rpm = std::max({rpm, std::abs(seg.rpm_start), std::abs(seg.rpm_end)});
+  }
+  const double per_rpm = static_cast<double>(c.p_r) * resolver::rpm_to_rad_s(1.0) / c.sample_rate_hz;  // rad/sample per r/min
+  const double travel = rpm * per_rpm;
+  const std::string option = profile ? "--profile" : "--rpm";
+  if (travel >= kAliasingTravel) {
+    fail(fmt::format("{} {:g} r/min is more than --sample-rate {:g} Hz can represent: the resolver electrical angle "
+                     "(--p-r {}) would advance {:.2f} rad per sample, and from pi rad per sample on a sampled angle "
+                     "aliases (the log would show a slower or backwards bench). The limit is {:.0f} r/min here; lower "
+                     "{}, raise --sample-rate above {:.0f} Hz, or lower --p-r",
+                     option, rpm, c.sample_rate_hz, c.p_r, travel, kAliasingTravel / per_rpm, option,
+                     c.sample_rate_hz * travel / kAliasingTravel));
+  }
+  if (travel > kOverspeedTravel) {
+    fmt::print(stderr,
+               "resolver-sim: warning: {} {:g} r/min is {:.2f} rad of resolver electrical travel per sample, beyond "
+               "pi/4 ({:.0f} r/min at --sample-rate {:g} Hz): resolverd will report overspeed and the estimators see "
+               "fewer than 8 samples per electrical revolution\n",
+               option, rpm, travel, kOverspeedTravel / per_rpm, c.sample_rate_hz);
+  }
 }
 
 /// Fills options the command line did not set from a TOML file.
@@ -177,7 +213,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
       "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects."};
-  app.footer(std::string(kExamples) + "\n" + resolver::format_effect_catalog());
+  app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText + "\n\n" +
+             resolver::format_effect_catalog());
   app.set_version_flag("--version", resolver::version_line("resolver-sim"));
   Options o;
   app.add_option("--out,-o", o.out, "candump -l log file to write (required)");
@@ -201,12 +238,11 @@ int main(int argc, char** argv) {
   app.add_option("--seed", o.seed, "noise seed (default 1; same seed, same log)");
   app.add_option("--iface", o.iface, "interface name written into the log (default can0)");
   app.add_option("--truth", o.truth, "also write the true configuration and effect parameters as JSON");
-  app.add_option("--config", o.config_file, "TOML file with the same options; the command line wins")
-      ->check(CLI::ExistingFile);
+  app.add_option("--config", o.config_file, "TOML file with the same options; the command line wins");
   app.add_flag("--list-effects", o.list_effects, "print the effect catalog and exit");
   bool effects_markdown = false;
   app.add_flag("--effects-markdown", effects_markdown, "print the effect catalog as Markdown (docs/EFFECTS.md) and exit");
-  CLI11_PARSE(app, argc, argv);
+  if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
 
   if (effects_markdown) {
     fmt::print("{}", resolver::effects_markdown());
@@ -217,10 +253,14 @@ int main(int argc, char** argv) {
     return 0;
   }
   std::vector<std::string> toml_effects;
-  if (!o.config_file.empty()) apply_toml(o.config_file, app, o, toml_effects);
+  if (!o.config_file.empty()) {
+    if (auto problem = resolver::exit_code::unreadable("--config", o.config_file)) fail(*problem, resolver::exit_code::kIo);
+    apply_toml(o.config_file, app, o, toml_effects);
+  }
   if (o.out.empty()) fail("--out FILE is required (the candump log to write); see --help");
 
   const SimConfig config = build_config(app, o, toml_effects);
+  check_speed(config, !o.profile_text.empty());
   std::optional<resolver::BenchSimulator> sim;
   try {
     sim.emplace(config);
@@ -259,13 +299,16 @@ int main(int argc, char** argv) {
       std::ofstream truth(o.truth);
       truth << resolver::sim_truth_json(sim->config(), total, o.out);
       truth.close();
-      if (!truth) fail(fmt::format("--truth {}: cannot write the file; check the directory exists and is writable", o.truth));
+      if (!truth) {
+        fail(fmt::format("--truth {}: cannot write the file; check the directory exists and is writable", o.truth),
+             resolver::exit_code::kIo);
+      }
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     fmt::print(stderr, "resolver-sim: wrote {} frames ({} samples, {:.3g} s of bench time) to {} in {:.2f} s\n",
                writer.frames_written(), total, sim->profile().duration(), o.out, wall);
   } catch (const std::exception& e) {
-    fail(e.what());
+    fail(e.what(), resolver::exit_code::kIo);  // the log could not be opened or written
   }
   return 0;
 }

@@ -103,6 +103,46 @@ TEST(DaemonConfig, WakeIdsAreAutoOrCanIds) {
   EXPECT_NE(error_of("[can]\nwake_ids = [\"0x102\"]\n").find("from 0 to 0x1FFFFFFF"), std::string::npos);
 }
 
+TEST(DaemonConfig, HealthThresholdsDefaultFromThePhysicsAndOverride) {
+  const DaemonConfig d = parse_daemon_config("", "t.toml");
+  EXPECT_FALSE(d.health_full_scale_set);  // from the DBC
+  EXPECT_DOUBLE_EQ(d.health.loss_of_signal_fraction, 0.05);
+  EXPECT_DOUBLE_EQ(d.health.loss_of_tracking_rad, 5.0 * kPi / 180.0);
+  const DaemonConfig c = parse_daemon_config(
+      "[health]\nfull_scale = 2047\nloss_of_signal_fraction = 0.1\ndegradation_low_fraction = 0.3\n"
+      "degradation_high_fraction = 0.9\ndegradation_mismatch = 0.2\nloss_of_tracking_deg = 10\n"
+      "overspeed_rad_per_sample = 1.0\nstopped_below_hz = 0.5\noutlier_sigmas = 10\nblock_s = 0.2\n",
+      "t.toml");
+  EXPECT_TRUE(c.health_full_scale_set);
+  EXPECT_DOUBLE_EQ(c.health.full_scale, 2047.0);
+  EXPECT_DOUBLE_EQ(c.health.loss_of_signal_fraction, 0.1);
+  EXPECT_DOUBLE_EQ(c.health.degradation_low_fraction, 0.3);
+  EXPECT_DOUBLE_EQ(c.health.degradation_high_fraction, 0.9);
+  EXPECT_DOUBLE_EQ(c.health.degradation_mismatch, 0.2);
+  EXPECT_DOUBLE_EQ(c.health.loss_of_tracking_rad, 10.0 * kPi / 180.0);
+  EXPECT_DOUBLE_EQ(c.health.overspeed_rad_per_sample, 1.0);
+  EXPECT_DOUBLE_EQ(c.health.stopped_below_hz, 0.5);
+  EXPECT_DOUBLE_EQ(c.health.outlier_sigmas, 10.0);
+  EXPECT_DOUBLE_EQ(c.health.block_s, 0.2);
+}
+
+TEST(DaemonConfig, HealthBadValuesAndUnknownKeys) {
+  EXPECT_NE(error_of("[health]\nlos = 0.1\n").find("unknown key 'los' in [health]"), std::string::npos);
+  EXPECT_NE(error_of("[health]\nfull_scale = -1\n").find("full_scale must be a finite number >= 0"), std::string::npos);
+  EXPECT_NE(error_of("[health]\nloss_of_signal_fraction = 0\n").find("loss_of_signal_fraction must be in (0, 1]"),
+            std::string::npos);
+  EXPECT_NE(error_of("[health]\nloss_of_signal_fraction = nan\n").find("loss_of_signal_fraction must be"),
+            std::string::npos);
+  EXPECT_NE(error_of("[health]\nloss_of_signal_fraction = 0.5\n").find("loss_of_signal_fraction <= degradation_low"),
+            std::string::npos);
+  EXPECT_NE(error_of("[health]\noverspeed_rad_per_sample = 4\n").find("(0, pi]"), std::string::npos);
+  EXPECT_NE(error_of("[health]\nloss_of_tracking_deg = 0\n").find("(0, 180] degrees"), std::string::npos);
+  EXPECT_NE(error_of("[health]\nstopped_below_hz = -1\n").find("stopped_below_hz must be"), std::string::npos);
+  EXPECT_NE(error_of("[health]\noutlier_sigmas = 1\n").find("above 2"), std::string::npos);
+  EXPECT_NE(error_of("[health]\nblock_s = 0\n").find("block_s must be in (0, 10]"), std::string::npos);
+  EXPECT_NE(error_of("[health]\nblock_s = \"fast\"\n").find("must be a number"), std::string::npos);
+}
+
 TEST(DaemonConfig, MissingFileSaysSo) {
   try {
     load_daemon_config("/nonexistent/resolverd.toml");

@@ -1,9 +1,11 @@
 // Our LCM log writer against liblcm's own reader (lcm::LogFile): every event
-// comes back with its channel, bytes, event number and a wall-clock timestamp.
+// comes back with its channel, bytes, event number and its message's utime as
+// the event time (bench time, never going back), so lcm-logplayer plays a
+// --fast replay's log at the bench's speed.
 #include <gtest/gtest.h>
 #include <lcm/lcm-cpp.hpp>
 
-#include <chrono>
+#include <algorithm>
 #include <cstdio>
 #include <string>
 
@@ -33,19 +35,20 @@ TEST(LcmLogWriter, ParsesOnlyWriteAndAppendFileUrls) {
 
 TEST(LcmLogWriter, LiblcmReadsBackEveryEvent) {
   const std::string path = std::string(RESOLVER_BINARY_DIR) + "/writer_test.lcmlog";
-  const auto before = std::chrono::duration_cast<std::chrono::microseconds>(
-                          std::chrono::system_clock::now().time_since_epoch()).count();
   constexpr int kEvents = 20000;  // > one 256 KiB buffer: the flush path runs
+  constexpr std::int64_t kT0 = 1'700'000'000'000'000;  // [us] bench time of the first sample
+  constexpr std::int64_t kPeriod = 500;                // [us] 2 kHz
   {
     LcmOutput out("file://" + path + "?mode=w", LcmChannels{});
     for (int i = 0; i < kEvents; ++i) {
       angle_t a{};
-      a.utime = i;
+      a.utime = kT0 + kPeriod * i;
       a.sample_index = 3 * static_cast<std::int64_t>(i);
       a.theta_rd = 0.001 * i;
       out.publish(a);
     }
     estimate_t e{};
+    e.utime = kT0;  // older than the last angle_t (a result published late): the event time must not go back
     e.method = "hwang_integral";
     e.num_params = 1;
     e.param_name = {"amplitude_imbalance.alpha"};
@@ -60,12 +63,12 @@ TEST(LcmLogWriter, LiblcmReadsBackEveryEvent) {
   int n = 0;
   while (const lcm::LogEvent* ev = log.readNextEvent()) {
     EXPECT_EQ(ev->eventnum, n);
-    EXPECT_GE(ev->timestamp, before);
+    EXPECT_EQ(ev->timestamp, kT0 + kPeriod * std::min(n, kEvents - 1)) << "event " << n;
     if (n < kEvents) {
       ASSERT_EQ(ev->channel, "RESOLVER_ANGLE");
       angle_t a{};
       ASSERT_EQ(a.decode(ev->data, 0, ev->datalen), ev->datalen);
-      EXPECT_EQ(a.utime, n);
+      EXPECT_EQ(a.utime, kT0 + kPeriod * n);
       EXPECT_EQ(a.sample_index, 3 * n);
       EXPECT_DOUBLE_EQ(a.theta_rd, 0.001 * n);
     } else {

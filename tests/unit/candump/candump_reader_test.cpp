@@ -2,6 +2,10 @@
 // chunk boundaries, long lines, missing final newline, time going backwards.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -300,6 +304,59 @@ TEST(CandumpReader, MovedReaderContinuesWhereItWas) {
   EXPECT_EQ(f.id, 2U);
   EXPECT_EQ(b.line_number(), 2U);
   EXPECT_EQ(b.path(), tmp.str());
+}
+
+// The stop flag (issue 16): a set flag ends next() with kEnd and stopped() on
+// any input, without reading on. No timing: the flag is set before the call, so
+// a reader that ignored it would block (FIFO) or never return (/dev/zero) and
+// the test would hang instead of passing.
+TEST(CandumpReader, StopFlagEndsAnEndlessDevice) {
+  std::atomic<bool> stop{false};
+  CandumpReader reader("/dev/zero");
+  reader.set_stop_flag(&stop);
+  stop = true;
+  CanFrame f;
+  EXPECT_EQ(reader.next(f), CandumpReader::Status::kEnd);
+  EXPECT_TRUE(reader.stopped());
+}
+
+TEST(CandumpReader, StopFlagEndsAFifoWithoutWriterAndOpeningDoesNotBlock) {
+  TempPath fifo(".fifo");
+  ::unlink(fifo.str().c_str());
+  ASSERT_EQ(::mkfifo(fifo.str().c_str(), 0600), 0);
+  std::atomic<bool> stop{true};
+  CandumpReader reader(fifo.str());  // no writer: must not block here
+  EXPECT_EQ(reader.total_bytes(), 0U);
+  reader.set_stop_flag(&stop);
+  CanFrame f;
+  EXPECT_EQ(reader.next(f), CandumpReader::Status::kEnd);
+  EXPECT_TRUE(reader.stopped());
+}
+
+TEST(CandumpReader, StopFlagMidFileDropsNoFrameAsBadAndControlReadsToTheEnd) {
+  TempPath log;
+  std::string text;
+  for (int i = 0; i < 100; ++i) text += "(1." + std::to_string(100000 + i) + ") can0 100#00\n";
+  write_text(log.str(), text);
+  std::atomic<bool> stop{false};
+  CandumpReader reader(log.str(), CandumpReader::kMinBufferBytes);
+  reader.set_stop_flag(&stop);
+  CanFrame f;
+  ASSERT_EQ(reader.next(f), CandumpReader::Status::kFrame);
+  stop = true;
+  // What is already buffered may still come out as frames, never as bad lines.
+  CandumpReader::Status s;
+  while ((s = reader.next(f)) == CandumpReader::Status::kFrame) {
+  }
+  EXPECT_EQ(s, CandumpReader::Status::kEnd);
+  // Control: without the flag the same file reads to its end, not stopped.
+  CandumpReader control(log.str());
+  std::atomic<bool> never{false};
+  control.set_stop_flag(&never);
+  int frames = 0;
+  while (control.next(f) == CandumpReader::Status::kFrame) ++frames;
+  EXPECT_EQ(frames, 100);
+  EXPECT_FALSE(control.stopped());
 }
 
 }  // namespace

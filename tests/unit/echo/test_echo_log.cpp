@@ -194,11 +194,15 @@ TEST_F(EchoLog, BinaryHelpAndUsageErrors) {
   EXPECT_EQ(run(kEchoBinary + " --log " + log_ + " --lcm memq:// 2>&1").exit_code, 2);
   EXPECT_EQ(run(kEchoBinary + " --log " + log_ + " --count 3 2>&1").exit_code, 2) << "--count is for --lcm";
   const auto bad_type = run(kEchoBinary + " --log " + log_ + " --type nope_t 2>&1");
-  EXPECT_EQ(bad_type.exit_code, 1);
+  EXPECT_EQ(bad_type.exit_code, 2) << "a usage error";
   EXPECT_NE(bad_type.out.find("--type nope_t"), std::string::npos) << bad_type.out;
   const auto bad_regex = run(kEchoBinary + " --log " + log_ + " --channel '(' 2>&1");
-  EXPECT_EQ(bad_regex.exit_code, 1);
+  EXPECT_EQ(bad_regex.exit_code, 2) << "a usage error";
   EXPECT_NE(bad_regex.out.find("--channel"), std::string::npos) << bad_regex.out;
+  const auto missing = run(kEchoBinary + " --log " + log_ + ".missing 2>&1");
+  EXPECT_EQ(missing.exit_code, 3) << "an I/O error, not CLI11's 105";
+  EXPECT_NE(missing.out.find("cannot read --log " + log_ + ".missing: No such file or directory"), std::string::npos)
+      << missing.out;
 }
 
 TEST_F(EchoLog, BinaryLoadsExtraTypes) {

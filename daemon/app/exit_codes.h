@@ -1,0 +1,58 @@
+// Exit codes shared by every program of the project (resolverd, resolver-sim,
+// resolver-model, resolver-echo, resolver-accuracy), so a script can tell "the
+// data was bad" from "I called it wrong" from "the disk said no":
+//
+//   0  done
+//   1  the input had no usable data (nothing decoded, a damaged log)
+//   2  usage or configuration error (bad option, bad config file or DBC)
+//   3  I/O error (a file missing or unreadable, a write that failed)
+//   70 internal error (an unexpected exception: a bug, please report it)
+//
+// CLI11's own codes (105 for a missing --config file, 106 for a missing
+// option, ...) never leave a program: parse_command_line() maps them.
+#pragma once
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace resolver::exit_code {
+
+inline constexpr int kDone = 0;
+inline constexpr int kNoUsableData = 1;
+inline constexpr int kUsage = 2;
+inline constexpr int kIo = 3;
+inline constexpr int kInternal = 70;  // sysexits.h EX_SOFTWARE
+
+/// The paragraph every --help ends with.
+inline constexpr const char* kHelpText =
+    "Exit codes: 0 done; 1 the input had no usable data; 2 usage or configuration error; "
+    "3 I/O error (a file missing or unreadable, a write failed); 70 internal error (a bug).";
+
+/// Parses the command line. Returns nullopt to go on, or the code to exit with:
+/// 0 after --help (printed), kUsage after printing CLI11's message.
+[[nodiscard]] inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int cli = app.exit(e);  // prints --help, or the error and "Run with --help"
+    return cli == 0 ? kDone : kUsage;
+  }
+  return std::nullopt;
+}
+
+/// nullopt when `path` exists and may be read, else "cannot read <option> <path>: <strerror>".
+/// access(2), not open(2): opening a FIFO would briefly be its reader and let a
+/// waiting writer write into a pipe nobody reads.
+[[nodiscard]] inline std::optional<std::string> unreadable(const std::string& option, const std::string& path) {
+  if (::access(path.c_str(), R_OK) != 0) return "cannot read " + option + " " + path + ": " + std::strerror(errno);
+  return std::nullopt;
+}
+
+}  // namespace resolver::exit_code

@@ -1,0 +1,313 @@
+// SignalHealthMonitor on synthetic resolver signals with known faults: each
+// fault is raised by the damage it names and by nothing else, with a clean
+// control beside it. Signals: s = A sin(theta), c = A cos(theta) in ADC counts
+// (rounded, as an ADC reports them) plus Gaussian noise, theta_rd = theta.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/health/signal_health.h"
+
+namespace resolver {
+namespace {
+
+constexpr double kRate = 2000.0;     // [Hz] default bench sample rate
+constexpr int kPr = 3;               // resolver pole pairs
+constexpr double kAmplitude = 26000; // [counts] the simulator's default envelope
+constexpr double kNoise = 2.0;       // [counts] rms, the simulator's default sigma_sc
+
+struct Bench {
+  double rpm = 200.0;           // mechanical
+  double seconds = 2.0;
+  double amplitude = kAmplitude;
+  double noise = kNoise;
+  bool reference = true;
+  bool rd = true;
+  /// Changes sample k (index, theta [rad], in/out sample) after it is built.
+  std::function<void(std::int64_t, double, Sample&)> damage;
+};
+
+double clamp_adc(double v) { return std::clamp(std::round(v), -32768.0, 32767.0); }
+
+std::vector<Sample> make_samples(const Bench& b, unsigned seed = 7) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const auto n = static_cast<std::int64_t>(b.seconds * kRate);
+  const double omega_m = b.rpm / 60.0 * kTwoPi;  // [rad/s] mechanical
+  std::vector<Sample> out;
+  out.reserve(static_cast<std::size_t>(n));
+  for (std::int64_t k = 0; k < n; ++k) {
+    Sample s;
+    s.index = k;
+    s.t = static_cast<double>(k) / kRate;
+    s.utime = static_cast<std::int64_t>(s.t * 1e6);
+    const double theta_m = omega_m * s.t + 0.3;
+    const double theta = kPr * theta_m;
+    s.has_sincos = true;
+    s.sin = clamp_adc(b.amplitude * std::sin(theta) + b.noise * noise(rng));
+    s.cos = clamp_adc(b.amplitude * std::cos(theta) + b.noise * noise(rng));
+    s.has_rd = b.rd;
+    s.theta_rd = wrap_2pi(theta);
+    s.has_ref = b.reference;
+    s.theta_m_ref = wrap_2pi(theta_m);
+    if (b.damage) b.damage(k, theta, s);
+    out.push_back(s);
+  }
+  return out;
+}
+
+SignalHealthSummary run(const Bench& b, SignalHealthConfig config = {}) {
+  return summarize_signal_health(make_samples(b), config, kPr, kRate);
+}
+
+/// The faults seen at all (samples > 0), by name, for readable failures.
+std::vector<std::string> seen(const SignalHealthSummary& s) {
+  std::vector<std::string> out;
+  for (const auto& f : s.faults) {
+    if (f.samples > 0) out.emplace_back(fault_name(f.fault));
+  }
+  return out;
+}
+
+TEST(SignalHealth, CleanBenchHasNoFault) {
+  for (double rpm : {200.0, 1000.0, 3000.0}) {
+    Bench b;
+    b.rpm = rpm;
+    const SignalHealthSummary s = run(b);
+    EXPECT_TRUE(seen(s).empty()) << rpm << " r/min: " << s.describe();
+    EXPECT_NEAR(s.amplitude.mean(), kAmplitude, 1.0) << "mean radius = A (noise adds sigma^2/2A, far below a count)";
+    EXPECT_EQ(s.events.size(), 0U);
+  }
+}
+
+TEST(SignalHealth, DeadExcitationIsLossOfSignalOnlyAndSinCosLost) {
+  Bench b;
+  b.amplitude = 0.0;  // sin = cos = 0 plus ADC noise
+  const auto samples = make_samples(b);
+  const SignalHealthSummary s = summarize_signal_health(samples, {}, kPr, kRate);
+  const auto& los = s.fault(SignalFault::kLossOfSignal);
+  EXPECT_EQ(los.samples, s.samples) << s.describe();
+  EXPECT_DOUBLE_EQ(los.share, 1.0);
+  EXPECT_EQ(los.episodes, 1);
+  EXPECT_TRUE(los.active_at_end);
+  EXPECT_DOUBLE_EQ(los.first_t, 0.0);
+  // LOS says it all: no DOS, LOT or outliers on top of a missing signal.
+  EXPECT_EQ(s.fault(SignalFault::kDegradationOfSignal).samples, 0);
+  EXPECT_EQ(s.fault(SignalFault::kLossOfTracking).samples, 0);
+  EXPECT_EQ(s.fault(SignalFault::kOutliers).samples, 0);
+  ASSERT_EQ(s.events.size(), 1U);
+  EXPECT_TRUE(s.events[0].started);
+  EXPECT_NE(s.events[0].detail.find("below 1638"), std::string::npos) << s.events[0].detail;
+  SignalHealthMonitor m({}, kPr, kRate);
+  EXPECT_TRUE(m.sincos_lost(samples[10]));
+  EXPECT_FALSE(m.sincos_lost(make_samples(Bench{})[10]));
+}
+
+TEST(SignalHealth, LossOfSignalInTheMiddleStartsAndEndsOnce) {
+  Bench b;
+  b.seconds = 3.0;
+  b.damage = [](std::int64_t k, double, Sample& s) {
+    if (k >= 2000 && k < 4000) s.sin = s.cos = 0.0;  // t = 1 s .. 2 s
+  };
+  const SignalHealthSummary s = run(b);
+  const auto& los = s.fault(SignalFault::kLossOfSignal);
+  EXPECT_EQ(los.episodes, 1) << s.describe();
+  // Blocks of 0.1 s = 200 samples line up with the damage here, so the count is exact.
+  EXPECT_EQ(los.samples, 2000) << s.describe();
+  ASSERT_GE(s.events.size(), 2U);
+  std::vector<SignalFaultEvent> los_events;
+  for (const auto& e : s.events) {
+    if (e.fault == SignalFault::kLossOfSignal) los_events.push_back(e);
+  }
+  ASSERT_EQ(los_events.size(), 2U);
+  EXPECT_TRUE(los_events[0].started);
+  EXPECT_NEAR(los_events[0].t, 1.0, 1e-9);
+  EXPECT_FALSE(los_events[1].started);
+  EXPECT_NEAR(los_events[1].t, 2.0, 1e-9);
+  EXPECT_FALSE(los.active_at_end);
+}
+
+TEST(SignalHealth, OneOpenChannelIsDegradationNotLoss) {
+  Bench b;
+  b.damage = [](std::int64_t, double, Sample& s) { s.sin = 0.0; };
+  const SignalHealthSummary s = run(b);
+  EXPECT_EQ(s.fault(SignalFault::kLossOfSignal).samples, 0) << s.describe();
+  EXPECT_GT(s.fault(SignalFault::kDegradationOfSignal).share, 0.9) << s.describe();
+}
+
+TEST(SignalHealth, ImbalanceInsideTheBandIsFineBeyondItDegraded) {
+  for (const auto& [alpha, degraded] : {std::pair{0.05, false}, std::pair{0.2, true}}) {
+    Bench b;
+    b.damage = [alpha = alpha](std::int64_t, double theta, Sample& s) {
+      s.cos = clamp_adc(kAmplitude * (1.0 + alpha) * std::cos(theta));
+    };
+    const SignalHealthSummary s = run(b);
+    EXPECT_EQ(s.fault(SignalFault::kDegradationOfSignal).share > 0.5, degraded) << alpha << ": " << s.describe();
+  }
+}
+
+TEST(SignalHealth, WeakAmplitudeIsDegradation) {
+  Bench b;
+  b.amplitude = 0.15 * 32767;  // between LOS (5 %) and the DOS low line (25 %)
+  const SignalHealthSummary s = run(b);
+  EXPECT_EQ(s.fault(SignalFault::kLossOfSignal).samples, 0);
+  EXPECT_DOUBLE_EQ(s.fault(SignalFault::kDegradationOfSignal).share, 1.0) << s.describe();
+}
+
+TEST(SignalHealth, ClippingCountsTheClippedSamples) {
+  Bench b;
+  b.amplitude = 34000;  // beyond full scale on the axes
+  const auto samples = make_samples(b);
+  std::int64_t clipped = 0;
+  for (const Sample& x : samples) clipped += (std::abs(x.sin) >= 32767 || std::abs(x.cos) >= 32767) ? 1 : 0;
+  ASSERT_GT(clipped, 0);
+  const SignalHealthSummary s = summarize_signal_health(samples, {}, kPr, kRate);
+  EXPECT_EQ(s.fault(SignalFault::kClipping).samples, clipped) << s.describe();
+  Bench control;
+  control.amplitude = 32000;  // 98 % of full scale plus 2 counts of noise: never at the rail
+  EXPECT_EQ(run(control).fault(SignalFault::kClipping).samples, 0);
+}
+
+TEST(SignalHealth, LossOfTrackingBeyondFiveDegrees) {
+  for (const auto& [offset_deg, lot] : {std::pair{2.0, false}, std::pair{10.0, true}}) {
+    Bench b;
+    b.damage = [off = offset_deg * kPi / 180.0](std::int64_t, double, Sample& s) {
+      s.theta_rd = wrap_2pi(s.theta_rd + off);
+    };
+    const SignalHealthSummary s = run(b);
+    EXPECT_EQ(s.fault(SignalFault::kLossOfTracking).share > 0.9, lot) << offset_deg << " deg: " << s.describe();
+    EXPECT_EQ(s.fault(SignalFault::kLossOfTracking).samples == 0, !lot);
+  }
+}
+
+TEST(SignalHealth, StoppedMotor) {
+  Bench b;
+  b.rpm = 0.0;
+  const SignalHealthSummary s = run(b);
+  EXPECT_DOUBLE_EQ(s.fault(SignalFault::kStopped).share, 1.0) << s.describe();
+  EXPECT_EQ(seen(s), std::vector<std::string>{"stopped"});
+  Bench slow;
+  slow.rpm = 5.0;  // 0.25 Hz electrical with p_r = 3: slow, not stopped
+  EXPECT_EQ(run(slow).fault(SignalFault::kStopped).samples, 0);
+}
+
+TEST(SignalHealth, StallsAndLostSamplesDoNotFakeAStop) {
+  // A loaded live reader: the sample clock re-anchors after stalls (t jumps 90 ms
+  // forward every 50 samples while the counter goes on by one), and bursts of samples
+  // are lost (gaps of 20 indices). The motor turns at 200 r/min all along.
+  auto samples = make_samples(Bench{});
+  std::vector<Sample> damaged;
+  double shift = 0.0;
+  for (const Sample& x : samples) {
+    if (x.index % 100 >= 40 && x.index % 100 < 60) continue;  // lost
+    if (x.index % 50 == 0) shift += 0.09;
+    Sample y = x;
+    y.t += shift;
+    damaged.push_back(y);
+  }
+  const SignalHealthSummary s = summarize_signal_health(damaged, {}, kPr, kRate);
+  EXPECT_EQ(s.fault(SignalFault::kStopped).samples, 0) << s.describe();
+  EXPECT_EQ(s.fault(SignalFault::kOverspeed).samples, 0) << s.describe();
+  // Control: the same damage on a stopped motor is still a stop.
+  Bench stopped;
+  stopped.rpm = 0.0;
+  std::vector<Sample> still;
+  for (const Sample& x : make_samples(stopped)) {
+    if (x.index % 100 >= 40 && x.index % 100 < 60) continue;
+    still.push_back(x);
+  }
+  EXPECT_GT(summarize_signal_health(still, {}, kPr, kRate).fault(SignalFault::kStopped).share, 0.9);
+}
+
+TEST(SignalHealth, OverspeedBeforeAliasingAndWithAnAliasedAngle) {
+  // Line pi/4 rad per sample = 5000 r/min at 2 kHz with p_r = 3.
+  Bench below;
+  below.rpm = 4500;
+  EXPECT_EQ(run(below).fault(SignalFault::kOverspeed).samples, 0) << run(below).describe();
+  Bench above;
+  above.rpm = 10000;  // pi/2 per sample
+  EXPECT_DOUBLE_EQ(run(above).fault(SignalFault::kOverspeed).share, 1.0) << run(above).describe();
+  // 38000 r/min: 0.95 resolver electrical revolutions per sample (1900 Hz with
+  // p_r = 3), so the resolver angle aliases to a slow backwards turn (-0.05 rev
+  // per sample, "-2000 r/min"); the mechanical reference (0.32 rev per sample)
+  // still resolves it.
+  Bench aliased;
+  aliased.rpm = 38000;
+  const SignalHealthSummary with_ref = run(aliased);
+  EXPECT_DOUBLE_EQ(with_ref.fault(SignalFault::kOverspeed).share, 1.0) << with_ref.describe();
+  aliased.reference = false;
+  EXPECT_EQ(run(aliased).fault(SignalFault::kOverspeed).samples, 0)
+      << "without a reference an alias is indistinguishable from a slow turn (documented)";
+}
+
+TEST(SignalHealth, OutliersCountedExactlyAndNotInTheNoise) {
+  const std::vector<std::int64_t> spikes{500, 1234, 2000, 2001, 3999};
+  Bench b;
+  b.damage = [&spikes](std::int64_t k, double, Sample& s) {
+    if (std::find(spikes.begin(), spikes.end(), k) != spikes.end()) s.sin += 3000.0;
+  };
+  const SignalHealthSummary s = run(b);
+  EXPECT_EQ(s.fault(SignalFault::kOutliers).samples, static_cast<std::int64_t>(spikes.size())) << s.describe();
+  EXPECT_EQ(s.fault(SignalFault::kDegradationOfSignal).samples, 0) << "a spike is not a degraded signal";
+  EXPECT_EQ(s.fault(SignalFault::kLossOfTracking).samples, 0);
+  // Controls: long noisy runs, a speed ramp and an amplitude step raise no
+  // outlier beyond the few samples of a level change.
+  Bench noisy;
+  noisy.seconds = 30.0;
+  noisy.noise = 20.0;
+  EXPECT_EQ(run(noisy).fault(SignalFault::kOutliers).samples, 0);
+  std::vector<Sample> ramp;
+  {
+    Bench r;
+    r.seconds = 4.0;
+    ramp = make_samples(r);
+    double theta_m = 0.0;
+    for (Sample& x : ramp) {
+      const double rpm = 200.0 + 250.0 * x.t;  // 200 -> 1200 r/min in 4 s
+      theta_m += rpm / 60.0 * kTwoPi / kRate;
+      x.sin = std::round(kAmplitude * std::sin(kPr * theta_m));
+      x.cos = std::round(kAmplitude * std::cos(kPr * theta_m));
+      x.theta_rd = wrap_2pi(kPr * theta_m);
+      x.theta_m_ref = wrap_2pi(theta_m);
+    }
+  }
+  EXPECT_EQ(summarize_signal_health(ramp, {}, kPr, kRate).fault(SignalFault::kOutliers).samples, 0);
+  Bench step;
+  step.damage = [](std::int64_t k, double theta, Sample& x) {
+    if (k >= 1500) {
+      x.sin = std::round(20000 * std::sin(theta));
+      x.cos = std::round(20000 * std::cos(theta));
+    }
+  };
+  EXPECT_LE(run(step).fault(SignalFault::kOutliers).samples, 8) << "a level change costs at most one run of 8";
+}
+
+TEST(SignalHealth, AmplitudeWindowIsSinceTheLastTake) {
+  SignalHealthMonitor m({}, kPr, kRate);
+  Bench b;
+  b.noise = 0.0;
+  for (const Sample& s : make_samples(b)) m.add(s);
+  const AmplitudeStats w = m.take_amplitude_window();
+  EXPECT_EQ(w.n, 4000);
+  EXPECT_NEAR(w.mean(), kAmplitude, 1.0);  // rounding to counts: within a count
+  EXPECT_LE(w.max - w.min, 2.0);
+  EXPECT_EQ(m.take_amplitude_window().n, 0);
+  EXPECT_EQ(m.amplitude_total().n, 4000);
+}
+
+TEST(SignalHealth, ThresholdsComeFromTheConfig) {
+  Bench b;
+  b.amplitude = 0.15 * 32767;
+  SignalHealthConfig c;
+  c.degradation_low_fraction = 0.1;  // now 15 % is inside the band
+  EXPECT_EQ(run(b, c).fault(SignalFault::kDegradationOfSignal).samples, 0);
+  c.full_scale = 2047;  // a 12-bit ADC: 4915 counts are far above its full scale
+  EXPECT_GT(run(b, c).fault(SignalFault::kClipping).samples, 0);
+}
+
+}  // namespace
+}  // namespace resolver
