@@ -1,0 +1,28 @@
+#include "drivers/asc/asc_reader.h"
+
+#include <fmt/format.h>
+
+namespace resolver {
+
+AscReader::Status AscReader::next(CanFrame& frame) {
+  for (;;) {
+    std::string_view line;
+    const LineReader::Result got = lines_.next(line);
+    if (got == LineReader::Result::kEnd) return Status::kEnd;
+    if (got == LineReader::Result::kTooLong) {
+      problem_ = TextProblem{"line_too_long", kMaxLineLength + 1,
+                             fmt::format("line is {} bytes long; at most {} are accepted - is this a Vector ASC log? "
+                                         "The line was skipped",
+                                         lines_.skipped_length(), kMaxLineLength)};
+      return Status::kBadLine;
+    }
+    const AscLineParser::Result r = parser_.parse(line, frame);
+    if (r.kind == AscLineParser::Kind::kFrame) return Status::kFrame;
+    if (r.kind == AscLineParser::Kind::kProblem) {
+      problem_ = r.problem;
+      return Status::kBadLine;
+    }
+  }
+}
+
+}  // namespace resolver
