@@ -47,6 +47,18 @@
 //   effects = ["amplitude_imbalance"]   # the active model; SIGHUP reloads it
 //   window_revolutions = 16    # resolver electrical revolutions per window
 //   candidates = true          # also rank the catalog effects not in the model
+//   [input]
+//   format = "auto"            # replayed files: "candump", "asc", "csv"; auto = by extension
+//   [input.csv]                # CSV / scope exports (daemon/decode/row_decoder.h)
+//   delimiter = "auto"         # ",", ";", "tab", "space" (runs of spaces), "auto"
+//   decimal = "."              # or ","
+//   header_lines = 0           # lines skipped before the column-name line; "auto" = until a line of numbers
+//   column_names = true        # the first line after them names the columns
+//   time_column = "Time"       # name or 1-based index; "" = none (rows at row_rate_hz)
+//   time_unit = "s"            # "ms", "us", "filetime" (100 ns ticks since 1601-01-01)
+//   row_rate_hz = 0            # only without a time column
+//   [input.csv.columns]        # role = { column = name|index, unit, scale = 1, offset = 0,
+//   rd_angle = { column = "Resolver", unit = "deg" }   #  full_scale (unit "counts"), divide (angles) }
 #pragma once
 
 #include <optional>
@@ -54,9 +66,12 @@
 #include <string>
 #include <vector>
 
+#include "daemon/app/log_format.h"
 #include "daemon/core/estimation/hwang_integral.h"
 #include "daemon/core/estimation/sample_processor.h"
+#include "daemon/decode/row_decoder.h"
 #include "daemon/decode/signal_map.h"
+#include "drivers/csv/csv_format.h"
 
 namespace resolver {
 
@@ -105,6 +120,12 @@ struct ModelFitOptions {
   bool candidates = true;            ///< rank the missing catalog effects (explain) or only fit
 };
 
+/// A CSV / scope export's layout and column map ([input.csv]).
+struct CsvInputConfig {
+  CsvFormat format;
+  RowMap map;  ///< empty: no [input.csv.columns] (a CSV cannot be read)
+};
+
 struct DaemonConfig {
   std::string source;  ///< file the config came from ("" = built-in defaults)
   std::string lcm_url;  ///< "" = LCM's default (udpm multicast)
@@ -125,6 +146,8 @@ struct DaemonConfig {
   bool compensation_enabled = true;
   CompensationDomain compensation_domain = CompensationDomain::kAngle;
   ModelFitOptions model;
+  std::optional<LogFormat> input_format;  ///< [input] format; nullopt = from the extension
+  CsvInputConfig csv;
 };
 
 /// Thrown for unreadable or invalid configuration; what() names the file,

@@ -28,6 +28,9 @@ Examples:
   resolverd --replay demo.log --once --fast --lcm 'file:///tmp/out.lcmlog?mode=w'
   # replay in the log's own timing, publishing on the default LCM multicast
   resolverd --replay demo.log
+  # a Vector ASC log, or a scope export mapped by [input.csv] in the config; seconds 2..10 only
+  resolverd --replay bench.asc --once --fast --from 2 --to 10
+  resolverd --replay scope.csv --config scope.toml --once --fast
   # live from SocketCAN
   resolverd --can can0 --config /etc/resolverd/resolverd.toml
 
@@ -46,12 +49,26 @@ static int run(int argc, char** argv) {
   std::optional<std::string> lcm_url;
   bool once = false, fast = false, quiet = false;
   app.add_option("--config", config_path, "TOML config file (see README; every key optional)")->check(CLI::ExistingFile);
-  auto* replay = app.add_option("--replay", replay_path, "replay a candump -l log file instead of reading CAN")
+  auto* replay = app.add_option("--replay", replay_path,
+                                "replay a log file instead of reading CAN: candump -l, Vector ASC or a CSV/scope export")
                      ->check(CLI::ExistingFile);
   auto* can = app.add_option("--can", can_iface, "read live frames from this SocketCAN interface (can0, vcan0)");
   replay->excludes(can);
   app.add_flag("--once", once, "with --replay: stop at the end of the log (default: loop it)")->needs(replay);
   app.add_flag("--fast", fast, "with --replay: as fast as possible instead of the log's timing")->needs(replay);
+  std::string format_name;
+  SampleSlice slice;
+  app.add_option("--format", format_name,
+                 "with --replay: candump, asc (Vector ASC) or csv (scope export, [input.csv] in --config); "
+                 "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
+      ->check(CLI::IsMember({"candump", "asc", "csv"}))
+      ->needs(replay);
+  app.add_option("--from", slice.from_s, "with --replay: process samples from this time on [s, 0 = the log's first sample]")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(replay);
+  app.add_option("--to", slice.to_s, "with --replay: stop after this time [s, from the log's first sample]")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(replay);
   app.add_option("--lcm", lcm_url,
                  "LCM URL, overrides the config (default: LCM's udpm multicast; "
                  "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
@@ -62,6 +79,10 @@ static int run(int argc, char** argv) {
                  "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
                  "saved at exit when the estimate has converged");
   CLI11_PARSE(app, argc, argv);
+  if (slice.to_s < slice.from_s) {
+    std::cerr << "resolverd: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
+    return 2;
+  }
   if (replay_path.empty() && can_iface.empty()) {
     std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
     return 2;
@@ -80,7 +101,7 @@ static int run(int argc, char** argv) {
   std::unique_ptr<Pipeline> pipeline;
   try {
     output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
-    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty());
+    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty(), slice);
   } catch (const std::exception& e) {
     std::cerr << "resolverd: " << e.what() << "\n";
     return 2;
@@ -110,6 +131,7 @@ static int run(int argc, char** argv) {
     if (!replay_path.empty()) {
       ReplayOptions ro;
       ro.path = replay_path;
+      ro.format = log_format_from_name(format_name);
       ro.fast = fast;
       ro.once = once;
       ro.progress = !quiet;

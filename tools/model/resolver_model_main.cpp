@@ -3,8 +3,9 @@
 //   resolver-model explain LOG [--effects a,b] [--json]
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
 // All take --config FILE: a resolverd config whose [layout] (DBC, signal map),
-// [bench] pole pairs and [model] effects apply (logs of a user's own layout).
-// Reads the log (default bench layout), fits the named catalog effects
+// [input.csv] column map, [bench] pole pairs and [model] effects apply (logs of
+// a user's own layout, scope exports), --format candump|asc|csv and --from/--to [s].
+// Reads the log through resolverd's input path (tools/model/log_samples.h), fits the named catalog effects
 // (default amplitude_imbalance), prints residuals against the noise floor and,
 // for explain, the ranked missing effects and a verdict; report runs the
 // discovery loop to its verdict and writes one self-contained HTML page of it.
@@ -116,11 +117,13 @@ int run(int argc, char** argv) {
   std::string log;
   std::vector<std::string> effects_args;
   std::string config_path;
+  std::string format_name;
+  resolver::SampleSlice slice;
   bool json = false;
   std::string fittable;
   for (auto e : resolver::fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(e);
   auto add_common = [&](CLI::App* sub) {
-    sub->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+    sub->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
     sub->add_option("--effects", effects_args,
                     "comma-separated catalog effects of the model (default amplitude_imbalance); fittable: " + fittable)
         ->delimiter(',');
@@ -128,9 +131,17 @@ int run(int argc, char** argv) {
   };
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config_path,
-                    "resolverd config (TOML): its [layout] DBC and signals decode the log, [bench] p_r/p apply "
-                    "without BENCH_INFO, [model] effects is the model when --effects is not given")
+                    "resolverd config (TOML): its [layout] DBC and signals decode the log ([input.csv] a CSV), "
+                    "[bench] p_r/p apply without BENCH_INFO, [model] effects is the model when --effects is not given")
         ->check(CLI::ExistingFile);
+    sub->add_option("--format", format_name,
+                    "log format: candump, asc (Vector ASC) or csv (scope export, needs [input.csv] in --config); "
+                    "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
+        ->check(CLI::IsMember({"candump", "asc", "csv"}));
+    sub->add_option("--from", slice.from_s, "use samples from this time on [s, 0 = the log's first sample]")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--to", slice.to_s, "use samples up to this time [s, from the log's first sample]")
+        ->check(CLI::NonNegativeNumber);
   };
   CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
@@ -140,7 +151,7 @@ int run(int argc, char** argv) {
       "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
   std::string html_out;
   int max_steps = 6;
-  report->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+  report->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
   report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)")->delimiter(',');
   report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
   report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
@@ -148,6 +159,10 @@ int run(int argc, char** argv) {
   add_config(explain);
   add_config(report);
   CLI11_PARSE(app, argc, argv);
+  if (slice.to_s < slice.from_s) {
+    std::cerr << "resolver-model: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
+    return 2;
+  }
 
   const bool do_explain = explain->parsed();
   try {
@@ -158,7 +173,10 @@ int run(int argc, char** argv) {
     resolver::LogSamples samples;
     {
       ProgressBar bar("reading " + log);
-      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config);
+      resolver::LogReadOptions read_options;
+      read_options.format = resolver::log_format_from_name(format_name);
+      read_options.slice = slice;
+      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config, read_options);
     }
     resolver::DiscoveryOptions options;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
