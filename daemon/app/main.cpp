@@ -160,6 +160,9 @@ static int run(int argc, char** argv) {
       info.source = can_iface;
       info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }
+  } catch (const ConfigError& e) {  // e.g. a CSV column map that does not fit the export
+    std::cerr << "resolverd: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "resolverd: " << e.what() << "\n";
     return 1;

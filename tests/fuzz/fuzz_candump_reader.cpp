@@ -1,8 +1,9 @@
 // Fuzz target: CandumpReader (drivers/candump/candump_reader.h) over a whole
 // log held in a memfd, the way resolverd --replay reads a file: buffering,
-// line splitting, over-long lines, blank lines, the monotonic-time check.
+// line splitting, over-long lines, blank lines.
 // Properties: never throws on bad content, line numbers only grow, every bad
-// line names a column and a reason, accepted timestamps never go backwards.
+// line names a column and a reason, accepted timestamps are never negative
+// (they may step back: the sample clock handles that, sample_clock.h).
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -28,8 +29,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     resolver::CandumpReader reader("/proc/self/fd/" + std::to_string(fd), resolver::CandumpReader::kMinBufferBytes);
     resolver::CanFrame frame;
     std::uint64_t last_line = 0;
-    bool have_time = false;
-    std::int64_t last_time = 0;
     // Every call consumes at least one line, so size + 2 calls must reach kEnd.
     std::size_t calls = 0;
     for (;;) {
@@ -44,9 +43,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         FUZZ_CHECK(!reader.problem().message.empty(), "bad line without a message");
         continue;
       }
-      FUZZ_CHECK(!have_time || frame.timestamp_us >= last_time, "reader accepted a timestamp that goes backwards");
-      have_time = true;
-      last_time = frame.timestamp_us;
+      FUZZ_CHECK(frame.timestamp_us >= 0, "reader accepted a negative timestamp");
     }
     FUZZ_CHECK(reader.next(frame) == resolver::CandumpReader::Status::kEnd, "kEnd does not repeat");
   }
