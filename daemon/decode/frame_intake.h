@@ -88,7 +88,7 @@ class FrameIntake {
   BenchInfo info_;
 };
 
-/// "frame 0x100 (RESOLVER_SAMPLE) at 1700000000.123456 s" — how messages name a frame.
+/// "frame 100 at (1700000000.123456)": how messages name a frame (ID in hex, time as candump prints it).
 std::string describe_frame(const CanFrame& frame);
 /// "(1700000000.123456)": a frame or sample time as candump logs print it.
 std::string describe_frame_time(std::int64_t timestamp_us);

@@ -60,11 +60,15 @@ ClockReading SampleClock::read(std::int64_t stamp_us, std::optional<std::int64_t
     const double expected_s = static_cast<double>(r.index_step) * period;
     if (r.step_s < 0.0) {
       r.event = ClockEvent::kStepBack;
+    } else if (!counter_index) {
+      if (r.step_s > kMaxGapSeconds) {
+        r.event = ClockEvent::kJump;
+      } else if (period > 0.0 && r.step_s > kGapPeriods * period) {
+        r.samples_lost = std::llround(r.step_s / period) - 1;
+        if (r.samples_lost > 0) r.event = ClockEvent::kGap;
+      }
     } else if (period > 0.0 && r.step_s - expected_s > kMaxUnexplainedPeriods * period) {
       r.event = consecutive ? ClockEvent::kJump : ClockEvent::kOutage;
-    } else if (!counter_index && period > 0.0 && r.step_s > kGapPeriods * period) {
-      r.samples_lost = std::llround(r.step_s / period) - 1;
-      if (r.samples_lost > 0) r.event = ClockEvent::kGap;
     }
     r.index = last_index_ + r.index_step + r.samples_lost;
     const double frame_t = anchor_t_ + static_cast<double>(stamp_us - anchor_stamp_us_) / 1e6;

@@ -16,14 +16,16 @@
 //              continues from the counter; else t continues one period after
 //              the previous sample (the two pieces are joined end to end).
 //   kJump      the stamp jumped forward by more than kMaxUnexplainedPeriods
-//              periods while the counter says the samples are consecutive
-//              (or, without a counter, nothing says otherwise): a clock jump.
-//              Time continues from the counter (or one period on).
+//              periods while the counter says the samples are consecutive: a
+//              clock jump; time continues from the counter. Without a counter
+//              only a step beyond kMaxGapSeconds is read as a jump (t continues
+//              one period on): shorter silences are real (a recorder pausing).
 //   kOutage    the stamp jumped forward and the counter jumped too: samples
 //              were lost for longer than a u8 counter can count. t takes the
 //              frame-time gap.
-//   kGap       no counter: the stamp says 1.5 .. 128 periods passed; the
-//              missing samples are counted (samples_lost) and `index` skips them.
+//   kGap       no counter: the stamp says more than 1.5 periods passed; the
+//              missing samples are counted (samples_lost), `index` skips them
+//              and t keeps the gap.
 //
 // The period is 1 / sample rate where known, else the median stamp spacing of
 // the first kPeriodSamples steps. Pure: no I/O, no clocks.
@@ -62,6 +64,11 @@ class SampleClock {
   /// it could have wrapped unseen, so counting cannot bridge such a gap; slow or
   /// bursty delivery (canplayer bursts, emulated replays) stays far below it.
   static constexpr double kMaxUnexplainedPeriods = 128.0;
+  /// [s] Without a counter, a longer silence is a clock jump (a second recording
+  /// appended, a clock set), not a pause: recorders that pause for seconds exist
+  /// (the ServoProject export in tests/data/corpus stops for 1.1 s every 5 s and
+  /// once for 7.8 s), benches that log an hour of nothing do not.
+  static constexpr double kMaxGapSeconds = 3600.0;
   /// Stamp steps a learned period is the median of.
   static constexpr int kPeriodSamples = 64;
 

@@ -97,7 +97,7 @@ void SampleStream::report_clock_event(const BenchSample& joined, const ClockRead
           "timestamp_jump",
           fmt::format("{}: the timestamp jumps forward {:.6f} s{}; read as a clock jump, {}", where, r.step_s,
                       joined.has_counter ? fmt::format(" while the counter advanced by {}", r.index_step)
-                                         : std::string(" (no counter tells a clock jump from an outage)"),
+                                         : std::string(" (more than an hour, with no counter to count it)"),
                       counter_time ? "time continues from the counter"
                                    : "time continues one sample period after the previous sample"));
       break;

@@ -115,6 +115,20 @@ TEST(SampleClock, WithoutACounterAJumpOrAStepBackJoinsOnePeriodOn) {
   EXPECT_EQ(back.index, jump.index + 1);
 }
 
+TEST(SampleClock, WithoutACounterARecorderPauseIsAGapNotAJump) {
+  // The ServoProject export (tests/data/corpus) pauses 7.8 s once: the servo
+  // kept turning, so time must keep the pause; only the samples are missing.
+  SampleClock clock(SampleClockConfig{true, 0.0, 8});
+  std::int64_t stamp = 0;
+  ClockReading r;
+  for (int k = 0; k < 40; ++k, stamp += 4200) r = clock.read(stamp, std::nullopt);
+  const double before = r.t;
+  r = clock.read(stamp + 7'777'200 - 4200, std::nullopt);
+  EXPECT_EQ(r.event, ClockEvent::kGap);
+  EXPECT_NEAR(r.t - before, 7.7772, 1e-9);
+  EXPECT_EQ(r.samples_lost, 1851);  // 7.7772 s / 4.2 ms = 1851.7 periods: 1851 rows missing
+}
+
 TEST(SampleClock, FrameTimeWhenAsked) {
   SampleClock clock(SampleClockConfig{false, kRate, 8});  // [bench] time_source = "frame"
   clock.read(kT0, 0);
