@@ -9,9 +9,14 @@ PACKAGES=(
   liblcm-dev liblcm-bin
   libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
   can-utils python3 python3-can
+  python3-numpy  # tests/independent (benchgen)
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
   chromium  # headless, screenshots the resolver-model HTML report (tests/model)
+  # packaging (cmake/Packaging.cmake, tests/install): man pages from --help, the
+  # .deb's shared-library dependencies (dpkg-shlibdeps), systemd-analyze for the
+  # installed units, /bin/kill their ExecReload= names; numpy for resolver_lcm's arrays
+  help2man dpkg-dev systemd procps
 )
 
 missing=()

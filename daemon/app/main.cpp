@@ -16,6 +16,7 @@
 #include "daemon/app/stop_flag.h"
 #include "daemon/service/calibration_store.h"
 #include "daemon/service/sd_notify.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -45,6 +46,7 @@ after printing the report), SIGHUP reloads the config (a bad config keeps the ol
 static int run(int argc, char** argv) {
   using namespace resolver;
   CLI::App app{kDescription, "resolverd"};
+  app.set_version_flag("--version", resolver::version_line("resolverd"));
   std::string config_path, replay_path, can_iface, report_path;
   std::optional<std::string> lcm_url;
   bool once = false, fast = false, quiet = false;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "tools/accuracy/accuracy_experiments.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -114,6 +115,7 @@ int main(int argc, char** argv) {
   CLI::App app{"resolver-accuracy: estimator bias and spread against the Cramer-Rao bound, convergence and 2x dq "
                "ripple reduction on simulated data with known truth; prints a markdown report."};
   app.footer(kExamples);
+  app.set_version_flag("--version", resolver::version_line("resolver-accuracy"));
   int seeds = 50;
   bool quick = false;
   app.add_option("--seeds", seeds, "number of simulated logs per configuration (default 50)")->check(CLI::Range(2, 100000));

@@ -17,6 +17,7 @@
 #include "tools/echo/lcm_type_registry.h"
 #include "tools/echo/live_echo.h"
 #include "tools/echo/json_writer.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -69,6 +70,7 @@ void print_line(const std::string& line) {
 int main(int argc, char** argv) {
   CLI::App app{kDescription, "resolver-echo"};
   app.footer(kFooter);
+  app.set_version_flag("--version", resolver::version_line("resolver-echo"));
   app.get_formatter()->column_width(28);
 
   std::string log_path;

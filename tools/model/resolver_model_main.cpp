@@ -29,6 +29,7 @@
 #include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -114,6 +115,7 @@ int run(int argc, char** argv) {
                "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json\n"
                "  resolver-model report build/demo/demo.log --html demo.html"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
   std::vector<std::string> effects_args;
   std::string config_path;

@@ -17,6 +17,7 @@
 #include "drivers/candump/candump_writer.h"
 #include "tools/sim/bench_simulator.h"
 #include "tools/sim/sim_truth.h"
+#include "daemon/service/program_version.h"
 
 namespace {
 
@@ -172,6 +173,7 @@ int main(int argc, char** argv) {
       "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
       "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects."};
   app.footer(std::string(kExamples) + "\n" + resolver::format_effect_catalog());
+  app.set_version_flag("--version", resolver::version_line("resolver-sim"));
   Options o;
   app.add_option("--out,-o", o.out, "candump -l log file to write (required)");
   app.add_option("--rpm", o.rpm, "constant mechanical speed [r/min] (default 200)");

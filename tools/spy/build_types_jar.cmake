@@ -4,17 +4,9 @@
 # Inputs (-D): LCM_GEN, JAVAC, JAR, LCM_JAR, LCM_DIR, WORK_DIR, OUTPUT.
 # WORK_DIR is wiped first so a struct removed from the .lcm files cannot
 # survive as a stale class in the jar.
-foreach(var LCM_GEN JAVAC JAR LCM_JAR LCM_DIR WORK_DIR OUTPUT)
-  if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
-    message(FATAL_ERROR "build_types_jar.cmake: -D${var}=... is required")
-  endif()
-endforeach()
-
-file(GLOB lcm_files ${LCM_DIR}/*.lcm)
-if(NOT lcm_files)
-  message(FATAL_ERROR "build_types_jar.cmake: no .lcm files in ${LCM_DIR}")
-endif()
-list(SORT lcm_files)
+include(${CMAKE_CURRENT_LIST_DIR}/../../cmake/ScriptHelpers.cmake)
+resolver_require_defines(build_types_jar.cmake LCM_GEN JAVAC JAR LCM_JAR LCM_DIR WORK_DIR OUTPUT)
+resolver_lcm_files(lcm_files ${LCM_DIR} build_types_jar.cmake)
 
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR}/java ${WORK_DIR}/classes)

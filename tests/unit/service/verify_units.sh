@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Checks the unit and networkd files in systemd/:
+# Checks the unit and networkd files in SYSTEMD_DIR (build/systemd: systemd/ as
+# configured for the install prefix):
 #   1. systemd-analyze verify accepts both units with no warning at all (the
 #      ExecStart binary is replaced by an existing dummy so "not executable" is
 #      not a false alarm, and everything else still counts);
@@ -32,7 +33,9 @@ printf '#!/bin/sh\nexit 0\n' >"$dummy"
 chmod +x "$dummy"
 for unit in resolverd.service resolverd@.service; do
   [ -f "$src_dir/$unit" ] || { bad "$src_dir/$unit is missing"; continue; }
-  sed "s#/usr/local/bin/resolverd#$dummy#g" "$src_dir/$unit" >"$work/units/$unit"
+  if grep -nE '@[A-Za-z_]+@' "$src_dir/$unit"; then bad "$unit: a template variable was not configured"; fi
+  grep -q '^ExecStart=/[^ ]*/resolverd ' "$src_dir/$unit" || bad "$unit: ExecStart= does not start an absolute .../resolverd"
+  sed "s#^ExecStart=/[^ ]*/resolverd #ExecStart=$dummy #" "$src_dir/$unit" >"$work/units/$unit"
 done
 [ "$fail" = 0 ] || exit 1
 
