@@ -1,6 +1,7 @@
 #include "daemon/app/log_input.h"
 
 #include <cmath>
+#include <utility>
 
 #include "daemon/decode/row_decoder.h"
 #include "drivers/asc/asc_reader.h"
@@ -11,59 +12,59 @@ namespace resolver {
 
 namespace {
 
-class CandumpInput final : public LogInput {
+/// The position accessors every reader has, forwarded.
+template <typename Reader>
+class ReaderInput : public LogInput {
  public:
-  explicit CandumpInput(const std::string& path) : LogInput(LogFormat::kCandump), reader_(path) {}
-  Status next(LogRecord& record) override {
-    record.is_row = false;
-    switch (reader_.next(record.frame)) {
-      case CandumpReader::Status::kEnd: return Status::kEnd;
-      case CandumpReader::Status::kBadLine: {
-        const LogLineProblem& p = reader_.problem();
-        problem_ = TextProblem{std::string(to_string(p.kind)), p.column, p.message};
-        return Status::kBadLine;
-      }
-      case CandumpReader::Status::kFrame: break;
-    }
-    record.timestamp_us = record.frame.timestamp_us;
-    return Status::kRecord;
-  }
-  [[nodiscard]] const TextProblem& problem() const override { return problem_; }
   [[nodiscard]] std::uint64_t line_number() const override { return reader_.line_number(); }
   [[nodiscard]] std::uint64_t bytes_read() const override { return reader_.bytes_read(); }
   [[nodiscard]] std::uint64_t total_bytes() const override { return reader_.total_bytes(); }
+  [[nodiscard]] const TextProblem& problem() const override { return problem_; }
 
- private:
-  CandumpReader reader_;
+ protected:
+  template <typename... Args>
+  explicit ReaderInput(LogFormat format, Args&&... args) : LogInput(format), reader_(std::forward<Args>(args)...) {}
+  Reader reader_;
   TextProblem problem_;
 };
 
-class AscInput final : public LogInput {
+class CandumpInput final : public ReaderInput<CandumpReader> {
  public:
-  explicit AscInput(const std::string& path) : LogInput(LogFormat::kAsc), reader_(path) {}
+  explicit CandumpInput(const std::string& path) : ReaderInput(LogFormat::kCandump, path) {}
   Status next(LogRecord& record) override {
     record.is_row = false;
-    switch (reader_.next(record.frame)) {
-      case AscReader::Status::kEnd: return Status::kEnd;
-      case AscReader::Status::kBadLine: return Status::kBadLine;
-      case AscReader::Status::kFrame: break;
+    const CandumpReader::Status st = reader_.next(record.frame);
+    if (st == CandumpReader::Status::kEnd) return Status::kEnd;
+    if (st == CandumpReader::Status::kBadLine) {
+      const LogLineProblem& p = reader_.problem();
+      problem_ = TextProblem{std::string(to_string(p.kind)), p.column, p.message};
+      return Status::kBadLine;
     }
     record.timestamp_us = record.frame.timestamp_us;
     return Status::kRecord;
   }
-  [[nodiscard]] const TextProblem& problem() const override { return reader_.problem(); }
-  [[nodiscard]] std::uint64_t line_number() const override { return reader_.line_number(); }
-  [[nodiscard]] std::uint64_t bytes_read() const override { return reader_.bytes_read(); }
-  [[nodiscard]] std::uint64_t total_bytes() const override { return reader_.total_bytes(); }
-
- private:
-  AscReader reader_;
 };
 
-class CsvInput final : public LogInput {
+class AscInput final : public ReaderInput<AscReader> {
+ public:
+  explicit AscInput(const std::string& path) : ReaderInput(LogFormat::kAsc, path) {}
+  Status next(LogRecord& record) override {
+    record.is_row = false;
+    const AscReader::Status st = reader_.next(record.frame);
+    if (st == AscReader::Status::kEnd) return Status::kEnd;
+    if (st == AscReader::Status::kBadLine) {
+      problem_ = reader_.problem();
+      return Status::kBadLine;
+    }
+    record.timestamp_us = record.frame.timestamp_us;
+    return Status::kRecord;
+  }
+};
+
+class CsvInput final : public ReaderInput<CsvReader> {
  public:
   CsvInput(const std::string& path, const CsvInputConfig& config)
-      : LogInput(LogFormat::kCsv), reader_(path, config.format), decoder_(config.map), decimal_(config.format.decimal),
+      : ReaderInput(LogFormat::kCsv, path, config.format), decoder_(config.map), decimal_(config.format.decimal),
         row_rate_hz_(config.map.row_rate_hz) {
     // Read up to the first row so the column names are known and bound now:
     // a column the export lacks is a config error before anything runs.
@@ -96,19 +97,13 @@ class CsvInput final : public LogInput {
                             : std::llround(static_cast<double>(record.row.sequence) * 1e6 / row_rate_hz_);
     return Status::kRecord;
   }
-  [[nodiscard]] const TextProblem& problem() const override { return problem_; }
-  [[nodiscard]] std::uint64_t line_number() const override { return reader_.line_number(); }
-  [[nodiscard]] std::uint64_t bytes_read() const override { return reader_.bytes_read(); }
-  [[nodiscard]] std::uint64_t total_bytes() const override { return reader_.total_bytes(); }
 
  private:
-  CsvReader reader_;
   RowDecoder decoder_;
   char decimal_;
   double row_rate_hz_;
   CsvRow row_;
   std::optional<CsvReader::Status> first_;
-  TextProblem problem_;
 };
 
 }  // namespace

@@ -1,32 +1,18 @@
 #include "daemon/decode/signal_units.h"
 
 #include <array>
-#include <cctype>
 #include <cstdio>
 
 #include "daemon/core/angles.h"
+#include "drivers/text/text_util.h"
 
 namespace resolver {
 
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
-bool equals_ignoring_case(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
-  }
-  return true;
-}
-
 bool any_of(std::string_view unit, std::initializer_list<std::string_view> names) {
   for (const std::string_view n : names) {
-    if (equals_ignoring_case(unit, n)) return true;
+    if (text::iequals(unit, n)) return true;
   }
   return false;
 }
@@ -34,7 +20,7 @@ bool any_of(std::string_view unit, std::initializer_list<std::string_view> names
 }  // namespace
 
 std::optional<double> angle_unit_to_rad(std::string_view unit) {
-  unit = trim(unit);
+  unit = text::trim(unit);
   if (any_of(unit, {"rad", "radian", "radians"})) return 1.0;
   // "\xB0": the degree sign in Latin-1 / Windows-1252, the usual DBC encoding.
   if (any_of(unit, {"deg", "degree", "degrees", "\xC2\xB0", "\xB0"})) return kPi / 180.0;
@@ -43,7 +29,7 @@ std::optional<double> angle_unit_to_rad(std::string_view unit) {
 }
 
 std::optional<double> current_unit_to_amps(std::string_view unit) {
-  unit = trim(unit);
+  unit = text::trim(unit);
   if (unit == "A") return 1.0;
   if (unit == "mA") return 1e-3;
   return std::nullopt;

@@ -1,7 +1,8 @@
 #include "drivers/asc/asc_line.h"
 
+#include "drivers/text/text_util.h"
+
 #include <array>
-#include <cctype>
 #include <limits>
 #include <string>
 
@@ -36,17 +37,9 @@ Tokens tokenize(std::string_view line) {
   return t;
 }
 
-bool iequals(std::string_view a, std::string_view b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
-  }
-  return true;
-}
-bool istarts_with(std::string_view s, std::string_view prefix) {
-  return s.size() >= prefix.size() && iequals(s.substr(0, prefix.size()), prefix);
-}
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
+using text::iequals;
+using text::is_digit;
+using text::istarts_with;
 
 int digit_value(char c) {
   if (is_digit(c)) return c - '0';
@@ -265,7 +258,7 @@ AscLineParser::Result AscLineParser::parse(std::string_view line, CanFrame& fram
     // Relative timestamps count from the previous event (every event, frame or not).
     last_event_us_ = relative_ ? last_event_us_ + *time_us : *time_us;
     frame = CanFrame{};
-    const Result r = parse_event(t, line, base_, frame);
+    Result r = parse_event(t, line, base_, frame);
     frame.timestamp_us = start_us_.value_or(0) + last_event_us_;
     return r;
   }

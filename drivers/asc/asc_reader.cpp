@@ -1,7 +1,5 @@
 #include "drivers/asc/asc_reader.h"
 
-#include <fmt/format.h>
-
 namespace resolver {
 
 AscReader::Status AscReader::next(CanFrame& frame) {
@@ -10,10 +8,7 @@ AscReader::Status AscReader::next(CanFrame& frame) {
     const LineReader::Result got = lines_.next(line);
     if (got == LineReader::Result::kEnd) return Status::kEnd;
     if (got == LineReader::Result::kTooLong) {
-      problem_ = TextProblem{"line_too_long", kMaxLineLength + 1,
-                             fmt::format("line is {} bytes long; at most {} are accepted - is this a Vector ASC log? "
-                                         "The line was skipped",
-                                         lines_.skipped_length(), kMaxLineLength)};
+      problem_ = lines_.too_long_problem("a Vector ASC log");
       return Status::kBadLine;
     }
     const AscLineParser::Result r = parser_.parse(line, frame);

@@ -1,6 +1,6 @@
 #include "drivers/candump/candump_reader.h"
 
-#include <fmt/format.h>
+#include <utility>
 
 namespace resolver {
 
@@ -10,12 +10,8 @@ CandumpReader::Status CandumpReader::next(CanFrame& frame) {
     const LineReader::Result got = lines_.next(line);
     if (got == LineReader::Result::kEnd) return Status::kEnd;
     if (got == LineReader::Result::kTooLong) {
-      problem_ = LogLineProblem{
-          LogLineError::kLineTooLong, kMaxCandumpLineLength + 1,
-          // No "path:line:" prefix: callers add it, as for every other problem.
-          fmt::format("line is {} bytes long; at most {} are accepted - is this a candump -l log? "
-                      "The line was skipped",
-                      lines_.skipped_length(), kMaxCandumpLineLength)};
+      TextProblem p = lines_.too_long_problem("a candump -l log");
+      problem_ = LogLineProblem{LogLineError::kLineTooLong, p.column, std::move(p.message)};
       return Status::kBadLine;
     }
     if (is_blank_line(line)) continue;

@@ -1,5 +1,7 @@
 #include "drivers/csv/csv_number.h"
 
+#include "drivers/text/text_util.h"
+
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -9,13 +11,8 @@ namespace resolver {
 
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
-bool is_digit(char c) { return c >= '0' && c <= '9'; }
+using text::is_digit;
+using text::trim;
 
 /// A number split into its parts: sign, up to 19 significant digits, and a
 /// power of ten; nullopt when the text is not a plain decimal number.

@@ -1,7 +1,5 @@
 #include "drivers/csv/csv_reader.h"
 
-#include <fmt/format.h>
-
 #include "drivers/csv/csv_number.h"
 
 namespace resolver {
@@ -130,9 +128,7 @@ CsvReader::Status CsvReader::next(CsvRow& row) {
     const LineReader::Result got = lines_.next(line);
     if (got == LineReader::Result::kEnd) return Status::kEnd;
     if (got == LineReader::Result::kTooLong) {
-      problem_ = TextProblem{"line_too_long", kMaxLineLength + 1,
-                             fmt::format("line is {} bytes long; at most {} are accepted. The line was skipped",
-                                         lines_.skipped_length(), kMaxLineLength)};
+      problem_ = lines_.too_long_problem("a CSV export");
       return Status::kBadLine;
     }
     if (lines_.line_number() == 1 && line.starts_with(kUtf8Bom)) line.remove_prefix(kUtf8Bom.size());

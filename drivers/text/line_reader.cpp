@@ -18,6 +18,13 @@ bool is_blank_line(std::string_view line) {
   return std::all_of(line.begin(), line.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; });
 }
 
+TextProblem LineReader::too_long_problem(std::string_view expected) const {
+  // No "path:line:" prefix: callers add it, as for every other problem.
+  return TextProblem{"line_too_long", max_line_ + 1,
+                     fmt::format("line is {} bytes long; at most {} are accepted - is this {}? The line was skipped",
+                                 skipped_len_, max_line_, expected)};
+}
+
 LineReader::LineReader(const std::string& path, std::size_t max_line_length, std::size_t buffer_bytes)
     : path_(path),
       max_line_(max_line_length),

@@ -15,6 +15,8 @@
 #include <string>
 #include <string_view>
 
+#include "drivers/text/text_problem.h"
+
 namespace resolver {
 
 class LineReader {
@@ -47,6 +49,9 @@ class LineReader {
   [[nodiscard]] std::uint64_t line_number() const { return line_number_; }
   /// [bytes] length of the line kTooLong skipped.
   [[nodiscard]] std::uint64_t skipped_length() const { return skipped_len_; }
+  /// The problem to report for the line kTooLong skipped ("line_too_long",
+  /// column one past the limit); `expected` names the format, e.g. "a Vector ASC log".
+  [[nodiscard]] TextProblem too_long_problem(std::string_view expected) const;
   /// [bytes] consumed through the end of the line last returned.
   [[nodiscard]] std::uint64_t bytes_read() const { return bytes_consumed_; }
   /// [bytes] file size, 0 if unknown (pipe, FIFO).

@@ -6,40 +6,18 @@
 // Properties: never throws on bad content, every bad row names a reason and
 // a column inside the line, every good row becomes one sample, sample time
 // never goes back, unwrapped-and-divided angles stay in [0, 2pi).
-#include <sys/mman.h>
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
-#include <memory>
-#include <stdexcept>
 #include <string>
-#include <variant>
 
 #include "daemon/core/angles.h"
-#include "daemon/dbc/dbc_parser.h"
 #include "daemon/decode/row_decoder.h"
 #include "daemon/decode/sample_stream.h"
 #include "drivers/csv/csv_reader.h"
+#include "tests/fuzz/fuzz_bench_decoder.h"
 #include "tests/fuzz/fuzz_support.h"
 
-#ifndef RESOLVER_BENCH_DBC
-#error "RESOLVER_BENCH_DBC must name proto/resolver_bench.dbc"
-#endif
-
 namespace {
-
-std::shared_ptr<const resolver::FrameDecoder> bench_decoder() {
-  static const std::shared_ptr<const resolver::FrameDecoder> decoder = [] {
-    auto loaded = resolver::dbc::load_dbc_file(RESOLVER_BENCH_DBC);
-    if (const auto* error = std::get_if<resolver::dbc::DbcError>(&loaded)) {
-      throw std::runtime_error("fuzz_csv_reader: cannot load the bench DBC: " + error->what());
-    }
-    auto db = std::make_shared<const resolver::dbc::Database>(std::get<resolver::dbc::Database>(std::move(loaded)));
-    return std::make_shared<const resolver::FrameDecoder>(db, resolver::SignalMap::bench_default());
-  }();
-  return decoder;
-}
 
 /// Layout from the selector byte: bits 0-2 separator, bit 3 decimal comma,
 /// bit 4 skip until numbers (else 1 header line), bit 5 column names,
@@ -79,60 +57,48 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   resolver::CsvFormat format;
   resolver::RowMap map;
   choose(data[0], format, map);
-  const int fd = ::memfd_create("fuzz_csv", MFD_CLOEXEC);
-  if (fd < 0) return 0;
-  std::size_t written = 1;
-  while (written < size) {
-    const ssize_t n = ::write(fd, data + written, size - written);
-    if (n <= 0) break;
-    written += static_cast<std::size_t>(n);
-  }
-  if (written == size) {
-    resolver::SampleStreamConfig sc;
-    sc.row_rate_hz = map.row_rate_hz;
-    std::int64_t samples = 0;
-    double last_t = -1.0;
-    resolver::SampleStream stream(
-        bench_decoder(), sc,
-        resolver::SampleStream::Callbacks{[&](const resolver::Sample& s, std::uint8_t) {
-                                            FUZZ_CHECK(s.t >= last_t, "sample time went back");
-                                            FUZZ_CHECK(!s.has_ref || (s.theta_m_ref >= 0.0 && s.theta_m_ref < resolver::kTwoPi),
-                                                       "reference angle outside [0, 2pi)");
-                                            last_t = s.t;
-                                            ++samples;
-                                          },
-                                          nullptr, nullptr});
-    resolver::CsvReader reader("/proc/self/fd/" + std::to_string(fd), format,
-                               resolver::LineReader::min_buffer_bytes(resolver::CsvReader::kMaxLineLength));
-    resolver::RowDecoder decoder(map);
-    bool bound = false;
-    bool bind_failed = false;
-    resolver::CsvRow row;
-    resolver::RowSample sample;
-    std::int64_t good = 0;
-    std::size_t calls = 0;
-    for (;;) {
-      FUZZ_CHECK(calls++ <= size + 2, "reader does not reach the end of its input");
-      const auto status = reader.next(row);
-      if (status == resolver::CsvReader::Status::kEnd) break;
-      if (!bound) {
-        bound = true;
-        bind_failed = decoder.bind(reader.column_names()).has_value();  // a config error in resolverd
-      }
-      if (bind_failed) break;
-      if (status == resolver::CsvReader::Status::kBadLine) continue;
-      FUZZ_CHECK(row.fields.size() == row.columns.size(), "fields and columns differ in number");
-      if (const auto problem = decoder.decode(row, format.decimal, sample)) {
-        FUZZ_CHECK(!problem->reason.empty() && !problem->message.empty(), "bad row without a reason or message");
-        FUZZ_CHECK(problem->column >= 1 && problem->column <= row.end_column, "column outside the row");
-        continue;
-      }
-      stream.feed_row(sample, reader.line_number());
-      ++good;
+  const resolver::fuzz::MemFile file(data + 1, size - 1);
+  if (file.path().empty()) return 0;  // no memfd: nothing to test
+  resolver::SampleStreamConfig sc;
+  sc.row_rate_hz = map.row_rate_hz;
+  std::int64_t samples = 0;
+  double last_t = -1.0;
+  resolver::SampleStream stream(
+      resolver::fuzz::bench_decoder(), sc,
+      resolver::SampleStream::Callbacks{[&](const resolver::Sample& s, std::uint8_t) {
+                                          FUZZ_CHECK(s.t >= last_t, "sample time went back");
+                                          FUZZ_CHECK(!s.has_ref || (s.theta_m_ref >= 0.0 && s.theta_m_ref < resolver::kTwoPi),
+                                                     "reference angle outside [0, 2pi)");
+                                          last_t = s.t;
+                                          ++samples;
+                                        },
+                                        nullptr, nullptr});
+  resolver::CsvReader reader(file.path(), format, resolver::LineReader::min_buffer_bytes(resolver::CsvReader::kMaxLineLength));
+  resolver::RowDecoder decoder(map);
+  bool bound = false;
+  resolver::CsvRow row;
+  resolver::RowSample sample;
+  std::int64_t good = 0;
+  std::size_t calls = 0;
+  for (;;) {
+    FUZZ_CHECK(calls++ <= size + 2, "reader does not reach the end of its input");
+    const auto status = reader.next(row);
+    if (status == resolver::CsvReader::Status::kEnd) break;
+    if (!bound) {
+      bound = true;
+      if (decoder.bind(reader.column_names())) break;  // a config error in resolverd: nothing more to read
     }
-    stream.flush();
-    FUZZ_CHECK(samples == good, "a good row did not become exactly one sample");
+    if (status == resolver::CsvReader::Status::kBadLine) continue;
+    FUZZ_CHECK(row.fields.size() == row.columns.size(), "fields and columns differ in number");
+    if (const auto problem = decoder.decode(row, format.decimal, sample)) {
+      FUZZ_CHECK(!problem->reason.empty() && !problem->message.empty(), "bad row without a reason or message");
+      FUZZ_CHECK(problem->column >= 1 && problem->column <= row.end_column, "column outside the row");
+      continue;
+    }
+    stream.feed_row(sample, reader.line_number());
+    ++good;
   }
-  ::close(fd);
+  stream.flush();
+  FUZZ_CHECK(samples == good, "a good row did not become exactly one sample");
   return 0;
 }

@@ -57,32 +57,51 @@ std::string write_odd_time_log(std::uint64_t& samples) {
   return path;
 }
 
-TEST(OneSampleOneClock, ResolverModelReadsWhatTheProcessorGets) {
-  std::uint64_t simulated = 0;
-  const std::string path = write_odd_time_log(simulated);
+/// What resolverd --replay LOG [--from --to] feeds its processor, and what it counted.
+struct Replayed {
+  std::vector<Sample> samples;
+  RejectCounters rejects;
+  std::string diagnostics;
+};
 
+Replayed replay(const std::string& path, const DaemonConfig& config, const SampleSlice& slice = {}) {
   NullSink sink;
   std::ostringstream diag;
-  DaemonConfig config;
-  config.model.enabled = false;  // only the input side is under test
-  Pipeline pipeline(config, sink, diag);
-  std::vector<Sample> live;
-  pipeline.set_sample_observer([&](const Sample& s) { live.push_back(s); });
+  Pipeline pipeline(config, sink, diag, false, slice);
+  Replayed out;
+  pipeline.set_sample_observer([&](const Sample& s) { out.samples.push_back(s); });
   StopFlags flags;
   ReplayOptions ro;
   ro.path = path;
   ro.fast = true;
   ro.progress = false;
   run_replay(ro, pipeline, flags, diag);
+  out.rejects = pipeline.intake().rejects();
+  out.diagnostics = diag.str();
+  return out;
+}
 
+DaemonConfig input_only() {
+  DaemonConfig config;
+  config.model.enabled = false;  // only the input side is under test
+  return config;
+}
+
+TEST(OneSampleOneClock, ResolverModelReadsWhatTheProcessorGets) {
+  std::uint64_t simulated = 0;
+  const std::string path = write_odd_time_log(simulated);
+  const DaemonConfig config = input_only();
+  const Replayed replayed = replay(path, config);
+  const std::vector<Sample>& live = replayed.samples;
+  const std::string& diag = replayed.diagnostics;
   const LogSamples offline = read_log_samples(path, nullptr, config);
   std::remove(path.c_str());
 
   // Every sample decoded: the step back and the jump are counted, nothing is lost.
-  ASSERT_EQ(live.size(), simulated) << diag.str();
-  EXPECT_EQ(pipeline.intake().rejects().get("timestamp_step_back"), 1) << diag.str();
-  EXPECT_EQ(pipeline.intake().rejects().get("timestamp_jump"), 1) << diag.str();
-  EXPECT_EQ(pipeline.intake().rejects().total(), 2) << diag.str();
+  ASSERT_EQ(live.size(), simulated) << diag;
+  EXPECT_EQ(replayed.rejects.get("timestamp_step_back"), 1) << diag;
+  EXPECT_EQ(replayed.rejects.get("timestamp_jump"), 1) << diag;
+  EXPECT_EQ(replayed.rejects.total(), 2) << diag;
   // Counter time straight through both: t = index / 2 kHz, exactly (an integer over a power-of-ten rate).
   for (const Sample& s : live) ASSERT_DOUBLE_EQ(s.t, static_cast<double>(s.index - live.front().index) / 2000.0) << s.index;
 
@@ -111,22 +130,11 @@ TEST(OneSampleOneClock, ResolverModelReadsWhatTheProcessorGets) {
 TEST(OneSampleOneClock, SliceIsTheSameForBoth) {
   std::uint64_t simulated = 0;
   const std::string path = write_odd_time_log(simulated);
-  NullSink sink;
-  std::ostringstream diag;
-  DaemonConfig config;
-  config.model.enabled = false;
+  const DaemonConfig config = input_only();
   SampleSlice slice;
   slice.from_s = 0.25;
   slice.to_s = 1.5;
-  Pipeline pipeline(config, sink, diag, false, slice);
-  std::vector<Sample> live;
-  pipeline.set_sample_observer([&](const Sample& s) { live.push_back(s); });
-  StopFlags flags;
-  ReplayOptions ro;
-  ro.path = path;
-  ro.fast = true;
-  ro.progress = false;
-  run_replay(ro, pipeline, flags, diag);
+  const std::vector<Sample> live = replay(path, config, slice).samples;
   LogReadOptions lo;
   lo.slice = slice;
   const LogSamples offline = read_log_samples(path, nullptr, config, lo);
