@@ -89,10 +89,15 @@ void Pipeline::count_problem(std::string_view reason, const std::string& message
 }
 
 void Pipeline::advance_health_clock(std::int64_t now_us) {
+  // The input's own clock stepping back (a log appended, a clock set) starts
+  // the window again, so health keeps coming every second of input time; a
+  // jump publishes once. Compared with the previous frame, not with the
+  // window start: live, tick() starts windows on the wall clock, and frames
+  // that waited in the socket are older than that without any step.
+  const bool stepped_back = have_frame_time_ && now_us < last_frame_us_;
+  have_frame_time_ = true;
   last_frame_us_ = now_us;
-  // A stamp that steps back starts the window again (health keeps coming
-  // every second of input time); one that jumps publishes once.
-  if (health_window_start_us_ < 0 || now_us < health_window_start_us_) health_window_start_us_ = now_us;
+  if (health_window_start_us_ < 0 || stepped_back) health_window_start_us_ = now_us;
   if (now_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(now_us);
 }
 

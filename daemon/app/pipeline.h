@@ -125,7 +125,8 @@ class Pipeline {
   std::int64_t samples_ = 0;
   CompletingFrames completing_frames_;
   std::vector<std::uint32_t> wake_ids_;
-  std::int64_t last_frame_us_ = 0;
+  std::int64_t last_frame_us_ = 0;  ///< [us] stamp of the last frame or row
+  bool have_frame_time_ = false;
   std::int64_t health_window_start_us_ = -1;
   std::int64_t frames_at_window_start_ = 0;
   std::int64_t last_sample_index_ = 0;
