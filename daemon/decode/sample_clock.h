@@ -89,6 +89,8 @@ class SampleClock {
   /// [s] nominal period, else the learned one; 0 while unknown.
   [[nodiscard]] double period_s() const;
   [[nodiscard]] double sample_rate_hz() const { return config_.sample_rate_hz; }
+  /// [s] time of the last sample read (0 before the first).
+  [[nodiscard]] double last_t() const { return last_t_; }
   /// True when t comes from the counter (a counter and a rate exist).
   [[nodiscard]] bool uses_counter_time() const { return last_counter_time_; }
 

@@ -282,6 +282,8 @@ class ScopeCsv(unittest.TestCase):
         # health) to keep the clock; reading stops at the first row after it.
         self.assertEqual([a["sample_index"] for a in angles], list(range(2000, 5001)))
         self.assertEqual(report["samples_complete"], 5002)
+        self.assertEqual(report["samples_used"], 3001)
+        self.assertEqual(report["samples_outside_slice"], 2001)
         model = fit(self.csv, "--config", self.config, "--from", "1", "--to", "2.5")
         self.assertEqual(signal_rows(model, "position_error"), 3001)
 

@@ -1,5 +1,6 @@
 #include "tools/model/log_samples.h"
 
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -59,9 +60,10 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
   if (progress) progress(1.0);
   if (out.input.samples.empty()) {
     if (options.slice.limited() && out.outside_slice > 0) {
-      throw std::runtime_error(fmt::format("{}: no samples between --from {} s and --to {} s ({} samples outside; the "
-                                           "log starts at 0 s)",
-                                           path, options.slice.from_s, options.slice.to_s, out.outside_slice));
+      const std::string to = std::isfinite(options.slice.to_s) ? fmt::format(" to --to {} s", options.slice.to_s) : "";
+      throw std::runtime_error(fmt::format("{}: no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
+                                           path, options.slice.from_s, to, out.outside_slice,
+                                           stream.clock().last_t()));
     }
     const std::string layout = format == LogFormat::kCsv ? "the [input.csv] column map of " + config.source
                                                          : describe_layout(config, *decoder);
