@@ -8,6 +8,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   liblcm-dev liblcm-bin
   libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
+  libmuparser-dev  # [[model.custom]] effects: expressions users write (daemon/core/model/custom_effect.h)
   can-utils python3 python3-can
   python3-numpy  # tests/independent (benchgen)
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev

@@ -107,18 +107,56 @@ void read_wake_ids(const toml::table& t, bool& wake_auto, std::vector<std::uint3
   }
 }
 
+std::vector<CustomEffectSpec> read_custom_blocks(const toml::node& node, const std::string& s) {
+  const toml::array* blocks = node.as_array();
+  if (blocks == nullptr) {
+    throw ConfigError(where(s, node) + ": [[model.custom]] must be an array of tables (write [[model.custom]] blocks)");
+  }
+  std::vector<CustomEffectSpec> out;
+  int index = 0;
+  for (const auto& b : *blocks) {
+    ++index;
+    const toml::table* t = b.as_table();
+    if (t == nullptr) throw ConfigError(where(s, b) + ": [[model.custom]] entry " + std::to_string(index) + " must be a table");
+    check_keys(*t, "model.custom", {"name", "signal", "terms", "description"}, s);
+    CustomEffectSpec spec;
+    spec.origin = where(s, b) + " [[model.custom]] #" + std::to_string(index);
+    read(*t, "name", spec.name, s, "model.custom");
+    read(*t, "signal", spec.signal, s, "model.custom");
+    read(*t, "description", spec.description, s, "model.custom");
+    const toml::node* terms = t->get("terms");
+    if (terms == nullptr || terms->as_array() == nullptr) {
+      throw ConfigError(spec.origin + ": terms must be an array of expressions, e.g. terms = [\"sin(4*theta_m)\"]");
+    }
+    for (const auto& term : *terms->as_array()) {
+      const auto text = term.value<std::string>();
+      if (!text) throw ConfigError(where(s, term) + ": [[model.custom]] terms: each entry must be a string");
+      spec.terms.push_back(*text);
+    }
+    if (spec.name.empty()) throw ConfigError(spec.origin + ": name = \"...\" is required");
+    out.push_back(std::move(spec));
+  }
+  return out;
+}
+
 void read_model_section(const toml::table& t, ModelFitOptions& m, const std::string& s) {
-  check_keys(t, "model", {"enabled", "effects", "window_revolutions", "candidates"}, s);
+  check_keys(t, "model", {"enabled", "effects", "window_revolutions", "candidates", "custom"}, s);
   read(t, "enabled", m.enabled, s, "model");
   read(t, "candidates", m.candidates, s, "model");
   read(t, "window_revolutions", m.window_revolutions, s, "model");
   if (!(m.window_revolutions >= 2.0) || !std::isfinite(m.window_revolutions)) {
     throw ConfigError(s + ": [model] window_revolutions must be a number >= 2 (the fit needs two revolutions)");
   }
+  if (const toml::node* c = t.get("custom")) {
+    m.custom = read_custom_blocks(*c, s);
+    try {
+      m.customs = std::make_shared<const CustomEffects>(m.custom);
+    } catch (const std::invalid_argument& e) {
+      throw ConfigError(e.what());
+    }
+  }
   const toml::node* e = t.get("effects");
   if (e == nullptr) return;
-  std::string fittable;
-  for (auto name : fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(name);
   const toml::array* arr = e->as_array();
   if (arr == nullptr) {
     throw ConfigError(where(s, *e) + ": [model] effects must be an array of effect names, e.g. [\"amplitude_imbalance\"]");
@@ -127,10 +165,10 @@ void read_model_section(const toml::table& t, ModelFitOptions& m, const std::str
   for (const auto& item : *arr) {
     const auto name = item.value<std::string>();
     if (!name) throw ConfigError(where(s, item) + ": [model] effects: each entry must be a string");
-    const auto list = fittable_effects();
-    if (std::find(list.begin(), list.end(), *name) == list.end()) {
-      throw ConfigError(where(s, item) + ": [model] effects: '" + *name + "' is not a fittable catalog effect; one of: " +
-                        fittable);
+    try {
+      (void)ModelSpec::parse(std::vector<std::string>{*name}, m.customs.get());
+    } catch (const std::invalid_argument& err) {
+      throw ConfigError(where(s, item) + ": [model] effects: " + err.what());
     }
     m.effects.push_back(*name);
   }

@@ -33,7 +33,8 @@
 //   [layout.signals]           # role = "MESSAGE.signal"
 //   sin = "RESOLVER_SAMPLE.sin"
 //   [estimator]
-//   method = "hwang_integral"  # or "sincos_least_squares", "fourier_reference"
+//   method = "model"           # the [model] fitted live (default); or the seed "hwang_integral",
+//                              # "sincos_least_squares", "fourier_reference"
 //   min_revolutions = 3        # hwang_integral
 //   max_speed_change = 0.02    # hwang_integral
 //   forgetting = 1.0           # sincos_least_squares / fourier_reference: 1 = all data
@@ -59,8 +60,14 @@
 //   row_rate_hz = 0            # only without a time column
 //   [input.csv.columns]        # role = { column = name|index, unit, scale = 1, offset = 0,
 //   rd_angle = { column = "Resolver", unit = "deg" }   #  full_scale (unit "counts"), divide (angles) }
+//   [[model.custom]]           # effects users add without recompiling (custom_effect.h)
+//   name = "slow_drift"
+//   signal = "position_error"  # position_error | rd_angle | sin | cos | i_d | i_q
+//   terms = ["t", "t*sin(2*theta)"]
+//   description = "alpha warming up"
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -68,6 +75,7 @@
 
 #include "daemon/app/log_format.h"
 #include "daemon/core/estimation/hwang_integral.h"
+#include "daemon/core/model/custom_effect.h"
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/row_decoder.h"
 #include "daemon/decode/signal_map.h"
@@ -115,7 +123,12 @@ struct BenchDefaults {
 /// Live model discovery (DESIGN 7): the active effect list and its window.
 struct ModelFitOptions {
   bool enabled = true;
+  /// The active model: effect references (daemon/core/model/model_spec.h), catalog
+  /// effects or [[model.custom]] names, e.g. ["amplitude_imbalance", "harmonics(k5)"].
   std::vector<std::string> effects{"amplitude_imbalance"};  ///< the seed's model
+  /// [[model.custom]] blocks as written, and compiled (shared: models point into them).
+  std::vector<CustomEffectSpec> custom;
+  std::shared_ptr<const CustomEffects> customs;
   double window_revolutions = 16.0;  ///< resolver electrical revolutions per model_fit_t
   bool candidates = true;            ///< rank the missing catalog effects (explain) or only fit
 };
@@ -138,8 +151,8 @@ struct DaemonConfig {
   std::string dbc_path;  ///< "" = proto/resolver_bench.dbc, compiled into the binary
   SignalMap signal_map = SignalMap::bench_default();
   int max_counter_delta = 8;
-  std::string estimator_method = "hwang_integral";
-  EstimatorMethod method = EstimatorMethod::kHwangIntegral;
+  std::string estimator_method = "model";
+  EstimatorMethod method = EstimatorMethod::kModel;
   HwangIntegralConfig hwang;
   SinCosLsConfig sincos;
   AngleFourierConfig fourier;

@@ -59,7 +59,7 @@ LiveModelFit::~LiveModelFit() {
   if (running_.valid()) running_.wait();
 }
 
-void LiveModelFit::add(const DiscoverySample& sample, int p_r, int p, const Stamp& stamp) {
+void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp) {
   last_stamp_ = stamp;
   if (window_.add(sample, p_r, p)) {
     DiscoveryInput w = window_.take();
@@ -93,16 +93,14 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
     Result r;
     model_fit_t& m = r.message;
     try {
-      if (opt.candidates) {
-        DiscoveryOptions dopt;
-        dopt.rank_when_explained = false;  // see DiscoveryOptions: the costly part, moot while explained
-        const Explanation ex = explain_model(w, opt.effects, dopt);
-        m = make_model_fit_message(&ex, true, opt.effects);
-      } else {
-        Explanation ex;
-        ex.fit = fit_model(w, opt.effects);
-        m = make_model_fit_message(&ex, false, opt.effects);
-      }
+      DiscoveryOptions dopt;
+      dopt.customs = opt.customs.get();
+      dopt.rank_when_explained = false;  // see DiscoveryOptions: the costly part, moot while explained
+      Explanation ex;
+      if (opt.candidates) ex = explain_model(w, opt.effects, dopt);
+      else ex.fit = fit_model(w, opt.effects, dopt);
+      m = make_model_fit_message(&ex, opt.candidates, opt.effects);
+      r.fitted = FittedModel{ex.fit.model, ex.fit.account.fitted, ex.fit.account.revolutions_electrical};
     } catch (const std::exception& e) {
       // Too few revolutions, no R/D angle, no currents for a current-side effect:
       // the window says so in its verdict instead of disappearing.
@@ -130,8 +128,15 @@ void LiveModelFit::publish_ready(bool wait) {
     }
   }
   last_error_ = r.error;
+  if (r.fitted) pending_model_ = std::move(r.fitted);
   sink_.publish(r.message);
   last_ = std::move(r.message);
+}
+
+std::optional<LiveModelFit::FittedModel> LiveModelFit::take_model() {
+  std::optional<FittedModel> out = std::move(pending_model_);
+  pending_model_.reset();
+  return out;
 }
 
 }  // namespace resolver

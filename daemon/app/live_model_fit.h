@@ -15,11 +15,13 @@
 
 #include <cstdint>
 #include <future>
+#include <optional>
 #include <ostream>
 #include <string>
 
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/output_sink.h"
+#include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/discovery/model_window.h"
 
 namespace resolver {
@@ -50,7 +52,7 @@ class LiveModelFit {
 
   /// One joined sample (pole pairs as currently known). May publish the previous
   /// window's model_fit_t.
-  void add(const DiscoverySample& sample, int p_r, int p, const Stamp& stamp);
+  void add(const Sample& sample, int p_r, int p, const Stamp& stamp);
   /// End of input: waits for the running fit and publishes it. The open, partial
   /// window is fitted too when it covers at least two revolutions.
   void finish();
@@ -58,10 +60,20 @@ class LiveModelFit {
   /// The last published message (verdict empty before the first window).
   [[nodiscard]] const model_fit_t& last() const { return last_; }
 
+  /// The model a window fitted since the last call (nullopt: none new). The
+  /// pipeline hands it to the processor, which compensates with it.
+  struct FittedModel {
+    Model model;
+    std::int64_t samples = 0;
+    double revolutions = 0.0;
+  };
+  [[nodiscard]] std::optional<FittedModel> take_model();
+
  private:
   struct Result {
     model_fit_t message;
     std::string error;  ///< why the window could not be fitted ("" = fitted)
+    std::optional<FittedModel> fitted;
   };
   void start(DiscoveryInput window, const Stamp& stamp);
   void publish_ready(bool wait);
@@ -77,6 +89,7 @@ class LiveModelFit {
   model_fit_t last_{};
   std::uint32_t since_poll_ = 0;
   Counters counters_;
+  std::optional<FittedModel> pending_model_;
 };
 
 }  // namespace resolver

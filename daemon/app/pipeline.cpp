@@ -152,7 +152,19 @@ void Pipeline::tick(std::int64_t now_us) {
 
 void Pipeline::finish() {
   stream_.flush();
-  if (model_fit_) model_fit_->finish();
+  if (model_fit_) {
+    model_fit_->finish();
+    if (auto fitted = model_fit_->take_model()) {
+      processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+      // No sample follows to carry it: publish the final estimate now.
+      if (processor_.config().method == EstimatorMethod::kModel) {
+        Sample last;
+        last.utime = last_utime_;
+        last.index = last_sample_index_;
+        publish_estimate(last, last_counter_);
+      }
+    }
+  }
   publish_health(last_frame_us_);
 }
 
@@ -184,6 +196,9 @@ void Pipeline::on_sample(const Sample& sample, std::uint8_t counter) {
   if (model_fit_) {
     const ProcessorConfig& pc = processor_.config();
     model_fit_->add(sample, pc.p_r, pc.p, {sample.utime, sample.index, counter});
+    if (auto fitted = model_fit_->take_model()) {
+      processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+    }
   }
   summary_.add(out, processor_);
   if (!out.has_angle) return;

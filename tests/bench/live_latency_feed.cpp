@@ -25,7 +25,7 @@ SimConfig sim_config(double sample_rate_hz, double rpm, int samples) {
   SimConfig c;
   c.sample_rate_hz = sample_rate_hz;
   c.profile = {{static_cast<double>(samples) / sample_rate_hz, rpm, rpm}};
-  c.chain.amplitude_imbalance.alpha = 0.003;
+  c.chain.set("amplitude_imbalance", "alpha", 0.003);
   return c;
 }
 

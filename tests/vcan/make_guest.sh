@@ -151,7 +151,13 @@ copy_libs() {
   done
 }
 for p in "${host_progs[@]}"; do cp -L "$p" "$root$p"; copy_libs "$p"; done
-for b in "${bins[@]}"; do cp -L "$b" "$root/opt/resolver/bin/"; copy_libs "$b"; done
+# Without their debug information: the guest unpacks the initramfs into its 512 MiB
+# of RAM, and RelWithDebInfo programs are ~90 MB each.
+for b in "${bins[@]}"; do
+  cp -L "$b" "$root/opt/resolver/bin/"
+  strip --strip-debug "$root/opt/resolver/bin/$(basename "$b")" 2>/dev/null || true
+  copy_libs "$b"
+done
 # Bookworm is merged-/usr: a program may ask ldd's /usr/lib path or /lib path.
 if [ -d "$root/usr/lib/x86_64-linux-gnu" ]; then
   cp -an "$root/usr/lib/x86_64-linux-gnu/." "$root/lib/x86_64-linux-gnu/" && rm -rf "$root/usr/lib"

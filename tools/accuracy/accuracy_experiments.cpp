@@ -69,7 +69,7 @@ ParamStats summarise(std::string name, double truth, const Samples& s, double bo
 SimConfig base_config(double rpm, double seconds, double alpha) {
   SimConfig cfg;
   cfg.profile = {{seconds, rpm, rpm}};
-  cfg.chain.amplitude_imbalance.alpha = alpha;
+  cfg.chain.set("amplitude_imbalance", "alpha", alpha);
   return cfg;
 }
 
@@ -116,7 +116,7 @@ SimConfig seeded(SimConfig base, std::uint64_t seed) {
 }
 
 double effective_sincos_sigma(const SimConfig& config) {
-  const double g = config.chain.noise.sigma_sc;
+  const double g = config.chain.get("noise", "sigma_sc");
   return std::sqrt(g * g + 1.0 / 12.0);  // Gaussian + rounding to integer counts (uniform, 1/12 count^2)
 }
 
@@ -129,9 +129,9 @@ double rd_quantization_sigma(const SimConfig& config) {
 
 AccuracyStudy run_accuracy_study(double alpha, const StudyOptions& options) {
   SimConfig base = base_config(options.rpm, options.seconds, alpha);
-  base.chain.quadrature.beta = kBeta;
-  base.chain.offsets.o_s = kOs;
-  base.chain.offsets.o_c = kOc;
+  base.chain.set("quadrature", "beta", kBeta);
+  base.chain.set("offsets", "o_s", kOs);
+  base.chain.set("offsets", "o_c", kOc);
 
   // [estimator][alpha, beta, o_s, o_c]
   Samples ref[4], conic[4], fourier[4], hwang;
@@ -293,7 +293,8 @@ ConvergenceStudy run_convergence_study(double alpha, const StudyOptions& options
 namespace {
 
 double ripple_floor(const SimConfig& cfg, double sigma_angle, double total_samples) {
-  const double si2 = cfg.chain.noise.sigma_i * cfg.chain.noise.sigma_i + kAmpsPerCurrentBit * kAmpsPerCurrentBit / 12.0;
+  const double sigma_i = cfg.chain.get("noise", "sigma_i");  // [A]
+  const double si2 = sigma_i * sigma_i + kAmpsPerCurrentBit * kAmpsPerCurrentBit / 12.0;
   const double ratio = static_cast<double>(cfg.p) / cfg.p_r;
   const double iq = std::hypot(cfg.i_d_cmd, cfg.i_q_cmd);
   const double var_d = 5.0 / 6.0 * si2 + iq * iq * ratio * ratio * sigma_angle * sigma_angle;

@@ -39,8 +39,9 @@ std::string revs(double r) {
 
 void print_accuracy(const AccuracyStudy& st, int seeds) {
   const auto& ch = st.config.chain;
-  fmt::print("\n## Estimator accuracy: alpha = {}, beta = {} rad, o_s = {}, o_c = {}\n\n", ch.amplitude_imbalance.alpha,
-             ch.quadrature.beta, ch.offsets.o_s, ch.offsets.o_c);
+  fmt::print("\n## Estimator accuracy: alpha = {}, beta = {} rad, o_s = {}, o_c = {}\n\n",
+             ch.get("amplitude_imbalance", "alpha"), ch.get("quadrature", "beta"), ch.get("offsets", "o_s"),
+             ch.get("offsets", "o_c"));
   fmt::print("{} r/min constant, {} samples per log ({:.0f} resolver electrical revolutions), {} seeds. "
              "Bound: CRLB (cramer_rao.h) with sigma_eff = {:.3f} counts and A = {:.0f} counts for the sin/cos "
              "estimators; the LS floor of the R/D quantization (sigma_q = {:.3e} rad) for the R/D-angle ones.\n\n",

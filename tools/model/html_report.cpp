@@ -444,10 +444,11 @@ DiscoveryRun run_discovery(const DiscoveryInput& input, std::vector<std::string>
                            const DiscoveryOptions& options, int max_steps, const std::function<void(int)>& on_step) {
   DiscoveryRun run;
   max_steps = std::max(1, max_steps);
+  const PreparedLog log = prepare_log(input, options.prepare);  // once: every step fits the same rows
   for (int step = 0; step < max_steps; ++step) {
     if (on_step) on_step(step + 1);
     try {
-      run.steps.push_back(explain_model(input, effects, options));
+      run.steps.push_back(explain_prepared(log, effects, options));
     } catch (const std::exception& e) {
       if (run.steps.empty()) throw;
       run.stopped = fmt::format("adding {} failed: {}", effects.back(), e.what());

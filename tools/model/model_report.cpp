@@ -31,55 +31,99 @@ std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}",
 
 std::string format_model_text(const Explanation& ex, bool explain, const std::vector<std::string>& notes) {
   const ModelFit& f = ex.fit;
+  const SampleAccount& a = f.account;
   std::string o;
   o += fmt::format("model: {}\n", f.effects.empty() ? std::string("(none)") : fmt::format("{}", fmt::join(f.effects, ", ")));
-  o += fmt::format("position error against {}\n", f.reference ? "the reference encoder" : "the speed-smoothed ideal angle");
+  o += fmt::format("position error against {}\n", f.reference ? "the reference encoder" : "the self-calibrated ideal angle");
+  o += fmt::format(
+      "covers: {} of {} samples fitted (moving; {} at standstill, {} outliers, {} excluded), {:.3g} s, {:.3g} "
+      "electrical ({:.3g} mechanical) revolutions travelled, {} reversal{}, {} standstill{}; units: {}\n",
+      a.fitted, a.samples_in, a.standstill, a.outliers, a.excluded, a.span_s, a.revolutions_electrical,
+      a.revolutions_mechanical, a.reversals, a.reversals == 1 ? "" : "s", a.standstills, a.standstills == 1 ? "" : "s",
+      a.units);
   for (const auto& n : notes) o += "note: " + n + "\n";
   for (const auto& n : f.notes) o += "note: " + n + "\n";
-  o += "\nparameters (value +- standard error):\n";
-  for (const auto& p : f.params) o += fmt::format("  {:<36} {:>12.4g} +- {:.2g}\n", p.name, p.value, p.std_error);
-  o += "\nresidual rms vs noise floor:\n";
+  o += fmt::format("\nparameters (value +- standard error{}):\n",
+                   f.robust_errors ? ", from the revolution-to-revolution spread" : ", formal");
+  for (const auto& p : f.params) {
+    o += fmt::format("  {:<36} {:>12.5g} +- {:.2g} {}\n", p.name, p.value, p.std_error, p.unit);
+  }
+  o += "\nresidual rms vs noise floor (held back: fitted on one fold, evaluated on the other):\n";
   for (const auto& s : f.signals) {
     const bool rad = s.signal == "position_error";
     const std::string unit = s.signal == "i_dq" ? " A" : " of the amplitude";
-    o += fmt::format("  {:<15} {:.3g}{} (before: {:.3g}), floor {:.3g}{} -> {:.2f}x floor\n", s.signal, s.rms,
-                     rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.rms)) : unit, s.raw_rms,
-                     s.floor, rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.floor)) : std::string(""),
-                     s.rms / s.floor);
+    o += fmt::format("  {:<15} {:.3g}{} (before: {:.3g}), floor {:.3g}{} -> {:.2f}x floor; held back {:.2f}x\n",
+                     s.signal, s.rms, rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.rms)) : unit,
+                     s.raw_rms, s.floor,
+                     rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.floor)) : std::string(""),
+                     s.rms / s.floor, s.held_back_rms / s.floor);
   }
-  o += "  (floor: rms of second differences of a saturated per-speed Fourier fit's residual / sqrt 6)\n";
+  auto floor_line = [&](const char* name, const FloorEstimate& e) {
+    if (e.source.empty() || e.source == "none") return;
+    o += fmt::format("  floor {:<13} from {} ({:.3g}; second differences {:.3g}, standstill {:.3g} over {} samples, "
+                     "quantization {:.3g})\n",
+                     name, e.source, e.chosen, e.second_difference, e.standstill, e.standstill_samples, e.quantization);
+  };
+  floor_line("position", f.floors.rd);
+  floor_line("sin/cos", f.floors.sc);
+  floor_line("i_dq", f.floors.cur);
+  o += fmt::format("  held-back folds: {}\n", a.fold_rule);
+  if (f.whiteness.lags > 0) {
+    o += fmt::format("  whiteness: autocorrelation at lags 1..{} within +-{:.3g} (99 %): {} outside, largest {:.3g}\n",
+                     f.whiteness.lags, f.whiteness.band, f.whiteness.outside, f.whiteness.max_abs);
+  }
+  for (const auto& out : f.outliers) {
+    o += fmt::format("  outliers on {}: {} (largest {:.3g}), kept out of the fit\n", out.signal, out.count, out.largest);
+  }
   o += "\nposition-error residual by harmonic order of theta [rad]:\n ";
   for (const auto& h : f.harmonics) o += fmt::format(" {}:{:.2g}", h.order, h.amplitude);
+  if (!f.harmonics_mech.empty()) {
+    o += "\nby harmonic order of theta_m [rad]:\n ";
+    for (const auto& h : f.harmonics_mech) o += fmt::format(" {}:{:.2g}", h.order, h.amplitude);
+  }
   if (f.currents_used) {
     o += "\ni_d / i_q residual by harmonic order of theta_e [A]:\n ";
     for (std::size_t n = 0; n < f.harmonics_id.size() && n < f.harmonics_iq.size(); ++n) {
       o += fmt::format(" {}:{:.2g}/{:.2g}", n, f.harmonics_id[n].amplitude, f.harmonics_iq[n].amplitude);
     }
   }
-  o += "\n\nby speed bin:\n";
+  o += "\n\nby speed bin (moving samples):\n";
   for (const auto& b : f.speed_bins) {
-    o += fmt::format("  {:>7.0f} r/min  {:>7} samples  rms {:.3g} rad ({:.2f}x floor), 2theta {:.3g} rad\n", b.rpm_mid,
-                     b.samples, b.rms, b.rms / f.noise_floor_rad, b.order2_amplitude);
+    o += fmt::format("  {:>7.0f} r/min  {:>7} samples  rms {:.3g} rad ({:.2f}x floor), 2theta {}\n", b.rpm_mid,
+                     b.samples, b.rms, b.rms / f.noise_floor_rad,
+                     std::isfinite(b.order2_amplitude) ? fmt::format("{:.3g} rad", b.order2_amplitude)
+                                                       : std::string("- (the bin does not cover a turn)"));
+  }
+  o += "\nby direction:\n";
+  for (const auto& d : f.directions) {
+    o += fmt::format("  {:<9} {:>7} samples  rms {:.3g} rad ({:.2f}x floor), mean {:.3g} rad\n",
+                     d.direction > 0 ? "forward" : "backward", d.samples, d.rms, d.rms / f.noise_floor_rad, d.mean);
   }
   o += "\nby time window:\n";
   for (const auto& b : f.time_bins) {
-    o += fmt::format("  {:>7.2f}-{:<7.2f} s  rms {:.3g} rad ({:.2f}x floor), 2theta {:.3g} rad\n", b.t_lo, b.t_hi, b.rms,
-                     b.rms / f.noise_floor_rad, b.order2_amplitude);
+    o += fmt::format("  {:>7.2f}-{:<7.2f} s  rms {:.3g} rad ({:.2f}x floor), mean {:.3g} rad\n", b.t_lo, b.t_hi,
+                     b.rms, b.rms / f.noise_floor_rad, b.mean);
   }
-  if (!explain) return o;
+  if (!explain) {
+    o += fmt::format("\nverdict: {}\n", f.explained ? "explained (every signal at its floor, held back too)"
+                                                     : "not explained: run `resolver-model explain` for why");
+    return o;
+  }
   if (!ex.where_it_fails.empty()) {
     o += "\nwhere it fails:\n";
     for (const auto& w : ex.where_it_fails) o += "  - " + w + "\n";
   }
-  o += "\ncandidates (lowest BIC first; * = proposed):\n";
+  o += "\ncandidates (lowest BIC first; * = proposed; ERR = share of the residual it removes):\n";
   for (const auto& c : ex.candidates) {
     const std::string dq = f.currents_used ? fmt::format(", i_dq {:.3g} A", c.dq_residual_after) : std::string();
-    o += fmt::format("  {} {:<22} residual {:.3g} rad ({:.2f}x floor){}  BIC {:.1f} (drop {:.1f}){}\n      {}\n",
+    o += fmt::format("  {} {:<26} residual {:.3g} rad ({:.2f}x floor){}  BIC {:.1f} (drop {:.1f}) ERR {:.3f}{}\n      {}\n",
                      c.proposed ? '*' : ' ', c.effect, c.residual_after_rad, c.residual_after_rad / f.noise_floor_rad,
-                     dq, c.score, c.bic_drop, c.reaches_floor ? "  reaches the floor" : "", c.reason);
+                     dq, c.score, c.bic_drop, c.err, c.reaches_floor ? "  reaches the floor" : "", c.reason);
+    if (!c.fits_as_well.empty()) o += fmt::format("      fits as well here: {}\n", fmt::join(c.fits_as_well, ", "));
   }
   for (const auto& n : ex.not_evaluated) o += "    not evaluated: " + n + "\n";
   o += fmt::format("\nverdict: {}\n{}\n", to_string(ex.verdict), ex.summary);
+  if (!ex.suggested_custom.empty()) o += "\nsuggested custom effect (paste into the config):\n" + ex.suggested_custom;
   return o;
 }
 
@@ -90,17 +134,61 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
   o += "],\"params\":{";
   for (std::size_t i = 0; i < f.params.size(); ++i) {
     o += (i ? "," : "") + json_str(f.params[i].name) + ":{\"value\":" + json_num(f.params[i].value) +
-         ",\"stderr\":" + json_num(f.params[i].std_error) + "}";
+         ",\"stderr\":" + json_num(f.params[i].std_error) + ",\"unit\":" + json_str(f.params[i].unit) + "}";
   }
   o += "},\"residual_rms_rad\":" + json_num(f.residual_rms_rad);
   o += ",\"residual_rms_arcmin\":" + json_num(rad_to_arcmin(f.residual_rms_rad));
   o += ",\"noise_floor_rad\":" + json_num(f.noise_floor_rad);
   o += ",\"reference\":" + std::string(f.reference ? "true" : "false");
+  const SampleAccount& a = f.account;
+  o += fmt::format(",\"covers\":{{\"samples_in\":{},\"rows\":{},\"fitted\":{},\"moving\":{},\"standstill\":{},"
+                   "\"outliers\":{},\"excluded\":{},\"without_angle\":{},\"without_reference\":{},\"span_s\":{},"
+                   "\"revolutions_electrical\":{},\"revolutions_mechanical\":{},\"reversals\":{},"
+                   "\"standstills\":{},\"fold_rule\":{},\"units\":{}}}",
+                   a.samples_in, a.rows, a.fitted, a.moving, a.standstill, a.outliers, a.excluded, a.without_angle,
+                   a.without_reference, json_num(a.span_s), json_num(a.revolutions_electrical),
+                   json_num(a.revolutions_mechanical), a.reversals, a.standstills, json_str(a.fold_rule),
+                   json_str(a.units));
+  auto floor_json = [&](const FloorEstimate& e) {
+    return fmt::format("{{\"value\":{},\"source\":{},\"second_differences\":{},\"standstill\":{},"
+                       "\"standstill_samples\":{},\"quantization\":{}}}",
+                       json_num(e.chosen), json_str(e.source), json_num(e.second_difference), json_num(e.standstill),
+                       e.standstill_samples, json_num(e.quantization));
+  };
+  o += ",\"floors\":{\"position_error\":" + floor_json(f.floors.rd) + ",\"sin_cos\":" + floor_json(f.floors.sc) +
+       ",\"i_dq\":" + floor_json(f.floors.cur) + "}";
+  o += ",\"outliers\":[";
+  for (std::size_t i = 0; i < f.outliers.size(); ++i) {
+    const auto& x = f.outliers[i];
+    o += (i ? "," : "") + fmt::format("{{\"signal\":{},\"count\":{},\"largest\":{},\"first_times_s\":[{}]}}",
+                                      json_str(x.signal), x.count, json_num(x.largest), fmt::join(x.times, ","));
+  }
+  o += "],\"residual_with_outliers_rad\":" + json_num(f.rms_with_outliers_rad);
+  o += fmt::format(",\"whiteness\":{{\"lags\":{},\"band\":{},\"max_abs\":{},\"outside\":{},\"samples\":{}}}",
+                   f.whiteness.lags, json_num(f.whiteness.band), json_num(f.whiteness.max_abs), f.whiteness.outside,
+                   f.whiteness.samples);
+  o += ",\"robust_standard_errors\":" + std::string(f.robust_errors ? "true" : "false");
+  o += ",\"passes\":" + std::to_string(f.passes);
+  o += ",\"directions\":[";
+  for (std::size_t i = 0; i < f.directions.size(); ++i) {
+    const auto& d = f.directions[i];
+    o += (i ? "," : "") + fmt::format("{{\"direction\":{},\"samples\":{},\"rms_rad\":{},\"mean_rad\":{}}}",
+                                      d.direction, d.samples, json_num(d.rms), json_num(d.mean));
+  }
+  o += "],\"harmonics_mech\":[";
+  for (std::size_t i = 0; i < f.harmonics_mech.size(); ++i) {
+    o += (i ? "," : "") + fmt::format("{{\"order\":{},\"amplitude_rad\":{},\"phase_rad\":{}}}",
+                                      f.harmonics_mech[i].order, json_num(f.harmonics_mech[i].amplitude),
+                                      json_num(f.harmonics_mech[i].phase));
+  }
+  o += "]";
   o += ",\"signals\":[";
   for (std::size_t i = 0; i < f.signals.size(); ++i) {
     const auto& s = f.signals[i];
-    o += (i ? "," : "") + fmt::format("{{\"signal\":{},\"rms\":{},\"floor\":{},\"raw_rms\":{},\"rows\":{}}}",
-                                      json_str(s.signal), json_num(s.rms), json_num(s.floor), json_num(s.raw_rms), s.rows);
+    o += (i ? "," : "") + fmt::format("{{\"signal\":{},\"rms\":{},\"floor\":{},\"raw_rms\":{},\"held_back_rms\":{},"
+                                      "\"rows\":{}}}",
+                                      json_str(s.signal), json_num(s.rms), json_num(s.floor), json_num(s.raw_rms),
+                                      json_num(s.held_back_rms), s.rows);
   }
   o += "],\"harmonics\":[";
   for (std::size_t i = 0; i < f.harmonics.size(); ++i) {
@@ -136,11 +224,17 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
     for (std::size_t i = 0; i < ex.candidates.size(); ++i) {
       const auto& c = ex.candidates[i];
       o += (i ? "," : "") + fmt::format("{{\"effect\":{},\"residual_after_rad\":{},\"dq_residual_after_a\":{},"
-                                        "\"score\":{},\"bic_drop\":{},"
-                                        "\"proposed\":{},\"reaches_floor\":{},\"reason\":{},\"params\":{{",
+                                        "\"score\":{},\"bic_drop\":{},\"err\":{},"
+                                        "\"proposed\":{},\"reaches_floor\":{},\"reason\":{},\"fits_as_well\":[{}],"
+                                        "\"params\":{{",
                                         json_str(c.effect), json_num(c.residual_after_rad),
                                         json_num(c.dq_residual_after), json_num(c.score),
-                                        json_num(c.bic_drop), c.proposed, c.reaches_floor, json_str(c.reason));
+                                        json_num(c.bic_drop), json_num(c.err), c.proposed, c.reaches_floor,
+                                        json_str(c.reason), [&] {
+                                          std::string l;
+                                          for (const auto& x : c.fits_as_well) l += (l.empty() ? "" : ",") + json_str(x);
+                                          return l;
+                                        }());
       for (std::size_t j = 0; j < c.params.size(); ++j) {
         o += (j ? "," : "") + json_str(c.params[j].name) + ":{\"value\":" + json_num(c.params[j].value) +
              ",\"stderr\":" + json_num(c.params[j].std_error) + "}";
@@ -151,9 +245,12 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
     for (std::size_t i = 0; i < ex.where_it_fails.size(); ++i) o += (i ? "," : "") + json_str(ex.where_it_fails[i]);
     o += "],\"missing_pair\":[";
     for (std::size_t i = 0; i < ex.missing_pair.size(); ++i) o += (i ? "," : "") + json_str(ex.missing_pair[i]);
+    o += "],\"not_evaluated\":[";
+    for (std::size_t i = 0; i < ex.not_evaluated.size(); ++i) o += (i ? "," : "") + json_str(ex.not_evaluated[i]);
     o += "],\"verdict\":" + json_str(to_string(ex.verdict)) + ",\"summary\":" + json_str(ex.summary);
+    o += ",\"suggested_custom\":" + (ex.suggested_custom.empty() ? std::string("null") : json_str(ex.suggested_custom));
   } else {
-    o += std::string(",\"verdict\":") + (f.explained ? "\"explained\"" : "null");
+    o += std::string(",\"verdict\":") + (f.explained ? "\"explained\"" : "\"not_explained\"");
   }
   return o + "}\n";
 }

@@ -181,6 +181,7 @@ int run(int argc, char** argv) {
       samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config, read_options);
     }
     resolver::DiscoveryOptions options;
+    options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
     resolver::Explanation ex;
     {

@@ -4,20 +4,21 @@
 //
 // Per control sample k (t_k = k / sample_rate_hz):
 //   theta_m(t)  from the speed profile (exact integral), theta = p_r theta_m, theta_e = p theta_m
-//   theta_s(t)  = resolver_angle(chain, theta_m(t)): the angle the resolver sees
-//                 (eccentricity, mounting offset; sensor_chain.h)
-//   sin/cos     = amplitude_counts * sampled_envelopes(chain, theta_s(t_k), theta_s(t_k + tau))
-//                 + noise (sin at t_k, cos tau later: sampling skew)   -> i16 counts
+//   theta_s(t)  = the angle the resolver sees: the registry's forward chain
+//                 (daemon/core/effects/forward_chain.h) at t - delay, through the
+//                 motion effects (backlash, eccentricity, mechanical harmonics, mounting)
+//   sin/cos     = amplitude_counts * envelopes: sin of theta_s(t_k), cos of
+//                 theta_s(t_k + dsp_cos_dt) (channel delay, sampling skew) + noise,
+//                 outliers                                             -> i16 counts
 //   rd_angle    = the tracking loop, integrated continuously from t_{k-1} to t_k on
-//                 the noise-free, unskewed envelopes of theta_s (the converter has its
-//                 own analog front end; ADC noise and sampling skew are the DSP's),
-//                 rounded to rd_bits                                   -> u16
-//   currents    = phase_currents_true: ideal current control in the drive frame
-//                 theta_e + theta_0 (Hwang eqs. 11-12; theta_0 = 0 is the TRUE theta_e)
-//                 with the dead-time distortion; then phase_currents_measured (sensor
-//                 gains and offsets) + noise                           -> mA
+//                 the noise-free envelopes with the converter's own channel timing
+//                 (ADC noise and the DSP's sampling skew are the DSP's), rounded to
+//                 rd_bits                                              -> u16
+//   currents    = the forward chain's machine currents: ideal current control in the
+//                 drive frame theta_e + theta_0 (Hwang eqs. 11-12) with the inverter's
+//                 distortion; then the current sensors + noise          -> mA
 //   reference   = theta_m wrapped, 2^32 counts per mechanical turn     -> u32
-// The same effect models (daemon/core/effects) are what the fit uses.
+// The same effect units (daemon/core/effects, registry.h) are what the fit uses.
 //
 // Randomness: one std::mt19937_64 seeded with `seed`; the same SimConfig gives the
 // same samples and frames.
@@ -27,7 +28,9 @@
 #include <string>
 #include <vector>
 
-#include "daemon/core/effects/sensor_chain.h"
+#include "daemon/core/effects/chain_values.h"
+#include "daemon/core/effects/forward_chain.h"
+#include "daemon/core/effects/noise.h"
 #include "daemon/core/effects/tracking_loop.h"
 #include "drivers/can_frame.h"
 #include "tools/sim/speed_profile.h"
@@ -45,7 +48,7 @@ namespace resolver {
 ///    -14 deg) at 3000 r/min: negligible at Hwang's speed, visible when swept.
 ///  - noise sigma_sc = 2 counts (~1e-4 of a 26000-count amplitude: a good 12-14 bit
 ///    ADC path), sigma_i = 0.02 A (about one LSB of a 12-bit ADC over +-50 A).
-[[nodiscard]] SensorChainConfig default_sim_chain();
+[[nodiscard]] ChainValues default_sim_chain();
 
 struct SimConfig {
   /// Hwang's setup: 200 r/min for 5 s.
@@ -62,7 +65,7 @@ struct SimConfig {
   double i_d_cmd = 0;               ///< [A] commanded d current
   double i_q_cmd = 10;              ///< [A] commanded q current
   bool reference = true;            ///< send REFERENCE_ANGLE frames
-  SensorChainConfig chain = default_sim_chain();
+  ChainValues chain = default_sim_chain();
   std::uint64_t seed = 1;
   std::int64_t start_time_us = 1700000000000000;  ///< [us] timestamp of sample 0
   double theta_m0 = 0;                            ///< [rad] mechanical angle at t = 0
@@ -115,16 +118,20 @@ class BenchSimulator {
  private:
   [[nodiscard]] double sample_time_s(std::uint64_t index) const;
   [[nodiscard]] double theta_m_at(double t) const;
-  /// [rad] the resolver electrical angle the resolver sees at time t [s] (continuous).
-  [[nodiscard]] double resolver_angle_at(double t) const;
+
+  /// [rad] the resolver electrical angle the chain sees at time t for its sin channel
+  /// (t - delay) with the cos channel `cos_dt` [s] later; commit at sample instants.
+  [[nodiscard]] double seen_angle(double t, bool commit);
+  [[nodiscard]] SinCos converter_envelopes(double t);
 
   SimConfig config_;
   SpeedProfile profile_;
+  ForwardChain chain_;
   TrackingLoop loop_;
   NoiseEngine engine_;
   std::uint64_t total_ = 0;
   std::uint64_t index_ = 0;
-  double alpha0_ = 0.0;  ///< chain alpha at t = 0 (config_.chain's alpha follows the drift)
+  double alpha0_ = 0.0;  ///< chain alpha at t = 0 (the forward chain's alpha follows the drift)
 };
 
 /// Frames per second the configuration puts on the bus (for the bus-load check).

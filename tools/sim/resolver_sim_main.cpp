@@ -13,7 +13,7 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
-#include "daemon/core/effects/effect_catalog.h"
+#include "daemon/core/effects/chain_values.h"
 #include "drivers/candump/candump_writer.h"
 #include "tools/sim/bench_simulator.h"
 #include "tools/sim/sim_truth.h"
@@ -156,12 +156,17 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
   // TOML effects first, then the command line's: a later spec of the same parameter wins.
   for (const auto* list : {&toml_effects, &o.effects}) {
     for (const std::string& spec : *list) {
-      if (auto err = resolver::apply_effect_spec(c.chain, spec)) fail(fmt::format("--effect: {}", *err));
+      try {
+        c.chain.apply_spec(spec);
+      } catch (const std::invalid_argument& e) {
+        fail(fmt::format("--effect: {}", e.what()));
+      }
     }
   }
   // --effect quantization:rd_bits=N and --rd-bits N are one setting.
-  if (app.get_option("--rd-bits")->count() == 0 && c.chain.quantization.rd_bits != 16) {
-    c.rd_bits = c.chain.quantization.rd_bits;
+  if (const int bits = static_cast<int>(c.chain.get("quantization", "rd_bits"));
+      app.get_option("--rd-bits")->count() == 0 && bits != 16) {
+    c.rd_bits = bits;
   }
   return c;
 }
@@ -199,8 +204,14 @@ int main(int argc, char** argv) {
   app.add_option("--config", o.config_file, "TOML file with the same options; the command line wins")
       ->check(CLI::ExistingFile);
   app.add_flag("--list-effects", o.list_effects, "print the effect catalog and exit");
+  bool effects_markdown = false;
+  app.add_flag("--effects-markdown", effects_markdown, "print the effect catalog as Markdown (docs/EFFECTS.md) and exit");
   CLI11_PARSE(app, argc, argv);
 
+  if (effects_markdown) {
+    fmt::print("{}", resolver::effects_markdown());
+    return 0;
+  }
   if (o.list_effects) {
     fmt::print("{}", resolver::format_effect_catalog());
     return 0;

@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "daemon/core/effects/effect_catalog.h"
+#include "daemon/core/effects/chain_values.h"
 
 namespace resolver {
 
@@ -52,19 +52,19 @@ std::string sim_truth_json(const SimConfig& c, std::uint64_t total_samples, cons
                        s.duration_s, s.rpm_start, s.rpm_end);
   }
   out += "],\n  \"effects\": {";
-  const std::vector<EffectValues> active = active_effect_values(c.chain);
+  const auto active = c.chain.active_effects();
   for (std::size_t i = 0; i < active.size(); ++i) {
-    out += fmt::format("{}\n    {}: {}", i == 0 ? "" : ",", json_string(active[i].effect),
+    out += fmt::format("{}\n    {}: {}", i == 0 ? "" : ",", json_string(active[i].effect->name()),
                        parameters_json(active[i].parameters));
   }
   out += active.empty() ? "},\n" : "\n  },\n";
   out += "  \"chain\": {";
   bool first = true;
-  for (const EffectInfo& e : effect_catalog()) {
-    if (!e.implemented) continue;
+  for (const Effect* e : effect_registry()) {
     std::vector<std::pair<std::string_view, double>> params;
-    for (const EffectParameter& p : e.parameters) params.emplace_back(p.name, p.get(c.chain));
-    out += fmt::format("{}\n    {}: {}", first ? "" : ",", json_string(e.name), parameters_json(params));
+    const Values v = c.chain.of(*e);
+    for (std::size_t i = 0; i < e->params().size(); ++i) params.emplace_back(e->params()[i].name, v[i]);
+    out += fmt::format("{}\n    {}: {}", first ? "" : ",", json_string(e->name()), parameters_json(params));
     first = false;
   }
   out += "\n  }\n}\n";

@@ -5,7 +5,7 @@
 
 namespace resolver {
 
-bool ModelWindow::add(const DiscoverySample& sample, int p_r, int p) {
+bool ModelWindow::add(const Sample& sample, int p_r, int p) {
   if (!input_.samples.empty() && (p_r != input_.p_r || p != input_.p)) {
     (void)take();  // the fit assumes one set of pole pairs: start again
   }

@@ -10,7 +10,7 @@
 #include <cstdint>
 
 #include "daemon/core/angles.h"
-#include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/discovery/prepare.h"
 
 namespace resolver {
 
@@ -26,7 +26,7 @@ class ModelWindow {
   /// Adds one sample (samples without an R/D angle are kept for the fit but do not
   /// advance the revolution count). Pole pairs that change mid-window restart it.
   /// Returns true when the window is complete: take() it.
-  bool add(const DiscoverySample& sample, int p_r, int p);
+  bool add(const Sample& sample, int p_r, int p);
   /// The collected window; the next add() starts a new one.
   [[nodiscard]] DiscoveryInput take();
 

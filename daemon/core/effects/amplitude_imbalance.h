@@ -28,4 +28,8 @@ struct AmplitudeImbalance {
 /// (Hanselman eq. 5, Hwang eq. 10).
 [[nodiscard]] double amplitude_imbalance_error(const AmplitudeImbalance& p, double theta);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& amplitude_imbalance_effect();
+
 }  // namespace resolver

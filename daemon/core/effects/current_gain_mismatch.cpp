@@ -1,7 +1,10 @@
 #include "daemon/core/effects/current_gain_mismatch.h"
 
+#include <array>
 #include <cmath>
 #include <numbers>
+
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -26,6 +29,51 @@ double current_gain_mismatch_ripple_2x(const CurrentGainMismatch& p, double i_d,
 
 PhaseCurrents compensate_current_gain_mismatch(const CurrentGainMismatch& p, const PhaseCurrents& measured) {
   return {measured.a / (1.0 + p.gain_a), measured.b / (1.0 + p.gain_b), measured.c};
+}
+
+}  // namespace resolver
+
+// ---- registry unit ------------------------------------------------------------
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "gain_a", .unit = "[1]", .description = "relative gain error of the phase a current sensor",
+              .min = -0.5, .max = 0.5},
+    ParamInfo{.name = "gain_b", .unit = "[1]", .description = "relative gain error of the phase b current sensor",
+              .min = -0.5, .max = 0.5},
+};
+
+class CurrentGainMismatchEffect final : public BasicEffect {
+ public:
+  CurrentGainMismatchEffect()
+      : BasicEffect({"current_gain_mismatch",
+                     "i_a (1+gain_a), i_b (1+gain_b): dq ripple at 2x theta_e of amplitude |I|/2 sqrt((gain_a - "
+                     "gain_b/2)^2 + gain_b^2/12)",
+                     "DESIGN 6; current_gain_mismatch.h",
+                     "the phase current sensors differ in gain: i_d and i_q ripple at 2x theta_e proportional to the "
+                     "current, while the resolver signals are clean (so it is not the resolver's amplitude imbalance)"},
+                    kParams, EffectStage::kCurrents) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_e = 2}; }
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
+    if (stage == CurrentStage::kSensorGain) i = apply_current_gain_mismatch(CurrentGainMismatch{v[0], v[1]}, i);
+  }
+  // Taken at the operating point (i_d0, i_q0): products of a gain error with its own
+  // DC shift are second order (current_gain_mismatch.h).
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
+    const DqCurrents a = current_gain_mismatch_dq_error(CurrentGainMismatch{1.0, 0.0}, row.i_d0, row.i_q0, row.theta_e);
+    const DqCurrents b = current_gain_mismatch_dq_error(CurrentGainMismatch{0.0, 1.0}, row.i_d0, row.i_q0, row.theta_e);
+    out.col(0) = SignalValues{.d = a.d, .q = a.q};
+    out.col(1) = SignalValues{.d = b.d, .q = b.q};
+  }
+};
+
+}  // namespace
+
+const Effect& current_gain_mismatch_effect() {
+  static const CurrentGainMismatchEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

@@ -44,4 +44,8 @@ struct CurrentGainMismatch {
 [[nodiscard]] PhaseCurrents compensate_current_gain_mismatch(const CurrentGainMismatch& p,
                                                              const PhaseCurrents& measured);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& current_gain_mismatch_effect();
+
 }  // namespace resolver

@@ -1,7 +1,10 @@
 #include "daemon/core/effects/current_offsets.h"
 
+#include <array>
 #include <cmath>
 #include <numbers>
+
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -21,6 +24,47 @@ double current_offsets_ripple_1x(const CurrentOffsets& p) { return std::hypot(p.
 
 PhaseCurrents compensate_current_offsets(const CurrentOffsets& p, const PhaseCurrents& measured) {
   return {measured.a - p.off_a, measured.b - p.off_b, measured.c};
+}
+
+}  // namespace resolver
+
+// ---- registry unit ------------------------------------------------------------
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "off_a", .unit = "[A]", .description = "offset of the phase a current sensor", .min = -1000.0,
+              .max = 1000.0},
+    ParamInfo{.name = "off_b", .unit = "[A]", .description = "offset of the phase b current sensor", .min = -1000.0,
+              .max = 1000.0},
+};
+
+class CurrentOffsetsEffect final : public BasicEffect {
+ public:
+  CurrentOffsetsEffect()
+      : BasicEffect({"current_offsets",
+                     "i_a + off_a, i_b + off_b: dq ripple at 1x theta_e of amplitude hypot(off_a, off_b/sqrt3)",
+                     "DESIGN 6; current_offsets.h",
+                     "DC offsets of the phase current sensors: i_d and i_q ripple at 1x theta_e, a quarter period "
+                     "apart, independent of load and speed; the resolver signals are clean"},
+                    kParams, EffectStage::kCurrents) {}
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
+    if (stage == CurrentStage::kSensorOffset) i = apply_current_offsets(CurrentOffsets{v[0], v[1]}, i);
+  }
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
+    const DqCurrents a = current_offsets_dq_error(CurrentOffsets{1.0, 0.0}, row.theta_e);
+    const DqCurrents b = current_offsets_dq_error(CurrentOffsets{0.0, 1.0}, row.theta_e);
+    out.col(0) = SignalValues{.d = a.d, .q = a.q};
+    out.col(1) = SignalValues{.d = b.d, .q = b.q};
+  }
+};
+
+}  // namespace
+
+const Effect& current_offsets_effect() {
+  static const CurrentOffsetsEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

@@ -41,4 +41,8 @@ struct CurrentOffsets {
 /// Compensation: removes the offsets from measured currents [A].
 [[nodiscard]] PhaseCurrents compensate_current_offsets(const CurrentOffsets& p, const PhaseCurrents& measured);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& current_offsets_effect();
+
 }  // namespace resolver

@@ -1,7 +1,10 @@
 #include "daemon/core/effects/dead_time.h"
 
+#include <array>
 #include <cmath>
 #include <numbers>
+
+#include "daemon/core/effects/effect.h"
 
 #include "daemon/core/angles.h"
 
@@ -38,6 +41,45 @@ DqCurrents dead_time_dq_error(const DeadTime& p, double i_d, double i_q, double 
 
 DqCurrents dead_time_ripple_6x(const DeadTime& p, double i_d, double i_q) {
   return {2.0 * p.k_dt() * std::abs(i_q), 2.0 * p.k_dt() * std::abs(i_d)};
+}
+
+}  // namespace resolver
+
+// ---- registry unit ------------------------------------------------------------
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    // 20 us is already an extreme dead time; it gives k_dt = 0.2 (dead_time.h).
+    ParamInfo{.name = "t_d", .unit = "[s]", .description = "inverter dead time (5th/7th current harmonics k_dt = t_d / 100 us)",
+              .min = 0.0, .max = 2e-5},
+};
+
+class DeadTimeEffect final : public BasicEffect {
+ public:
+  DeadTimeEffect()
+      : BasicEffect({"dead_time",
+                     "signature model: 5th/7th current harmonics k_dt |I|, dq ripple at 6x theta_e (2 k_dt i_q on i_d)",
+                     "DESIGN 6; dead_time.h",
+                     "inverter dead time: 5th and 7th harmonics of the phase currents, i.e. a 6x theta_e ripple on i_d "
+                     "and i_q perpendicular to the current vector"},
+                    kParams, EffectStage::kCurrents) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_e = 6}; }
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
+    if (stage == CurrentStage::kInverter) i = apply_dead_time(DeadTime{v[0]}, i);
+  }
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
+    const DqCurrents a = dead_time_dq_error(DeadTime{1.0}, row.i_d0, row.i_q0, row.theta_e);  // per second of t_d
+    out.col(0) = SignalValues{.d = a.d, .q = a.q};
+  }
+};
+
+}  // namespace
+
+const Effect& dead_time_effect() {
+  static const DeadTimeEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

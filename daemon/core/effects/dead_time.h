@@ -59,4 +59,8 @@ struct DeadTime {
 /// [A] amplitudes of the 6x theta_e ripple on i_d (2 k_dt |i_q|) and on i_q (2 k_dt |i_d|).
 [[nodiscard]] DqCurrents dead_time_ripple_6x(const DeadTime& p, double i_d, double i_q);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& dead_time_effect();
+
 }  // namespace resolver

@@ -1,6 +1,10 @@
 #include "daemon/core/effects/eccentricity.h"
 
+#include <array>
 #include <cmath>
+#include <stdexcept>
+
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -22,6 +26,62 @@ double compensate_eccentricity(const Eccentricity& p, double theta_seen_m) {
     if (change <= 1e-16 * (1.0 + std::abs(theta_seen_m))) break;
   }
   return theta_m;
+}
+
+}  // namespace resolver
+
+// ---- registry unit ------------------------------------------------------------
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "e", .unit = "[rad]", .description = "amplitude of the 1x angle error (mechanical rad)",
+              .min = -0.5, .max = 0.5, .polar = Polar::kAmplitude},
+    ParamInfo{.name = "phase", .unit = "[rad]", .description = "phase of the 1x angle error (mechanical rad)",
+              .min = -10.0, .max = 10.0, .polar = Polar::kPhase},
+};
+
+class EccentricityEffect final : public BasicEffect {
+ public:
+  EccentricityEffect()
+      : BasicEffect({"eccentricity",
+                     "resolver sees theta_m + e sin(theta_m + phase): eps = -p_r e sin(theta_m + phase), 1x mechanical",
+                     "DESIGN 6; eccentricity.h",
+                     "the rotor is not concentric: a 1x mechanical harmonic of the position error (order 1/p_r of "
+                     "theta), only visible against the reference encoder"},
+                    kParams, EffectStage::kMotion) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_m = 1}; }
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  [[nodiscard]] bool active(Values v) const override { return v[0] != 0.0; }
+  void validate(Values v) const override {
+    if (!(std::abs(v[0]) < 1.0)) {
+      throw std::invalid_argument("eccentricity.e must be in (-1, 1) mechanical rad so the resolver keeps turning one way");
+    }
+  }
+  [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double /*omega_m*/, MotionState& /*state*/,
+                                       bool /*commit*/) const override {
+    return eccentric_angle(Eccentricity{v[0], v[1]}, theta_m);
+  }
+  // Columns for x = e cos(phase), y = e sin(phase): e sin(theta_m + phase) = x sin theta_m + y cos theta_m.
+  void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
+    const double pr = row.p_r;
+    out.col(0) = shift_column(-pr * b.rd_mech_sin(1), pr * b.env_mech_sin(1));
+    out.col(1) = shift_column(-pr * b.rd_mech_cos(1), pr * b.env_mech_cos(1));
+  }
+  [[nodiscard]] bool linear_in_params() const override { return false; }
+  void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
+    const double x = v[0] * std::cos(v[1]), y = v[0] * std::sin(v[1]);
+    const double pr = row.p_r;
+    out += shift_column(-pr * (x * b.rd_mech_sin(1) + y * b.rd_mech_cos(1)),
+                        pr * (x * b.env_mech_sin(1) + y * b.env_mech_cos(1)));
+  }
+};
+
+}  // namespace
+
+const Effect& eccentricity_effect() {
+  static const EccentricityEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

@@ -39,4 +39,8 @@ struct Eccentricity {
 /// [rad], to |error| <= 1e-15 rad (plus rounding) for |e| <= 0.5. Requires |e| < 1.
 [[nodiscard]] double compensate_eccentricity(const Eccentricity& p, double theta_seen_m);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& eccentricity_effect();
+
 }  // namespace resolver

@@ -1,13 +1,19 @@
 // Effect: inductance harmonics of the resolver windings.
 //
 // Cause: the winding distribution only approximates a sinusoid (Hanselman III.C).
-// Forward model (Hanselman eq. 8), added to the fundamental envelopes:
-//   s += K_0 + sum_{n>=2} K_n sin(n theta)
-//   c += K_0 + sum_{n>=2} K_n cos(n theta)
+// Forward model (Hanselman eq. 8), added to the fundamental envelopes, in two
+// sequences:
+//   same sign on both windings (Hanselman's K_n, a positive-sequence harmonic):
+//     s += K_0 + sum_{n>=2} K_n sin(n theta),   c += K_0 + sum_{n>=2} K_n cos(n theta)
+//   opposite sign (negative sequence: an odd nonlinearity acting on both channels,
+//   e.g. saturation x - a x^3 gives K_3_opp = a/4 ... of the fundamental):
+//     s += sum K_n_opp sin(n theta),            c -= sum K_n_opp cos(n theta)
 // (K_1 = 1 is the fundamental itself, so it is not a parameter.)
-// Signature (Hanselman eq. 9), eps = theta - phi:
-//   eps ~= -sqrt(2) K_0 cos(theta + pi/4) - sum_{n>=2} K_n sin((n - 1) theta)
-// Note K_3 lands on 2theta like amplitude imbalance; only the sin/cos signals
+// Signature, eps = theta - phi = sin(theta) dc - cos(theta) ds to first order:
+//   eps ~= -sqrt(2) K_0 cos(theta + pi/4) - sum K_n sin((n - 1) theta)   (Hanselman eq. 9)
+//          - sum K_n_opp sin((n + 1) theta)
+// so K_3 lands on 2theta like amplitude imbalance, K_2 on 1theta like offsets, and
+// K_3_opp, K_5 and K_7_opp ... on 4theta, 4theta, 8theta: only the sin/cos signals
 // tell them apart (DESIGN 6). Omitted terms are second order in the K's.
 #pragma once
 
@@ -18,12 +24,14 @@
 namespace resolver {
 
 struct Harmonics {
-  /// Highest harmonic order a spec may set (k2 .. k16).
-  static constexpr int kMaxOrder = 16;
+  /// Highest harmonic order a spec may set (k2 .. k20, k2_opp .. k20_opp).
+  static constexpr int kMaxOrder = 20;
   /// [fraction of fundamental] inductive DC component K_0.
   double k0 = 0.0;
   /// [fraction of fundamental] K_n at index n for n = 2..kMaxOrder; k[0], k[1] are unused (stay 0).
   std::array<double, kMaxOrder + 1> k{};
+  /// [fraction of fundamental] opposite-sequence K_n at index n for n = 2..kMaxOrder.
+  std::array<double, kMaxOrder + 1> k_opp{};
 
   [[nodiscard]] bool active() const;
 };
@@ -34,5 +42,9 @@ struct Harmonics {
 
 /// Small-K position error eps = theta - phi [rad] (Hanselman eq. 9).
 [[nodiscard]] double harmonics_error(const Harmonics& p, double theta);
+
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& harmonics_effect();
 
 }  // namespace resolver

@@ -1,6 +1,9 @@
 #include "daemon/core/effects/mounting_offset.h"
 
+#include <array>
 #include <cmath>
+
+#include "daemon/core/effects/effect.h"
 
 #include "daemon/core/angles.h"
 
@@ -28,6 +31,48 @@ double estimate_mounting_offset(double i_d_ref, double i_q_ref, double i_d_cmd, 
 
 double compensate_mounting_offset(const MountingOffset& m, double theta_e_drive) {
   return theta_e_drive - m.theta_0;
+}
+
+}  // namespace resolver
+
+// ---- registry unit ------------------------------------------------------------
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "theta_0", .unit = "[rad]",
+              .description = "drive (resolver) zero ahead of the rotor d axis (motor electrical rad)", .min = -kPi,
+              .max = kPi},
+};
+
+class MountingOffsetEffect final : public BasicEffect {
+ public:
+  MountingOffsetEffect()
+      : BasicEffect({"mounting_offset",
+                     "drive angle = theta_e + theta_0: eps = -(p_r/p) theta_0; steady i_d = -i_q sin theta_0 in the "
+                     "reference frame",
+                     "DESIGN 6; mounting_offset.h",
+                     "the resolver is mounted at an angle: a constant position error against the reference, the same "
+                     "at every speed and in both directions"},
+                    kParams, EffectStage::kMotion) {}
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  [[nodiscard]] double resolver_angle_shift(Values v, int p_r, int p) const override {
+    return mounting_offset_resolver_shift(MountingOffset{v[0]}, p_r, p);
+  }
+  [[nodiscard]] double drive_frame_offset(Values v) const override { return v[0]; }
+  // The dq currents against the reference show the offset only as a steady
+  // current, which the operating point (the fit's DC i_d, i_q) absorbs: no dq column.
+  void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
+    const double r = static_cast<double>(row.p_r) / static_cast<double>(row.p);
+    out.col(0) = shift_column(-r, r);
+  }
+};
+
+}  // namespace
+
+const Effect& mounting_offset_effect() {
+  static const MountingOffsetEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

@@ -55,4 +55,8 @@ struct MountingOffset {
 /// Compensation: the rotor electrical angle [rad] from the drive's theta_e_drive [rad].
 [[nodiscard]] double compensate_mounting_offset(const MountingOffset& m, double theta_e_drive);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& mounting_offset_effect();
+
 }  // namespace resolver

@@ -1,4 +1,6 @@
 #include "daemon/core/effects/noise.h"
+#include <array>
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -8,6 +10,61 @@ double gaussian_noise(NoiseEngine& engine, double sigma) {
   // the sequence depends only on the engine state.
   std::normal_distribution<double> dist(0.0, sigma);
   return dist(engine);
+}
+
+// ---- registry unit ------------------------------------------------------------
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "sigma_sc", .unit = "[counts]", .description = "white noise on each sin/cos ADC sample",
+              .min = 0.0, .max = 32767.0},
+    ParamInfo{.name = "sigma_i", .unit = "[A]", .description = "white noise on each phase current sample",
+              .min = 0.0, .max = 1000.0},
+};
+
+class NoiseEffect final : public BasicEffect {
+ public:
+  NoiseEffect()
+      : BasicEffect({"noise", "white noise on sin/cos samples and phase currents; sets the floor", "DESIGN 6",
+                     "measurement noise: the floor every residual is compared with"},
+                    kParams, EffectStage::kNoise) {}
+  [[nodiscard]] bool fittable() const override { return false; }
+  void impairments(Values v, Impairments& imp) const override {
+    imp.sigma_sc += v[0];
+    imp.sigma_i += v[1];
+  }
+};
+
+constexpr std::array kOutlierParams{
+    ParamInfo{.name = "rate", .unit = "[1/s]", .description = "impulsive samples (EMI spikes) on the sin channel",
+              .min = 0.0, .max = 1e5},
+    ParamInfo{.name = "size", .unit = "[counts]", .description = "size of each spike (random sign)", .min = 0.0,
+              .max = 65535.0},
+};
+
+class OutliersEffect final : public BasicEffect {
+ public:
+  OutliersEffect()
+      : BasicEffect({"outliers", "impulsive samples on the sin channel (EMI, bit errors): never part of a model",
+                     "issue 14", "impulsive samples: found by a robust test and kept out of the fit"},
+                    kOutlierParams, EffectStage::kNoise) {}
+  [[nodiscard]] bool fittable() const override { return false; }
+  void impairments(Values v, Impairments& imp) const override {
+    imp.outlier_rate += v[0];
+    imp.outlier_size = v[1];
+  }
+};
+
+}  // namespace
+
+const Effect& noise_effect() {
+  static const NoiseEffect effect;
+  return effect;
+}
+
+const Effect& outliers_effect() {
+  static const OutliersEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

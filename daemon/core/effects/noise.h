@@ -28,4 +28,10 @@ using NoiseEngine = std::mt19937_64;
 /// the draws of the others.
 [[nodiscard]] double gaussian_noise(NoiseEngine& engine, double sigma);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& noise_effect();
+/// Impulsive samples (EMI spikes, bit errors): a simulator impairment the fit must keep out.
+[[nodiscard]] const Effect& outliers_effect();
+
 }  // namespace resolver

@@ -25,4 +25,8 @@ struct Offsets {
 /// Small-offset position error eps = theta - phi [rad] at resolver angle theta [rad].
 [[nodiscard]] double offsets_error(const Offsets& p, double theta);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& offsets_effect();
+
 }  // namespace resolver

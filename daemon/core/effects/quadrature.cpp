@@ -1,6 +1,10 @@
 #include "daemon/core/effects/quadrature.h"
 
+#include <array>
 #include <cmath>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -10,6 +14,49 @@ SinCos quadrature_fundamental(const Quadrature& p, double theta) {
 
 double quadrature_error(const Quadrature& p, double theta) {
   return -0.5 * p.beta * (1.0 - std::cos(2.0 * theta));
+}
+
+// ---- registry unit ------------------------------------------------------------
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "beta", .unit = "[rad]", .description = "misalignment of the cos winding", .min = -0.5,
+              .max = 0.5},
+};
+
+class QuadratureEffect final : public BasicEffect {
+ public:
+  QuadratureEffect()
+      : BasicEffect({"quadrature", "cos channel cos(theta+beta); eps ~ -(beta/2)(1 - cos 2theta)",
+                     "Hanselman eq. 6-7 (sign checked: eps = theta - phi)",
+                     "the cos winding is not at 90 degrees: position error at 2 theta in phase with cos 2 theta plus "
+                     "a constant, independent of speed, seen by the R/D angle and the sin/cos signals alike"},
+                    kParams, EffectStage::kWindings) {}
+  void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {
+    if (stage == WindingStage::kFundamental) env = quadrature_fundamental(Quadrature{v[0]}, theta);
+  }
+  // rd: -(1/2)(1 - cos 2theta) per unit beta, through the converter (first order;
+  // the omitted terms are O(beta^2)). c: the exact derivative of cos(theta + beta).
+  void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignatureColumns& out) const override {
+    const double th = b.env_angle();
+    out.col(0) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + v[0]));
+  }
+  [[nodiscard]] bool linear_in_params() const override { return false; }
+  void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
+    const double th = b.env_angle();
+    out.rd += -0.5 * v[0] * (1.0 - b.rd_cos(2));
+    // The pair (sin th, cos(th + beta)) exactly.
+    const double sn = b.env_sin(1), cq = std::cos(th + v[0]);
+    out.sa += wrap_pi(th - std::atan2(sn, cq));
+    out.sr += std::hypot(sn, cq) - 1.0;
+  }
+};
+
+}  // namespace
+
+const Effect& quadrature_effect() {
+  static const QuadratureEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

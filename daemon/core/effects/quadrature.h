@@ -31,4 +31,8 @@ struct Quadrature {
 /// (Hanselman eq. 7 with the sign checked against the exact model, see above).
 [[nodiscard]] double quadrature_error(const Quadrature& p, double theta);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& quadrature_effect();
+
 }  // namespace resolver

@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
+#include <array>
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -17,5 +19,31 @@ std::uint16_t quantize_rd_angle(double phi, int rd_bits) {
 }
 
 double rd_counts_to_angle(std::uint16_t counts) { return static_cast<double>(counts) * (kTwoPi / 65536.0); }
+
+// ---- registry unit ------------------------------------------------------------
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "rd_bits", .unit = "[bits]", .description = "R/D converter resolution",
+              .min = Quantization::kMinBits, .max = Quantization::kMaxBits, .neutral = Quantization::kMaxBits,
+              .integer = true},
+};
+
+class QuantizationEffect final : public BasicEffect {
+ public:
+  QuantizationEffect()
+      : BasicEffect({"quantization", "R/D angle rounded to 2pi/2^rd_bits; uniform +-1/2 LSB", "Hanselman Table I",
+                     "the converter's resolution: a uniform error of +-1/2 LSB that sets part of the floor"},
+                    kParams, EffectStage::kConverter) {}
+  [[nodiscard]] bool fittable() const override { return false; }
+  void converter(Values v, ConverterSpec& spec) const override { spec.rd_bits = static_cast<int>(v[0]); }
+};
+
+}  // namespace
+
+const Effect& quantization_effect() {
+  static const QuantizationEffect effect;
+  return effect;
+}
 
 }  // namespace resolver

@@ -29,4 +29,8 @@ struct Quantization {
 /// The angle [rad] in [0, 2pi) a u16 rd_angle field value stands for.
 [[nodiscard]] double rd_counts_to_angle(std::uint16_t counts);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& quantization_effect();
+
 }  // namespace resolver

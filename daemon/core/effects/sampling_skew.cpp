@@ -1,6 +1,8 @@
 #include "daemon/core/effects/sampling_skew.h"
 
 #include <cmath>
+#include <array>
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -15,6 +17,39 @@ SinCos compensate_sampling_skew(const SamplingSkew& p, const SinCos& sampled, do
   // c = cos(theta + beta) = cos(theta) cos(beta) - sin(theta) sin(beta), s = sin(theta).
   const double beta = sampling_skew_beta(p, omega_hat);
   return {sampled.s, (sampled.c + sampled.s * std::sin(beta)) / std::cos(beta)};
+}
+
+// ---- registry unit ------------------------------------------------------------
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "tau", .unit = "[s]", .description = "delay of the DSP's cos sample after the sin sample",
+              .min = -1e-3, .max = 1e-3},
+};
+
+class SamplingSkewEffect final : public BasicEffect {
+ public:
+  SamplingSkewEffect()
+      : BasicEffect({"sampling_skew",
+                     "cos sampled tau after sin: like quadrature with beta = omega tau on the sampled sin/cos "
+                     "(not the R/D angle); grows with speed",
+                     "DESIGN 6, Hanselman eq. 6-7 via beta = omega tau",
+                     "the cos channel is sampled after the sin channel: a quadrature-like error of the sin/cos pair "
+                     "that grows with speed and that the R/D angle does not show"},
+                    kParams, EffectStage::kChannels) {}
+  [[nodiscard]] bool needs_speed_change() const override { return true; }
+  void channel_timing(Values v, ChannelTiming& timing) const override { timing.dsp_cos_dt += v[0]; }
+  // c = C(theta(t + tau)) = cos(theta + omega tau): dc/dtau = -omega sin theta (first order).
+  void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
+    out.col(0) = envelope_column(b, 0.0, 0.0, -row.omega * b.env_sin(1));
+  }
+};
+
+}  // namespace
+
+const Effect& sampling_skew_effect() {
+  static const SamplingSkewEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

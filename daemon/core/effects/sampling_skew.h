@@ -52,4 +52,8 @@ struct SamplingSkew {
 /// Requires |omega_hat tau| < pi/2 (not checked).
 [[nodiscard]] SinCos compensate_sampling_skew(const SamplingSkew& p, const SinCos& sampled, double omega_hat);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& sampling_skew_effect();
+
 }  // namespace resolver

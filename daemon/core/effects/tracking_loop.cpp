@@ -1,6 +1,10 @@
 #include "daemon/core/effects/tracking_loop.h"
 
+#include <array>
 #include <complex>
+#include <stdexcept>
+
+#include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
@@ -50,6 +54,56 @@ double tracking_loop_gain(const TrackingLoopConfig& config, double omega) {
 double tracking_loop_phase(const TrackingLoopConfig& config, double omega) {
   if (!config.active()) return 0.0;
   return std::arg(closed_loop(config, omega));
+}
+
+}  // namespace resolver
+
+// ---- registry unit ------------------------------------------------------------
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "omega_n", .unit = "[rad/s]", .description = "closed-loop natural frequency (0 = ideal converter)",
+              .min = 0.0, .max = 1e6, .neutral = 0.0, .nonlinear = true, .scale = FitScale::kInverseSquare},
+    ParamInfo{.name = "zeta", .unit = "[1]", .description = "closed-loop damping ratio", .min = 0.01, .max = 10.0,
+              .neutral = 0.7, .nonlinear = true, .default_fit = false},
+};
+
+class TrackingLoopEffect final : public BasicEffect {
+ public:
+  TrackingLoopEffect()
+      : BasicEffect({"tracking_loop", "type-II R/D loop: error ripple filtered by H(s), lag a/omega_n^2 under acceleration",
+                     "Hanselman II.A, Hwang Fig. 2; tracking_loop.h",
+                     "the R/D converter's closed loop filters the error harmonics: the ripple of the R/D angle changes "
+                     "in amplitude and phase with speed, the sin/cos signals do not"},
+                    kParams, EffectStage::kConverter) {}
+  [[nodiscard]] bool needs_speed_change() const override { return true; }
+  [[nodiscard]] bool active(Values v) const override { return v[0] > 0.0; }
+  void validate(Values v) const override {
+    if (v[0] > 0.0 && !(v[1] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
+  }
+  void converter(Values v, ConverterSpec& spec) const override {
+    spec.omega_n = v[0];
+    spec.zeta = v[1];
+  }
+  void configure_basis(Values v, BasisTransform& t) const override {
+    t.omega_n = v[0];
+    t.zeta = v[1];
+  }
+  // Both parameters act through the basis (every other effect's rd harmonics),
+  // so they have no columns of their own; the fit differentiates numerically.
+  // The loop's own term: a type-II loop lags a constant acceleration a by a / omega_n^2.
+  [[nodiscard]] bool linear_in_params() const override { return false; }
+  void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
+    if (v[0] > 0.0) out.rd += row.accel / (v[0] * v[0]);
+  }
+};
+
+}  // namespace
+
+const Effect& tracking_loop_effect() {
+  static const TrackingLoopEffect effect;
+  return effect;
 }
 
 }  // namespace resolver

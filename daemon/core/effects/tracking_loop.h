@@ -99,4 +99,8 @@ class TrackingLoop {
 /// The linearised closed-loop phase arg H(j omega) [rad].
 [[nodiscard]] double tracking_loop_phase(const TrackingLoopConfig& config, double omega);
 
+/// The registry unit of this effect (registry.h).
+class Effect;
+[[nodiscard]] const Effect& tracking_loop_effect();
+
 }  // namespace resolver

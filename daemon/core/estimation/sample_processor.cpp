@@ -12,6 +12,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
 std::optional<EstimatorMethod> estimator_from_name(std::string_view name) {
+  if (name == "model") return EstimatorMethod::kModel;
   if (name == "hwang_integral") return EstimatorMethod::kHwangIntegral;
   if (name == "sincos_least_squares") return EstimatorMethod::kSinCosLeastSquares;
   if (name == "fourier_reference") return EstimatorMethod::kFourierReference;
@@ -20,6 +21,7 @@ std::optional<EstimatorMethod> estimator_from_name(std::string_view name) {
 
 std::string_view estimator_name(EstimatorMethod method) {
   switch (method) {
+    case EstimatorMethod::kModel: return "model";
     case EstimatorMethod::kHwangIntegral: return "hwang_integral";
     case EstimatorMethod::kSinCosLeastSquares: return "sincos_least_squares";
     case EstimatorMethod::kFourierReference: return "fourier_reference";
@@ -56,8 +58,16 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
 
   const double p_r = config_.p_r;
   ++samples_;
-  // Feed the active estimator.
+  // Feed the active estimator. Hwang's integral runs beside every method (the
+  // seed's baseline the reports show next to the default).
+  if (config_.method != EstimatorMethod::kHwangIntegral) out.revolution = estimator_.update(in.t, theta_meas);
   switch (config_.method) {
+    case EstimatorMethod::kModel:
+      if (model_updated_) {
+        model_updated_ = false;
+        out.estimate_updated = true;
+      }
+      break;
     case EstimatorMethod::kHwangIntegral:
       out.revolution = estimator_.update(in.t, theta_meas);
       if (out.revolution) {
@@ -95,10 +105,23 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
     }
   }
 
-  out.speed_mech = speed_.update(in.t, theta_meas) / p_r;
+  const double omega = speed_.update(in.t, theta_meas);
+  out.speed_mech = omega / p_r;
   // Compensation (DESIGN 3 sign): theta_c = theta_rd + eps_hat.
-  out.eps_hat = compensation_eps(in, theta_meas);
-  out.theta_comp = wrap_2pi(theta_meas + out.eps_hat);
+  if (config_.method == EstimatorMethod::kModel) {
+    if (config_.compensate && model_set_) {
+      const bool signal = config_.domain == CompensationDomain::kSignal && in.has_sincos;
+      out.theta_comp = compensator_.correct(signal ? out.theta_sincos : theta_meas, in.t, omega, 0.0, signal);
+      out.eps_hat = wrap_pi(out.theta_comp - theta_meas);
+      if (in.has_ref) compensator_.learn_reference(wrap_2pi(in.theta_m_ref));
+    } else {
+      out.eps_hat = 0.0;
+      out.theta_comp = theta_meas;
+    }
+  } else {
+    out.eps_hat = compensation_eps(in, theta_meas);
+    out.theta_comp = wrap_2pi(theta_meas + out.eps_hat);
+  }
 
   double theta_ref_cont = kNaN;
   if (in.has_ref) {
@@ -145,9 +168,18 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   return out;
 }
 
+void SampleProcessor::set_model(Model model, std::int64_t samples, double revolutions) {
+  compensator_ = Compensator(std::move(model));
+  model_set_ = true;
+  model_updated_ = true;
+  model_samples_ = samples;
+  model_revolutions_ = revolutions;
+}
+
 bool SampleProcessor::compensating() const {
   if (!config_.compensate) return false;
   switch (config_.method) {
+    case EstimatorMethod::kModel: return model_set_ && compensator_.active();
     case EstimatorMethod::kHwangIntegral: return active_alpha_ != 0.0;
     case EstimatorMethod::kSinCosLeastSquares: return sincos_fit_.has_value() && revolutions_ >= 1;
     case EstimatorMethod::kFourierReference: return fourier_fit_.has_value() && revolutions_ >= 1;
@@ -158,6 +190,7 @@ bool SampleProcessor::compensating() const {
 double SampleProcessor::compensation_eps(const SampleInput& in, double theta_meas) const {
   if (!compensating()) return 0.0;
   switch (config_.method) {
+    case EstimatorMethod::kModel: return 0.0;  // the compensator's (process())
     case EstimatorMethod::kHwangIntegral:
       return amplitude_imbalance_eps(active_alpha_, theta_meas);
     case EstimatorMethod::kSinCosLeastSquares: {
@@ -187,6 +220,14 @@ ModelEstimate SampleProcessor::estimate() const {
   e.samples = samples_;
   e.revolutions = static_cast<double>(revolutions_);
   switch (config_.method) {
+    case EstimatorMethod::kModel:
+      for (const ModelParameter& p : compensator_.model().parameters()) {
+        e.params.push_back({p.name, p.value, p.std_error});
+      }
+      e.samples = model_samples_;
+      e.revolutions = model_revolutions_;
+      e.converged = model_set_;
+      break;
     case EstimatorMethod::kHwangIntegral:
       e.params = {{"amplitude_imbalance.alpha", estimator_.alpha(), estimator_.alpha_stderr()}};
       e.samples = estimator_.samples_used();

@@ -25,6 +25,7 @@
 #include "daemon/core/estimation/sincos_least_squares.h"
 #include "daemon/core/estimation/revolution_ripple.h"
 #include "daemon/core/estimation/speed_estimator.h"
+#include "daemon/core/model/compensator.h"
 
 namespace resolver {
 
@@ -33,7 +34,12 @@ using SampleInput = Sample;
 
 /// Which estimator runs (DESIGN 6 "Estimators to provide and compare").
 enum class EstimatorMethod : std::uint8_t {
-  kHwangIntegral,      ///< R/D angle only, constant speed: alpha (Hwang 2009)
+  /// The active model ([model] effects) fitted by the live model fit on the
+  /// signals present (sin/cos and R/D angle against the reference when there is
+  /// one, self-calibrated otherwise), compensated by inverting it (compensator.h).
+  /// The default: the best estimator for the signals the log has.
+  kModel,
+  kHwangIntegral,      ///< R/D angle only, constant speed: alpha (Hwang 2009), the seed baseline
   kSinCosLeastSquares, ///< sin/cos envelopes: alpha, beta, offsets (+ harmonics with a reference)
   kFourierReference,   ///< position error vs reference angle, Fourier series (Hanselman III.A)
 };
@@ -61,7 +67,7 @@ struct ModelEstimate {
 };
 
 struct ProcessorConfig {
-  EstimatorMethod method = EstimatorMethod::kHwangIntegral;
+  EstimatorMethod method = EstimatorMethod::kModel;
   CompensationDomain domain = CompensationDomain::kAngle;
   SinCosLsConfig sincos;
   AngleFourierConfig fourier;
@@ -124,6 +130,13 @@ class SampleProcessor {
   }
   /// alpha used by the compensation now (0 until the estimator converged or a seed).
   [[nodiscard]] double active_alpha() const { return active_alpha_; }
+  /// Method kModel: compensate with `model` from now on (a live window's fit, or a
+  /// persisted calibration at start). `samples`, `revolutions`: what it was fitted on.
+  void set_model(Model model, std::int64_t samples, double revolutions);
+  /// The model compensating now (empty before the first fit).
+  [[nodiscard]] const Model& model() const { return compensator_.model(); }
+  /// Hwang's integral runs beside every method, as the seed's baseline for reports.
+  [[nodiscard]] const HwangIntegralEstimator& hwang() const { return estimator_; }
 
  private:
   double compensation_eps(const SampleInput& in, double theta_meas) const;
@@ -144,6 +157,11 @@ class SampleProcessor {
   RevolutionRipple ripple_raw_, ripple_comp_, ripple_ref_;
   RippleSet ripple_;
   double active_alpha_ = 0.0;
+  Compensator compensator_;
+  bool model_set_ = false;
+  bool model_updated_ = false;   ///< a new model arrived: estimate_t on the next sample
+  std::int64_t model_samples_ = 0;
+  double model_revolutions_ = 0.0;
 };
 
 }  // namespace resolver

@@ -12,7 +12,7 @@
 
 #include "daemon/app/pipeline.h"
 #include "daemon/core/discovery/model_window.h"
-#include "daemon/core/effects/effect_catalog.h"
+#include "daemon/core/effects/chain_values.h"
 #include "tools/sim/bench_simulator.h"
 
 namespace resolver {
@@ -31,8 +31,7 @@ std::vector<CanFrame> simulate_frames(const std::vector<std::string>& specs, dou
   SimConfig cfg;
   cfg.profile = {{seconds, 200.0, 200.0}};
   for (const auto& s : specs) {
-    const auto err = apply_effect_spec(cfg.chain, s);
-    EXPECT_FALSE(err.has_value()) << *err;
+    cfg.chain.apply_spec(s);
   }
   BenchSimulator sim(cfg);
   std::vector<CanFrame> frames;
@@ -93,7 +92,7 @@ TEST(LiveModelFit, DisabledPublishesNothingAndAStoppedMotorSaysInsufficientData)
   SimSample s{};
   int completed = 0;
   for (int i = 0; i < 2500 && sim.next(s); ++i) {
-    DiscoverySample d;
+    Sample d;
     d.has_rd = true;
     d.theta_rd = s.rd_angle;
     if (w.add(d, 3, 3)) {

@@ -13,7 +13,7 @@
 
 #include "daemon/core/angles.h"
 #include "daemon/core/discovery/model_discovery.h"
-#include "daemon/core/effects/effect_catalog.h"
+#include "daemon/core/effects/chain_values.h"
 #include "daemon/decode/bench_layout.h"
 #include "tools/sim/bench_simulator.h"
 
@@ -26,8 +26,7 @@ DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<Speed
   cfg.profile = std::move(profile);
   cfg.alpha_drift_per_s = alpha_drift_per_s;
   for (const auto& s : specs) {
-    const auto err = apply_effect_spec(cfg.chain, s);
-    EXPECT_FALSE(err.has_value()) << *err;
+    cfg.chain.apply_spec(s);
   }
   BenchSimulator sim(cfg);
   DiscoveryInput in;
@@ -35,7 +34,7 @@ DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<Speed
   in.p = cfg.p;
   SimSample s{};
   while (sim.next(s)) {
-    DiscoverySample d;
+    Sample d;
     d.t = static_cast<double>(s.t_us - cfg.start_time_us) * 1e-6;
     d.has_rd = true;
     d.theta_rd = s.rd_angle;

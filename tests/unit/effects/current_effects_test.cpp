@@ -1,5 +1,6 @@
 // The current-domain effects added in catalog v2: current sensor offsets, gain
-// mismatch and inverter dead time. Each forward model (on phase currents),
+// mismatch and inverter dead time. Each forward model (on phase currents: the
+// registry's forward chain, forward_chain.h, machine then measured currents),
 // transformed with an independent Clarke/Park (DESIGN 3), is Fourier-analysed
 // over one electrical turn and compared with the closed-form ripple the effect's
 // header predicts. The models are linear in the currents, so the only error is
@@ -13,14 +14,24 @@
 #include <numbers>
 
 #include "daemon/core/angles.h"
-#include "daemon/core/effects/sensor_chain.h"
+#include "daemon/core/effects/current_gain_mismatch.h"
+#include "daemon/core/effects/current_offsets.h"
+#include "daemon/core/effects/dead_time.h"
+#include "tests/unit/effects/chain_test_support.h"
 
 namespace resolver {
 namespace {
 
+using test::forward_chain;
+
 constexpr int kN = 720;          // theta_e grid over one electrical turn
 constexpr int kMaxOrder = 8;     // orders 0..8 analysed
 constexpr double kRound = 1e-10;  // [A] see the file comment
+
+/// What the current sensors report for the command (i_d, i_q) [A] at true theta_e [rad].
+PhaseCurrents measured_currents(const ForwardChain& chain, double i_d, double i_q, double theta_e) {
+  return chain.measured_currents(chain.machine_currents(i_d, i_q, theta_e), theta_e);
+}
 
 DqCurrents to_dq(const PhaseCurrents& i, double theta_e) {
   const double i_alpha = i.a;
@@ -70,24 +81,22 @@ void expect_only(const Spectrum& s, int order, DqCurrents mean, DqCurrents ampli
 
 TEST(EffectsCurrentOffsets, RippleAtOneTimesThetaE) {
   for (const auto& [off_a, off_b] : {std::pair{0.05, -0.03}, std::pair{0.0, 0.1}, std::pair{-0.2, 0.0}}) {
-    SensorChainConfig chain;
-    chain.current_offsets = {off_a, off_b};
+    const CurrentOffsets offsets{off_a, off_b};
+    const ForwardChain chain = forward_chain({{"current_offsets", "off_a", off_a}, {"current_offsets", "off_b", off_b}});
     const double i_d = -2.0;
     const double i_q = 10.0;
-    const auto measured = [&](double theta_e) {
-      return phase_currents_measured(chain, phase_currents_true(chain, i_d, i_q, theta_e));
-    };
+    const auto measured = [&](double theta_e) { return measured_currents(chain, i_d, i_q, theta_e); };
     // Clarke turns (off_a, off_b, 0) into the constant vector (off_a, off_b/sqrt3); Park spins it at -theta_e.
     const double amp = std::hypot(off_a, off_b / std::numbers::sqrt3);
-    EXPECT_NEAR(current_offsets_ripple_1x(chain.current_offsets), amp, 1e-15);
+    EXPECT_NEAR(current_offsets_ripple_1x(offsets), amp, 1e-15);
     expect_only(dq_spectrum(measured), 1, {i_d, i_q}, {amp, amp});
     for (int k = 0; k < 36; ++k) {
       const double theta_e = kTwoPi * k / 36.0;
-      const DqCurrents err = current_offsets_dq_error(chain.current_offsets, theta_e);
+      const DqCurrents err = current_offsets_dq_error(offsets, theta_e);
       const DqCurrents dq = to_dq(measured(theta_e), theta_e);
       EXPECT_NEAR(dq.d - i_d, err.d, kRound);
       EXPECT_NEAR(dq.q - i_q, err.q, kRound);
-      const PhaseCurrents back = compensate_current_offsets(chain.current_offsets, measured(theta_e));
+      const PhaseCurrents back = compensate_current_offsets(offsets, measured(theta_e));
       const PhaseCurrents ideal = ideal_phase_currents(i_d, i_q, theta_e);
       EXPECT_NEAR(back.a, ideal.a, kRound);
       EXPECT_NEAR(back.b, ideal.b, kRound);
@@ -105,11 +114,10 @@ TEST(EffectsCurrentGainMismatch, RippleAtTwoTimesThetaE) {
   };
   for (const Case& c : {Case{0.01, 0.0, 0.0, 10.0}, Case{0.0, -0.02, 0.0, 10.0}, Case{0.01, 0.01, -3.0, 8.0},
                         Case{0.02, -0.01, 5.0, 0.0}}) {
-    SensorChainConfig chain;
-    chain.current_gain_mismatch = {c.gain_a, c.gain_b};
-    const auto measured = [&](double theta_e) {
-      return phase_currents_measured(chain, phase_currents_true(chain, c.i_d, c.i_q, theta_e));
-    };
+    const CurrentGainMismatch gains{c.gain_a, c.gain_b};
+    const ForwardChain chain =
+        forward_chain({{"current_gain_mismatch", "gain_a", c.gain_a}, {"current_gain_mismatch", "gain_b", c.gain_b}});
+    const auto measured = [&](double theta_e) { return measured_currents(chain, c.i_d, c.i_q, theta_e); };
     // Derivation (current_gain_mismatch.h): I = i_d + j i_q, i_a = Re(I e^{j th}),
     // i_b = Re(I e^{j(th - 2pi/3)}); the dq error (g_a i_a + j g_b i_b / sqrt3) e^{-j th} is
     //   I (g_a + g_b/2 - j g_b/(2 sqrt3))/2 + I* (g_a - g_b/2 - j g_b/(2 sqrt3))/2 e^{-2j th}.
@@ -117,17 +125,17 @@ TEST(EffectsCurrentGainMismatch, RippleAtTwoTimesThetaE) {
     const double k3 = c.gain_b / (2.0 * std::numbers::sqrt3);
     const std::complex<double> dc = current * std::complex<double>(c.gain_a + 0.5 * c.gain_b, -k3) * 0.5;
     const double amp = 0.5 * std::abs(current) * std::abs(std::complex<double>(c.gain_a - 0.5 * c.gain_b, -k3));
-    EXPECT_NEAR(current_gain_mismatch_ripple_2x(chain.current_gain_mismatch, c.i_d, c.i_q), amp, 1e-15);
+    EXPECT_NEAR(current_gain_mismatch_ripple_2x(gains, c.i_d, c.i_q), amp, 1e-15);
     const Spectrum s = dq_spectrum(measured);
     expect_only(s, 2, {c.i_d + dc.real(), c.i_q + dc.imag()}, {amp, amp});
     EXPECT_GT(amp, 0.01) << "a visible ripple: the check above is not vacuous";
     for (int k = 0; k < 36; ++k) {
       const double theta_e = kTwoPi * k / 36.0;
-      const DqCurrents err = current_gain_mismatch_dq_error(chain.current_gain_mismatch, c.i_d, c.i_q, theta_e);
+      const DqCurrents err = current_gain_mismatch_dq_error(gains, c.i_d, c.i_q, theta_e);
       const DqCurrents dq = to_dq(measured(theta_e), theta_e);
       EXPECT_NEAR(dq.d - c.i_d, err.d, kRound);
       EXPECT_NEAR(dq.q - c.i_q, err.q, kRound);
-      const PhaseCurrents back = compensate_current_gain_mismatch(chain.current_gain_mismatch, measured(theta_e));
+      const PhaseCurrents back = compensate_current_gain_mismatch(gains, measured(theta_e));
       const PhaseCurrents ideal = ideal_phase_currents(c.i_d, c.i_q, theta_e);
       EXPECT_NEAR(back.a, ideal.a, kRound);
       EXPECT_NEAR(back.b, ideal.b, kRound);
@@ -136,17 +144,17 @@ TEST(EffectsCurrentGainMismatch, RippleAtTwoTimesThetaE) {
 }
 
 TEST(EffectsDeadTime, FifthAndSeventhGiveRippleAtSixTimesThetaE) {
-  for (const auto& [i_d, i_q] : {std::pair{0.0, 10.0}, std::pair{-4.0, 6.0}, std::pair{5.0, 0.0}}) {
-    SensorChainConfig chain;
-    chain.dead_time.t_d = 2e-6;  // [s] -> k_dt = 0.02
+  for (const auto& current : {std::pair{0.0, 10.0}, std::pair{-4.0, 6.0}, std::pair{5.0, 0.0}}) {
+    const double i_d = current.first;  // [A] (locals, not a structured binding: lambdas capture them)
+    const double i_q = current.second;
+    const DeadTime dead{2e-6};  // [s] -> k_dt = 0.02
+    const ForwardChain chain = forward_chain({{"dead_time", "t_d", dead.t_d}});
     const double k = 2e-6 / 100e-6;
-    EXPECT_DOUBLE_EQ(chain.dead_time.k_dt(), k);
-    const auto measured = [&](double theta_e) {
-      return phase_currents_measured(chain, phase_currents_true(chain, i_d, i_q, theta_e));
-    };
+    EXPECT_DOUBLE_EQ(dead.k_dt(), k);
+    const auto measured = [&](double theta_e) { return measured_currents(chain, i_d, i_q, theta_e); };
     // Header: delta i_d = 2 k i_q cos(6(theta_e + delta)), delta i_q = -2 k i_d cos(...).
     expect_only(dq_spectrum(measured), 6, {i_d, i_q}, {2.0 * k * std::abs(i_q), 2.0 * k * std::abs(i_d)});
-    const DqCurrents predicted = dead_time_ripple_6x(chain.dead_time, i_d, i_q);
+    const DqCurrents predicted = dead_time_ripple_6x(dead, i_d, i_q);
     EXPECT_NEAR(predicted.d, 2.0 * k * std::abs(i_q), 1e-15);
     EXPECT_NEAR(predicted.q, 2.0 * k * std::abs(i_d), 1e-15);
     // Phase a itself: 5th and 7th harmonics of k |I| each, no 3rd (three-wire), sum zero.
@@ -157,7 +165,7 @@ TEST(EffectsDeadTime, FifthAndSeventhGiveRippleAtSixTimesThetaE) {
       const PhaseCurrents cur = measured(theta_e);
       ASSERT_NEAR(cur.a + cur.b + cur.c, 0.0, kRound);
       for (int n = 0; n < 8; ++n) phase_a[static_cast<std::size_t>(n)] += cur.a * std::polar(2.0 / kN, -n * theta_e);
-      const DqCurrents err = dead_time_dq_error(chain.dead_time, i_d, i_q, theta_e);
+      const DqCurrents err = dead_time_dq_error(dead, i_d, i_q, theta_e);
       const DqCurrents dq = to_dq(cur, theta_e);
       ASSERT_NEAR(dq.d - i_d, err.d, kRound);
       ASSERT_NEAR(dq.q - i_q, err.q, kRound);
@@ -170,19 +178,20 @@ TEST(EffectsDeadTime, FifthAndSeventhGiveRippleAtSixTimesThetaE) {
 }
 
 TEST(EffectsCurrentChain, IdealChainIsIdealControlAndEffectsCompose) {
-  const SensorChainConfig ideal;
-  SensorChainConfig chain;
-  chain.current_gain_mismatch = {0.01, -0.02};
-  chain.current_offsets = {0.05, -0.04};
+  const ForwardChain ideal = forward_chain({});
+  const ForwardChain chain = forward_chain({{"current_gain_mismatch", "gain_a", 0.01},
+                                            {"current_gain_mismatch", "gain_b", -0.02},
+                                            {"current_offsets", "off_a", 0.05},
+                                            {"current_offsets", "off_b", -0.04}});
   for (int k = 0; k < 36; ++k) {
     const double theta_e = kTwoPi * k / 36.0;
     const PhaseCurrents want = ideal_phase_currents(1.0, 9.0, theta_e);
-    const PhaseCurrents got = phase_currents_measured(ideal, phase_currents_true(ideal, 1.0, 9.0, theta_e));
+    const PhaseCurrents got = measured_currents(ideal, 1.0, 9.0, theta_e);
     EXPECT_EQ(got.a, want.a);
     EXPECT_EQ(got.b, want.b);
     EXPECT_EQ(got.c, want.c);
     // Sensor order: gain first, then offset (an offset is not scaled by the gain error).
-    const PhaseCurrents m = phase_currents_measured(chain, want);
+    const PhaseCurrents m = chain.measured_currents(want, theta_e);
     EXPECT_NEAR(m.a, 1.01 * want.a + 0.05, 1e-14);
     EXPECT_NEAR(m.b, 0.98 * want.b - 0.04, 1e-14);
     EXPECT_EQ(m.c, want.c);

@@ -6,7 +6,7 @@
 
 #include "daemon/core/angles.h"
 #include "daemon/core/effects/phase_currents.h"
-#include "daemon/core/effects/sensor_chain.h"
+#include "tests/unit/effects/chain_test_support.h"
 
 namespace resolver {
 namespace {
@@ -59,8 +59,7 @@ TEST(EffectsPhaseCurrents, ImbalanceShowsHwangEq15InD) {
   // q ripple is O(alpha^2), checked below.)
   const double i_m = 10.0;
   const double alpha = 0.003;  // Hwang's experiment: 0.3 %
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = alpha;
+  const ForwardChain chain = test::forward_chain({{"amplitude_imbalance", "alpha", alpha}});
   // |eps - (alpha/2) sin 2theta| <= b (series bound, see signatures_test) and
   // |sin(eps) - eps| <= |eps|^3/6.
   const double q = alpha / (2.0 + alpha);
@@ -70,7 +69,7 @@ TEST(EffectsPhaseCurrents, ImbalanceShowsHwangEq15InD) {
   double max_d = 0.0;
   for (int k = 0; k < 720; ++k) {
     const double theta_e = kTwoPi * (k + 0.25) / 720.0;
-    const double phi = static_rd_angle(sensor_envelopes(chain, theta_e));
+    const double phi = static_rd_angle(chain.envelopes(theta_e));
     const Dq dq = to_dq(ideal_phase_currents(0.0, i_m, theta_e), phi);
     ASSERT_NEAR(dq.d, -i_m * 0.5 * alpha * std::sin(2.0 * theta_e), tol) << k;
     ASSERT_NEAR(dq.q, i_m, i_m * 0.5 * e_max * e_max);

@@ -1,23 +1,27 @@
 // Each envelope effect's exact forward model (through an ideal converter,
 // phi = atan2(s, c)) against the paper's small-parameter signature, within an
-// approximation bound derived for that effect.
+// approximation bound derived for that effect. The envelopes are the effect
+// registry's forward chain (forward_chain.h), the signatures each effect header's
+// closed form.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
 #include "daemon/core/angles.h"
-#include "daemon/core/effects/sensor_chain.h"
+#include "daemon/core/effects/amplitude_imbalance.h"
+#include "daemon/core/effects/harmonics.h"
+#include "daemon/core/effects/offsets.h"
+#include "daemon/core/effects/quadrature.h"
+#include "tests/unit/effects/chain_test_support.h"
 
 namespace resolver {
 namespace {
 
-constexpr int kGrid = 3600;  // theta grid over one electrical turn
+using test::exact_error;
+using test::forward_chain;
 
-/// Exact position error eps = theta - phi [rad] of the chain through an ideal converter.
-double exact_error(const SensorChainConfig& chain, double theta) {
-  return wrap_pi(theta - static_rd_angle(sensor_envelopes(chain, theta)));
-}
+constexpr int kGrid = 3600;  // theta grid over one electrical turn
 
 /// Largest |exact - signature| over the grid, and the largest |signature|.
 struct Residual {
@@ -25,7 +29,7 @@ struct Residual {
   double max_signature = 0.0;
 };
 template <typename Signature>
-Residual residual(const SensorChainConfig& chain, Signature&& signature) {
+Residual residual(const ForwardChain& chain, Signature&& signature) {
   Residual r;
   for (int i = 0; i < kGrid; ++i) {
     const double theta = kTwoPi * (i + 0.37) / kGrid;  // off the symmetric points on purpose
@@ -36,23 +40,18 @@ Residual residual(const SensorChainConfig& chain, Signature&& signature) {
   return r;
 }
 
-/// Bound on the second-order remainder of atan2 for a perturbation of length d
-/// from the unit circle: the Hessian of atan2 has norm 1/r^2 and r >= 1 - d on the
-/// segment, so |remainder| <= d^2 / (2 (1 - d)^2).
-double atan2_second_order_bound(double d) { return 0.5 * d * d / ((1.0 - d) * (1.0 - d)); }
+using test::atan2_second_order_bound;
 
 TEST(EffectsSignatures, IdealChainHasNoError) {
-  const SensorChainConfig ideal;
+  const ForwardChain ideal = forward_chain({});
   const Residual r = residual(ideal, [](double) { return 0.0; });
   EXPECT_LT(r.max_residual, 1e-15 * kTwoPi * 4);  // rounding of atan2 only
 }
 
 TEST(EffectsSignatures, AmplitudeImbalanceMatchesHanselmanEq5) {
   for (const double alpha : {-0.05, -0.01, 0.003, 0.01, 0.05}) {
-    SensorChainConfig chain;
-    chain.amplitude_imbalance.alpha = alpha;
-    const Residual r =
-        residual(chain, [&](double theta) { return amplitude_imbalance_error(chain.amplitude_imbalance, theta); });
+    const ForwardChain chain = forward_chain({{"amplitude_imbalance", "alpha", alpha}});
+    const Residual r = residual(chain, [&](double theta) { return amplitude_imbalance_error({alpha}, theta); });
     // Exact: tan(phi) = tan(theta)/(1+alpha) gives
     //   eps = -sum_k q^k/k sin(2k theta), q = -alpha/(2+alpha),
     // so eps - (alpha/2) sin 2theta is bounded by the change of the first term,
@@ -73,26 +72,24 @@ TEST(EffectsSignatures, QuadratureSignMatchesExactModel) {
   // ~= -beta. Hanselman eq. 7 as printed, +(beta/2)(1 - cos 2theta), would give +beta:
   // with eps = theta - phi the sign is negative.
   const double beta = 0.004;
-  SensorChainConfig chain;
-  chain.quadrature.beta = beta;
+  const ForwardChain chain = forward_chain({{"quadrature", "beta", beta}});
   const double theta = 0.5 * std::numbers::pi;
   EXPECT_NEAR(exact_error(chain, theta), -std::atan(std::sin(beta)), 1e-15);
-  EXPECT_NEAR(quadrature_error(chain.quadrature, theta), -beta, 1e-15);
+  EXPECT_NEAR(quadrature_error({beta}, theta), -beta, 1e-15);
   // atan(sin beta) = beta - beta^3/2 + ...: the signature is right to third order here.
-  EXPECT_NEAR(exact_error(chain, theta), quadrature_error(chain.quadrature, theta), beta * beta * beta);
+  EXPECT_NEAR(exact_error(chain, theta), quadrature_error({beta}, theta), beta * beta * beta);
 }
 
 TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
   for (const double beta : {-0.03, -0.004, 0.004, 0.01, 0.03}) {
-    SensorChainConfig chain;
-    chain.quadrature.beta = beta;
-    const Residual r = residual(chain, [&](double theta) { return quadrature_error(chain.quadrature, theta); });
+    const ForwardChain chain = forward_chain({{"quadrature", "beta", beta}});
+    const Residual r = residual(chain, [&](double theta) { return quadrature_error({beta}, theta); });
     // phi(beta) = atan2(sin theta, cos(theta + beta)); d phi/d beta = N/D with
     // N = sin theta sin(theta+beta), D = sin^2 theta + cos^2(theta+beta) = 1 - sin(2theta+beta) sin beta.
     // |N|, |N'|, |D'| <= 1, 1-|beta| <= D <= 1+|beta|, so |phi''| <= (2+|beta|)/(1-|beta|)^2 and the
     // Taylor remainder after the first-order term is <= beta^2/2 * (2+|beta|)/(1-|beta|)^2.
     const double b = std::abs(beta);
-    const double bound = 0.5 * b * b * (2.0 + b) / ((1.0 - b) * (1.0 - b));
+    const double bound = test::quadrature_remainder_bound(beta);
     EXPECT_LE(r.max_residual, bound) << "beta=" << beta;
     EXPECT_LT(bound, 0.05 * r.max_signature) << "beta=" << beta;
     EXPECT_NEAR(r.max_signature, b, 1e-6 * b);  // peak of (beta/2)(1 - cos 2theta) is beta
@@ -100,10 +97,11 @@ TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
 }
 
 TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
-  for (const auto& [o_s, o_c] : {std::pair{0.001, -0.002}, std::pair{-0.01, 0.0}, std::pair{0.0, 0.02}}) {
-    SensorChainConfig chain;
-    chain.offsets = {o_s, o_c};
-    const Residual r = residual(chain, [&](double theta) { return offsets_error(chain.offsets, theta); });
+  for (const auto& offsets : {std::pair{0.001, -0.002}, std::pair{-0.01, 0.0}, std::pair{0.0, 0.02}}) {
+    const double o_s = offsets.first;  // (locals, not a structured binding: the lambda captures them)
+    const double o_c = offsets.second;
+    const ForwardChain chain = forward_chain({{"offsets", "o_s", o_s}, {"offsets", "o_c", o_c}});
+    const Residual r = residual(chain, [&](double theta) { return offsets_error({o_s, o_c}, theta); });
     const double bound = atan2_second_order_bound(std::hypot(o_s, o_c));
     EXPECT_LE(r.max_residual, bound) << o_s << "," << o_c;
     EXPECT_LT(bound, 0.05 * r.max_signature);
@@ -112,12 +110,14 @@ TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
 }
 
 TEST(EffectsSignatures, HarmonicsMatchHanselmanEq9) {
-  SensorChainConfig chain;
-  chain.harmonics.k0 = 0.002;
-  chain.harmonics.k[2] = -0.001;
-  chain.harmonics.k[3] = 0.0015;
-  chain.harmonics.k[7] = 0.0005;
-  const Residual r = residual(chain, [&](double theta) { return harmonics_error(chain.harmonics, theta); });
+  const ForwardChain chain = forward_chain(
+      {{"harmonics", "k0", 0.002}, {"harmonics", "k2", -0.001}, {"harmonics", "k3", 0.0015}, {"harmonics", "k7", 0.0005}});
+  Harmonics h;
+  h.k0 = 0.002;
+  h.k[2] = -0.001;
+  h.k[3] = 0.0015;
+  h.k[7] = 0.0005;
+  const Residual r = residual(chain, [&](double theta) { return harmonics_error(h, theta); });
   // The harmonic part is an additive perturbation of length <= sqrt2 (|K_0| + sum |K_n|);
   // Hanselman eq. 9 is exactly its first-order atan2 term.
   const double d = std::numbers::sqrt2 * (0.002 + 0.001 + 0.0015 + 0.0005);
@@ -126,30 +126,54 @@ TEST(EffectsSignatures, HarmonicsMatchHanselmanEq9) {
   EXPECT_LT(bound, 0.05 * r.max_signature);
 }
 
+TEST(EffectsSignatures, OppositeSequenceHarmonicsLandOnNPlusOne) {
+  // harmonics.h: an opposite-sign K_n_opp gives eps ~ -K_n_opp sin((n + 1) theta):
+  // k3_opp lands on 4theta (where K_5 lands too), k2_opp on 3theta.
+  for (const auto& [name, order] : {std::pair{"k3_opp", 3}, std::pair{"k2_opp", 2}}) {
+    const double k = 0.002;
+    const ForwardChain chain = forward_chain({{"harmonics", name, k}});
+    Harmonics h;
+    h.k_opp[static_cast<std::size_t>(order)] = k;
+    const Residual r = residual(chain, [&](double theta) { return harmonics_error(h, theta); });
+    EXPECT_LE(r.max_residual, atan2_second_order_bound(std::numbers::sqrt2 * k)) << name;
+    // The grid's largest |sin((n + 1) theta)| is at least cos((n + 1) pi / kGrid): within 1e-5 relative.
+    EXPECT_NEAR(r.max_signature, k, 1e-5 * k) << name;
+    // The signature's own order: sin((n + 1) theta) with a minus sign at theta = pi / (2 (n + 1)).
+    EXPECT_NEAR(harmonics_error(h, 0.5 * kPi / (order + 1)), -k, 1e-15) << name;
+  }
+}
+
 TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
   // DESIGN 6: K_3 and alpha both give a 2theta error; K_3 = -alpha/2 mimics alpha to first order.
-  SensorChainConfig with_alpha;
-  with_alpha.amplitude_imbalance.alpha = 0.004;
-  SensorChainConfig with_k3;
-  with_k3.harmonics.k[3] = -0.002;
+  Harmonics k3;
+  k3.k[3] = -0.002;
   for (int i = 0; i < 64; ++i) {
     const double theta = kTwoPi * i / 64.0;
-    EXPECT_NEAR(small_signal_error(with_alpha, theta), small_signal_error(with_k3, theta), 1e-15);
+    EXPECT_NEAR(amplitude_imbalance_error({0.004}, theta), harmonics_error(k3, theta), 1e-15);
   }
   // ...but the envelopes differ at first order: the effects are told apart there.
-  const SinCos a = sensor_envelopes(with_alpha, 0.3);
-  const SinCos k = sensor_envelopes(with_k3, 0.3);
+  const SinCos a = forward_chain({{"amplitude_imbalance", "alpha", 0.004}}).envelopes(0.3);
+  const SinCos k = forward_chain({{"harmonics", "k3", -0.002}}).envelopes(0.3);
   EXPECT_GT(std::abs(a.c - k.c) + std::abs(a.s - k.s), 1e-3);
 }
 
 TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = 0.003;
-  chain.quadrature.beta = 0.002;
-  chain.offsets = {0.001, -0.0015};
-  chain.harmonics.k0 = 0.0005;
-  chain.harmonics.k[3] = 0.0008;
-  const Residual r = residual(chain, [&](double theta) { return small_signal_error(chain, theta); });
+  const ForwardChain chain = forward_chain({{"amplitude_imbalance", "alpha", 0.003},
+                                            {"quadrature", "beta", 0.002},
+                                            {"offsets", "o_s", 0.001},
+                                            {"offsets", "o_c", -0.0015},
+                                            {"harmonics", "k0", 0.0005},
+                                            {"harmonics", "k3", 0.0008}});
+  Harmonics h;
+  h.k0 = 0.0005;
+  h.k[3] = 0.0008;
+  // The first-order error of the composed chain is the sum of the individual
+  // effects' signatures (what the deleted small_signal_error summed).
+  const auto first_order = [&](double theta) {
+    return amplitude_imbalance_error({0.003}, theta) + quadrature_error({0.002}, theta) +
+           offsets_error({0.001, -0.0015}, theta) + harmonics_error(h, theta);
+  };
+  const Residual r = residual(chain, first_order);
   // Perturbation of the envelopes from the unit circle: d = d_lin + d_2 with
   // |d_2| <= beta^2/2 (cos(theta+beta) vs its linearisation) + |alpha| (|beta| + |H|)
   // (alpha times the perturbed cos channel). The signature sum is the first-order

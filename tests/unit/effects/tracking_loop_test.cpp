@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "daemon/core/angles.h"
-#include "daemon/core/effects/sensor_chain.h"
 #include "daemon/core/effects/tracking_loop.h"
+#include "tests/unit/effects/chain_test_support.h"
 
 namespace resolver {
 namespace {
@@ -138,13 +138,16 @@ TEST(EffectsTrackingLoop, ClosedLoopGainMatchesAnalyticH) {
 TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
   // DESIGN 6: the loop filters the 2theta error of amplitude imbalance: at resolver
   // speed w the ripple is (alpha/2)|H(j 2w)| sin(2theta + arg H(j 2w)).
-  TrackingLoopConfig c = loop_config(3000.0, 0.7);
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = 0.002;
+  const double alpha = 0.002;
+  const ForwardChain chain = test::forward_chain(
+      {{"amplitude_imbalance", "alpha", alpha}, {"tracking_loop", "omega_n", 3000.0}, {"tracking_loop", "zeta", 0.7}});
+  // The converter the registry's tracking_loop hook sets up (what the simulator integrates).
+  const TrackingLoopConfig c{chain.converter().omega_n, chain.converter().zeta};
+  ASSERT_EQ(c.omega_n, 3000.0);
   for (const double w : {50.0, 1500.0, 4000.0}) {  // |H(j2w)| from ~1 down to ~0.3
     TrackingLoop loop(c);
     loop.reset({0.0, w});
-    const auto envelope = [&](double t) { return sensor_envelopes(chain, w * t); };
+    const auto envelope = [&](double t) { return chain.envelopes(w * t); };
     const double period_2 = kPi / w;  // period of the 2theta ripple [s]
     const int per_period = 400;
     const double dt = period_2 / per_period;
@@ -158,7 +161,7 @@ TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
       acc += wrap_pi(theta - loop.state().phi) * std::exp(std::complex<double>(0.0, -2.0 * theta));
     }
     const std::complex<double> measured = acc / static_cast<double>(2 * per_period) * std::complex<double>(0.0, 2.0);
-    const std::complex<double> expected = 0.5 * chain.amplitude_imbalance.alpha * analytic_h(c.omega_n, c.zeta, 2.0 * w);
+    const std::complex<double> expected = 0.5 * alpha * analytic_h(c.omega_n, c.zeta, 2.0 * w);
     // Omitted: O(alpha^2) terms of the static error (<= ~alpha^2/4 at 2theta, see
     // the signature test) times a gain <= 1.2; integration error ~1e-5 relative.
     EXPECT_NEAR(std::abs(measured - expected), 0.0, 0.5 * 0.002 * 0.002) << "w=" << w;
@@ -166,14 +169,15 @@ TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
 }
 
 TEST(EffectsTrackingLoop, IdealConverterFollowsStaticAngle) {
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = 0.01;
-  TrackingLoop loop(chain.tracking_loop);  // omega_n = 0: ideal
+  const ForwardChain chain = test::forward_chain({{"amplitude_imbalance", "alpha", 0.01}});
+  // The chain's converter without a tracking_loop setting: omega_n = 0, ideal.
+  ASSERT_EQ(chain.converter().omega_n, 0.0);
+  TrackingLoop loop(TrackingLoopConfig{chain.converter().omega_n, chain.converter().zeta});
   const double w = 100.0;
   for (int k = 0; k < 400; ++k) {
-    loop.advance([&](double t) { return sensor_envelopes(chain, w * t); }, k * 1e-3, 1e-3);
+    loop.advance([&](double t) { return chain.envelopes(w * t); }, k * 1e-3, 1e-3);
     const double theta = w * (k + 1) * 1e-3;
-    ASSERT_NEAR(wrap_pi(loop.angle() - static_rd_angle(sensor_envelopes(chain, theta))), 0.0, 1e-12);
+    ASSERT_NEAR(wrap_pi(loop.angle() - static_rd_angle(chain.envelopes(theta))), 0.0, 1e-12);
     ASSERT_NEAR(loop.state().phi, theta - 0.0, 0.01);  // continuous, not wrapped
   }
 }

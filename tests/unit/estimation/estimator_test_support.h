@@ -1,6 +1,6 @@
 // Shared data generators for the estimator tests (sin/cos LS, Fourier fit,
 // compensation, CRLB). Two sources:
-//  - forward_samples(): the effect catalog's forward model (daemon/core/effects)
+//  - forward_samples(): the effect registry's forward chain (forward_chain.h)
 //    plus Gaussian noise in double precision, angles uniform over whole
 //    revolutions: exactly the CRLB's assumptions, for the statistical tests;
 //  - simulate(): the bench simulator (tools/sim), i16 counts, R/D converter,
@@ -12,8 +12,9 @@
 #include <vector>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/effects/forward_chain.h"
 #include "daemon/core/effects/noise.h"
-#include "daemon/core/effects/sensor_chain.h"
+#include "tests/unit/effects/chain_test_support.h"
 #include "tools/sim/bench_simulator.h"
 
 namespace resolver::test {
@@ -25,15 +26,15 @@ struct EnvelopeSample {
 };
 
 /// n samples at theta_k = theta0 + 2pi revs k / n (uniform over `revs` whole
-/// revolutions), envelopes amplitude * sensor_envelopes(chain) + N(0, sigma^2).
-inline std::vector<EnvelopeSample> forward_samples(const SensorChainConfig& chain, double amplitude, double sigma,
+/// revolutions), envelopes amplitude * chain.envelopes(theta) + N(0, sigma^2).
+inline std::vector<EnvelopeSample> forward_samples(const ForwardChain& chain, double amplitude, double sigma,
                                                    int n, int revs, double theta0, std::uint64_t seed) {
   NoiseEngine engine(seed);
   std::vector<EnvelopeSample> out;
   out.reserve(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) {
     const double theta = theta0 + kTwoPi * revs * k / n;
-    const SinCos sc = sensor_envelopes(chain, theta);
+    const SinCos sc = chain.envelopes(theta);
     const double s = amplitude * sc.s + gaussian_noise(engine, sigma);
     const double c = amplitude * sc.c + gaussian_noise(engine, sigma);
     out.push_back({wrap_2pi(theta), s, c});
@@ -72,7 +73,7 @@ inline std::vector<SimRecord> simulate(const SimConfig& config) {
 /// Effective per-channel noise of the simulator's i16 samples [counts]: Gaussian
 /// sigma plus rounding to integers (uniform, variance 1/12 count^2), independent.
 inline double sim_sigma(const SimConfig& config) {
-  const double g = config.chain.noise.sigma_sc;
+  const double g = config.chain.get("noise", "sigma_sc");
   return std::sqrt(g * g + 1.0 / 12.0);
 }
 

@@ -18,22 +18,21 @@
 namespace resolver {
 namespace {
 
-using test::SimRecord;
 using test::simulate;
 
 SimConfig fourier_sim(double seconds, double rpm0, double rpm1) {
   SimConfig cfg;
   cfg.profile = {{seconds, rpm0, rpm1}};
-  cfg.chain.amplitude_imbalance.alpha = 0.01;
-  cfg.chain.quadrature.beta = 0.004;
-  cfg.chain.offsets.o_s = 0.002;
-  cfg.chain.offsets.o_c = -0.003;
+  cfg.chain.set("amplitude_imbalance", "alpha", 0.01);
+  cfg.chain.set("quadrature", "beta", 0.004);
+  cfg.chain.set("offsets", "o_s", 0.002);
+  cfg.chain.set("offsets", "o_c", -0.003);
   return cfg;
 }
 
-double second_order(const SensorChainConfig& ch) {
-  const double sum = std::abs(ch.amplitude_imbalance.alpha) + std::abs(ch.quadrature.beta) +
-                     std::abs(ch.offsets.o_s) + std::abs(ch.offsets.o_c);
+double second_order(const ChainValues& ch) {
+  const double sum = std::abs(ch.get("amplitude_imbalance", "alpha")) + std::abs(ch.get("quadrature", "beta")) +
+                     std::abs(ch.get("offsets", "o_s")) + std::abs(ch.get("offsets", "o_c"));
   return sum * sum;
 }
 
@@ -48,12 +47,12 @@ TEST(AngleErrorFourier, ReferenceFitMapsToCatalogParameters) {
   ASSERT_TRUE(fit.has_value());
   const double so = second_order(cfg.chain);
   const auto& ch = cfg.chain;
-  EXPECT_NEAR(fit->alpha.value, ch.amplitude_imbalance.alpha, so);
-  EXPECT_NEAR(fit->beta.value, ch.quadrature.beta, so);
-  EXPECT_NEAR(fit->o_s.value, ch.offsets.o_s, so);
-  EXPECT_NEAR(fit->o_c.value, ch.offsets.o_c, so);
+  EXPECT_NEAR(fit->alpha.value, ch.get("amplitude_imbalance", "alpha"), so);
+  EXPECT_NEAR(fit->beta.value, ch.get("quadrature", "beta"), so);
+  EXPECT_NEAR(fit->o_s.value, ch.get("offsets", "o_s"), so);
+  EXPECT_NEAR(fit->o_c.value, ch.get("offsets", "o_c"), so);
   // Constant: -beta/2 (Hanselman 7, sign of effects/quadrature.h).
-  EXPECT_NEAR(fit->a0.value, -0.5 * ch.quadrature.beta, so);
+  EXPECT_NEAR(fit->a0.value, -0.5 * ch.get("quadrature", "beta"), so);
   // Coefficient std errors: the quantization floor sqrt(2/N) (x 1.3 for the
   // tracking loop's few-LSB dither and the O(1/N) non-uniformity).
   const double se = kQuantSigma * std::sqrt(2.0 / static_cast<double>(recs.size()));
@@ -93,7 +92,7 @@ TEST(AngleErrorFourier, CompensationRemovesTheErrorDownToTheResidualHarmonics) {
 // the harmonics.
 TEST(AngleErrorFourier, SmoothIdealAngleFitUnderAcceleration) {
   SimConfig cfg = fourier_sim(2.0, 200.0, 260.0);
-  cfg.chain.quadrature.beta = 0.0;  // its constant part is not identifiable without reference
+  cfg.chain.set("quadrature", "beta", 0.0);  // its constant part is not identifiable without reference
   const auto recs = simulate(cfg);
   std::vector<double> t, rd;
   for (const auto& r : recs) {
@@ -105,10 +104,10 @@ TEST(AngleErrorFourier, SmoothIdealAngleFitUnderAcceleration) {
   ASSERT_TRUE(fit.has_value());
   EXPECT_GE(fit->revolutions, 22.0);  // 2 s at 10..13 rev/s
   const double so = second_order(cfg.chain);
-  EXPECT_NEAR(fit->alpha.value, cfg.chain.amplitude_imbalance.alpha, so);
+  EXPECT_NEAR(fit->alpha.value, cfg.chain.get("amplitude_imbalance", "alpha"), so);
   EXPECT_NEAR(fit->beta.value, 0.0, so);
-  EXPECT_NEAR(fit->o_s.value, cfg.chain.offsets.o_s, so);
-  EXPECT_NEAR(fit->o_c.value, cfg.chain.offsets.o_c, so);
+  EXPECT_NEAR(fit->o_s.value, cfg.chain.get("offsets", "o_s"), so);
+  EXPECT_NEAR(fit->o_c.value, cfg.chain.get("offsets", "o_c"), so);
   // The tracking loop's acceleration lag a/omega_n^2 is constant: the polynomial takes it.
   EXPECT_LT(fit->residual_rms, 2.0 * kQuantSigma);
 
@@ -127,8 +126,8 @@ TEST(AngleErrorFourier, LargeAlphaUsesTheExactInversion) {
   // 2 a_2/(1 - a_2) leaves only the quantization noise.
   SimConfig cfg;
   cfg.profile = {{1.0, 200.0, 200.0}};
-  cfg.chain.tracking_loop.omega_n = 0.0;  // ideal converter: eps is exactly the static error
-  cfg.chain.amplitude_imbalance.alpha = 0.05;
+  cfg.chain.set("tracking_loop", "omega_n", 0.0);  // ideal converter: eps is exactly the static error
+  cfg.chain.set("amplitude_imbalance", "alpha", 0.05);
   const auto recs = simulate(cfg);
   AngleErrorFourier f(AngleFourierConfig{});
   for (const auto& r : recs) f.add(r.theta_ref, r.rd);

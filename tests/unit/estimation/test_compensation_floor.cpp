@@ -33,7 +33,6 @@
 #include <utility>
 #include <vector>
 
-#include "daemon/core/effects/effect_catalog.h"
 #include "daemon/core/effects/quantization.h"
 #include "daemon/core/estimation/angle_error_fourier.h"
 #include "daemon/core/estimation/sincos_compensation.h"
@@ -55,8 +54,7 @@ SimConfig with_effect(const std::string& spec, double rpm, int rd_bits = 16) {
   cfg.profile = {{2.0 * kFitSeconds, rpm, rpm}};
   cfg.rd_bits = rd_bits;
   cfg.theta_m0 = 0.37;  // [rad] any start angle; not a quantization-friendly one
-  const auto err = apply_effect_spec(cfg.chain, spec);
-  EXPECT_FALSE(err.has_value()) << err.value_or("");
+  EXPECT_NO_THROW(cfg.chain.apply_spec(spec));
   return cfg;
 }
 

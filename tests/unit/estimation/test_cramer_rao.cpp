@@ -1,5 +1,5 @@
 // The closed-form CRLB (cramer_rao.h) against the Fisher matrix built
-// numerically from the effect catalog's forward model: finite-difference
+// numerically from the effect registry's forward chain: finite-difference
 // gradients of (s, c) at N uniformly spread angles, F = sum J^T J / sigma^2,
 // inverted with Eigen. The unknown-angle case eliminates each sample's angle by
 // projecting out the tangential gradient (the per-sample Schur complement).
@@ -9,7 +9,7 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
-#include "daemon/core/effects/sensor_chain.h"
+#include "tests/unit/effects/chain_test_support.h"
 #include "daemon/core/estimation/cramer_rao.h"
 
 namespace resolver {
@@ -17,13 +17,10 @@ namespace {
 
 // x = (A, alpha, beta, o_s, o_c, delta); returns (s, c) [counts] at angle theta.
 Eigen::Vector2d model(const Eigen::VectorXd& x, double theta) {
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = x(1);
-  chain.quadrature.beta = x(2);
-  chain.offsets.o_s = x(3);
-  chain.offsets.o_c = x(4);
+  const ForwardChain chain = test::forward_chain(
+      {{"amplitude_imbalance", "alpha", x(1)}, {"quadrature", "beta", x(2)}, {"offsets", "o_s", x(3)}, {"offsets", "o_c", x(4)}});
   const double delta = x.size() > 5 ? x(5) : 0.0;
-  const SinCos sc = sensor_envelopes(chain, theta + delta);
+  const SinCos sc = chain.envelopes(theta + delta);
   return {x(0) * sc.s, x(0) * sc.c};
 }
 

@@ -72,6 +72,7 @@ TEST(SampleProcessor, HwangEq15And16RippleAndCompensation) {
   // After convergence the compensated angle removes the i_d ripple.
   const double alpha = 0.003, i_m = 10.0, rate = 2000.0, omega = kTwoPi * 10.0;
   ProcessorConfig pc;
+  pc.method = EstimatorMethod::kHwangIntegral;  // this test is about Hwang's estimator and its compensation
   pc.p_r = 3;
   pc.p = 3;
   SampleProcessor proc(pc);

@@ -18,16 +18,15 @@
 namespace resolver {
 namespace {
 
-using test::SimRecord;
 using test::simulate;
 
 SimConfig imperfect_sim(double seconds) {
   SimConfig cfg;
   cfg.profile = {{seconds, 200.0, 200.0}};
-  cfg.chain.amplitude_imbalance.alpha = 0.03;
-  cfg.chain.quadrature.beta = 0.01;
-  cfg.chain.offsets.o_s = 0.005;
-  cfg.chain.offsets.o_c = -0.004;
+  cfg.chain.set("amplitude_imbalance", "alpha", 0.03);
+  cfg.chain.set("quadrature", "beta", 0.01);
+  cfg.chain.set("offsets", "o_s", 0.005);
+  cfg.chain.set("offsets", "o_c", -0.004);
   return cfg;
 }
 
@@ -78,13 +77,13 @@ TEST(SinCosCompensation, SumDifferenceAndOrthogonalisationAreExactOnCleanSignals
   corr.beta = 0.08;
   corr.o_s = 0.01;
   corr.o_c = -0.02;
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = corr.alpha;
-  chain.quadrature.beta = corr.beta;
-  chain.offsets = {corr.o_s, corr.o_c};
+  const ForwardChain chain = test::forward_chain({{"amplitude_imbalance", "alpha", corr.alpha},
+                                                  {"quadrature", "beta", corr.beta},
+                                                  {"offsets", "o_s", corr.o_s},
+                                                  {"offsets", "o_c", corr.o_c}});
   for (int k = 0; k < 360; ++k) {
     const double theta = kTwoPi * k / 360.0 + 0.01;
-    const SinCos sc = sensor_envelopes(chain, theta);
+    const SinCos sc = chain.envelopes(theta);
     const double s = corr.amplitude * sc.s, c = corr.amplitude * sc.c;
     EXPECT_NEAR(wrap_pi(theta - corrected_angle(corr, s, c)), 0.0, 1e-12);
     EXPECT_NEAR(wrap_pi(theta - sum_difference_angle(corr, s, c)), 0.0, 1e-12);
@@ -97,16 +96,15 @@ TEST(SinCosCompensation, HarmonicRemovalLeavesSecondOrderError) {
   corr.alpha = 0.01;
   corr.orders = {3};
   corr.k = {0.005};
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = corr.alpha;
-  chain.harmonics.k[3] = 0.005;
+  const ForwardChain chain =
+      test::forward_chain({{"amplitude_imbalance", "alpha", corr.alpha}, {"harmonics", "k3", 0.005}});
   double worst = 0.0, worst_raw = 0.0;
   SinCosCorrection no_h = corr;
   no_h.orders.clear();
   no_h.k.clear();
   for (int k = 0; k < 720; ++k) {
     const double theta = kTwoPi * k / 720.0;
-    const SinCos sc = sensor_envelopes(chain, theta);
+    const SinCos sc = chain.envelopes(theta);
     worst = std::max(worst, std::abs(wrap_pi(theta - corrected_angle(corr, sc.s, sc.c))));
     worst_raw = std::max(worst_raw, std::abs(wrap_pi(theta - corrected_angle(no_h, sc.s, sc.c))));
   }

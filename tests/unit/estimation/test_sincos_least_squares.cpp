@@ -24,10 +24,10 @@ using test::simulate;
 SimConfig imperfect_sim(double seconds = 1.0) {
   SimConfig cfg;
   cfg.profile = {{seconds, 200.0, 200.0}};  // 10 resolver rev/s at p_r = 3, 200 samples/rev
-  cfg.chain.amplitude_imbalance.alpha = 0.03;
-  cfg.chain.quadrature.beta = 0.01;
-  cfg.chain.offsets.o_s = 0.005;
-  cfg.chain.offsets.o_c = -0.004;
+  cfg.chain.set("amplitude_imbalance", "alpha", 0.03);
+  cfg.chain.set("quadrature", "beta", 0.01);
+  cfg.chain.set("offsets", "o_s", 0.005);
+  cfg.chain.set("offsets", "o_c", -0.004);
   return cfg;
 }
 
@@ -56,10 +56,10 @@ TEST(SinCosLeastSquares, ReferenceFitRecoversCatalogParametersWithinCrlb) {
   const auto n = static_cast<std::int64_t>(recs.size());
   const CramerRao b = crlb_sincos(cfg.amplitude_counts, test::sim_sigma(cfg), n);
   const auto& ch = cfg.chain;
-  EXPECT_NEAR(fit->alpha.value, ch.amplitude_imbalance.alpha, 5.0 * b.alpha);
-  EXPECT_NEAR(fit->beta.value, ch.quadrature.beta, 5.0 * b.beta);
-  EXPECT_NEAR(fit->o_s.value, ch.offsets.o_s, 5.0 * b.o_s);
-  EXPECT_NEAR(fit->o_c.value, ch.offsets.o_c, 5.0 * b.o_c);
+  EXPECT_NEAR(fit->alpha.value, ch.get("amplitude_imbalance", "alpha"), 5.0 * b.alpha);
+  EXPECT_NEAR(fit->beta.value, ch.get("quadrature", "beta"), 5.0 * b.beta);
+  EXPECT_NEAR(fit->o_s.value, ch.get("offsets", "o_s"), 5.0 * b.o_s);
+  EXPECT_NEAR(fit->o_c.value, ch.get("offsets", "o_c"), 5.0 * b.o_c);
   EXPECT_NEAR(fit->amplitude.value, cfg.amplitude_counts, 5.0 * b.amplitude);
   // Reported standard errors: the data's own estimate of the bound. The residual
   // variance from 2000 samples is within ~3 % of the truth; 15 % allows the
@@ -79,8 +79,8 @@ TEST(SinCosLeastSquares, ReferenceFitFindsReferenceOffset) {
   ASSERT_TRUE(fit.has_value());
   const CramerRao b = crlb_sincos(cfg.amplitude_counts, test::sim_sigma(cfg), static_cast<std::int64_t>(recs.size()));
   EXPECT_NEAR(fit->reference_offset.value, delta, 5.0 * b.reference_offset);
-  EXPECT_NEAR(fit->beta.value, cfg.chain.quadrature.beta, 5.0 * b.beta_with_offset);
-  EXPECT_NEAR(fit->alpha.value, cfg.chain.amplitude_imbalance.alpha, 5.0 * b.alpha);
+  EXPECT_NEAR(fit->beta.value, cfg.chain.get("quadrature", "beta"), 5.0 * b.beta_with_offset);
+  EXPECT_NEAR(fit->alpha.value, cfg.chain.get("amplitude_imbalance", "alpha"), 5.0 * b.alpha);
 }
 
 TEST(SinCosLeastSquares, ConicFitRecoversCatalogParametersWithinBlindCrlb) {
@@ -92,10 +92,10 @@ TEST(SinCosLeastSquares, ConicFitRecoversCatalogParametersWithinBlindCrlb) {
   const CramerRao b =
       crlb_sincos_blind(cfg.amplitude_counts, test::sim_sigma(cfg), static_cast<std::int64_t>(recs.size()));
   const auto& ch = cfg.chain;
-  EXPECT_NEAR(fit->alpha.value, ch.amplitude_imbalance.alpha, 5.0 * b.alpha);
-  EXPECT_NEAR(fit->beta.value, ch.quadrature.beta, 5.0 * b.beta);
-  EXPECT_NEAR(fit->o_s.value, ch.offsets.o_s, 5.0 * b.o_s);
-  EXPECT_NEAR(fit->o_c.value, ch.offsets.o_c, 5.0 * b.o_c);
+  EXPECT_NEAR(fit->alpha.value, ch.get("amplitude_imbalance", "alpha"), 5.0 * b.alpha);
+  EXPECT_NEAR(fit->beta.value, ch.get("quadrature", "beta"), 5.0 * b.beta);
+  EXPECT_NEAR(fit->o_s.value, ch.get("offsets", "o_s"), 5.0 * b.o_s);
+  EXPECT_NEAR(fit->o_c.value, ch.get("offsets", "o_c"), 5.0 * b.o_c);
   EXPECT_NEAR(fit->amplitude.value, cfg.amplitude_counts, 5.0 * b.amplitude);
   EXPECT_NEAR(fit->alpha.std_error / b.alpha, 1.0, 0.25);
   EXPECT_NEAR(fit->beta.std_error / b.beta, 1.0, 0.25);
@@ -124,11 +124,10 @@ Spread spread(const std::vector<double>& v) {
 TEST(SinCosLeastSquares, SpreadOverFiftySeedsIsWithinTwiceTheCrlb) {
   constexpr double kA = 26000.0, kSigma = 2.0;
   constexpr int kN = 400, kRevs = 2, kSeeds = 50;
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = 0.03;
-  chain.quadrature.beta = 0.01;
-  chain.offsets.o_s = 0.005;
-  chain.offsets.o_c = -0.004;
+  const ForwardChain chain = test::forward_chain({{"amplitude_imbalance", "alpha", 0.03},
+                                                  {"quadrature", "beta", 0.01},
+                                                  {"offsets", "o_s", 0.005},
+                                                  {"offsets", "o_c", -0.004}});
   std::vector<double> ra, rb, ros, roc, ca, cb, cos_, coc;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     const auto data = forward_samples(chain, kA, kSigma, kN, kRevs, 0.37 * seed, static_cast<std::uint64_t>(seed));
@@ -174,10 +173,11 @@ TEST(SinCosLeastSquares, SpreadOverFiftySeedsIsWithinTwiceTheCrlb) {
 // fundamental, K_3 adds a 3theta term to both channels.
 TEST(SinCosLeastSquares, TellsAlphaFromThirdHarmonic) {
   SimConfig cfg = imperfect_sim();
-  cfg.chain.quadrature.beta = 0.0;
-  cfg.chain.offsets = {};
-  cfg.chain.amplitude_imbalance.alpha = 0.01;
-  cfg.chain.harmonics.k[3] = 0.005;
+  cfg.chain.set("quadrature", "beta", 0.0);
+  cfg.chain.set("offsets", "o_s", 0.0);
+  cfg.chain.set("offsets", "o_c", 0.0);
+  cfg.chain.set("amplitude_imbalance", "alpha", 0.01);
+  cfg.chain.set("harmonics", "k3", 0.005);
   const auto recs = simulate(cfg);
   SinCosLsConfig lc;
   lc.harmonics = {3};
@@ -215,7 +215,7 @@ TEST(SinCosLeastSquares, TellsAlphaFromThirdHarmonic) {
 TEST(SinCosLeastSquares, ConvergesWithinOneElectricalRevolution) {
   SimConfig cfg;
   cfg.profile = {{0.2, 200.0, 200.0}};
-  cfg.chain.amplitude_imbalance.alpha = 0.03;
+  cfg.chain.set("amplitude_imbalance", "alpha", 0.03);
   const auto recs = simulate(cfg);
   const std::size_t one_rev = static_cast<std::size_t>(cfg.sample_rate_hz / 10.0);  // 10 rev/s
   SinCosLsConfig lc;
@@ -231,15 +231,14 @@ TEST(SinCosLeastSquares, ConvergesWithinOneElectricalRevolution) {
 // Exponential forgetting follows a change: after 10 time constants (lambda =
 // 0.99, 100 samples) the old alpha's weight is e^-10 ~ 5e-5.
 TEST(SinCosLeastSquares, ForgettingTracksAChangeOfAlpha) {
-  SensorChainConfig chain;
-  chain.amplitude_imbalance.alpha = 0.02;
   SinCosLsConfig lc;
   lc.forgetting = 0.99;
   lc.fit_reference_offset = false;
   SinCosLeastSquares ls(lc);
-  for (const auto& d : forward_samples(chain, 26000.0, 2.0, 2000, 10, 0.0, 7)) ls.add(d.s, d.c, d.theta);
-  chain.amplitude_imbalance.alpha = 0.03;
-  for (const auto& d : forward_samples(chain, 26000.0, 2.0, 1000, 5, 0.0, 8)) ls.add(d.s, d.c, d.theta);
+  const ForwardChain before = test::forward_chain({{"amplitude_imbalance", "alpha", 0.02}});
+  const ForwardChain after = test::forward_chain({{"amplitude_imbalance", "alpha", 0.03}});
+  for (const auto& d : forward_samples(before, 26000.0, 2.0, 2000, 10, 0.0, 7)) ls.add(d.s, d.c, d.theta);
+  for (const auto& d : forward_samples(after, 26000.0, 2.0, 1000, 5, 0.0, 8)) ls.add(d.s, d.c, d.theta);
   const auto fit = ls.solve();
   ASSERT_TRUE(fit.has_value());
   // Effective samples n_eff = (1 + lambda)/(1 - lambda) = 199 for the bound.

@@ -49,8 +49,9 @@ Sweep simulate_sweep(const TrackingLoopConfig& loop, const std::vector<double>& 
   Sweep sw;
   SimConfig& cfg = sw.config;
   cfg.sample_rate_hz = 20000;
-  cfg.chain.amplitude_imbalance.alpha = kAlpha;
-  cfg.chain.tracking_loop = loop;
+  cfg.chain.set("amplitude_imbalance", "alpha", kAlpha);
+  cfg.chain.set("tracking_loop", "omega_n", loop.omega_n);
+  cfg.chain.set("tracking_loop", "zeta", loop.zeta);
   cfg.profile.clear();
   double prev = rpms.front();
   for (const double r : rpms) {

@@ -37,7 +37,8 @@ std::uint32_t u32(const CanFrame& f, int at) {
 SimConfig quiet_config(double seconds, double rpm) {
   SimConfig c;
   c.profile = {{seconds, rpm, rpm}};
-  c.chain.noise = {};  // noise off: values are exact up to rounding
+  c.chain.set("noise", "sigma_sc", 0.0);  // noise off: values are exact up to rounding
+  c.chain.set("noise", "sigma_i", 0.0);
   return c;
 }
 
@@ -56,7 +57,7 @@ TEST(SimBenchSimulator, TotalSamplesFollowTheProfile) {
 
 TEST(SimBenchSimulator, FramesDecodeByHandToTheSample) {
   SimConfig c = quiet_config(0.3, 200.0);
-  c.chain.amplitude_imbalance.alpha = 0.003;
+  c.chain.set("amplitude_imbalance", "alpha", 0.003);
   c.iface = "vcan0";
   BenchSimulator sim(c);
   SimSample s{};
@@ -186,7 +187,7 @@ bool same_frames(const std::vector<CanFrame>& a, const std::vector<CanFrame>& b)
 TEST(SimBenchSimulator, SameSeedSameOutput) {
   SimConfig c;  // default chain: noise and tracking loop on
   c.profile = {{0.2, 500.0, 500.0}};
-  c.chain.quadrature.beta = 0.002;
+  c.chain.set("quadrature", "beta", 0.002);
   const auto a = run_all(c);
   const auto b = run_all(c);
   EXPECT_TRUE(same_frames(a, b));
@@ -197,7 +198,8 @@ TEST(SimBenchSimulator, SameSeedSameOutput) {
 TEST(SimBenchSimulator, NoiseHasTheRequestedSigma) {
   SimConfig c;
   c.profile = {{2.0, 200.0, 200.0}};
-  c.chain.noise = {3.0, 0.05};
+  c.chain.set("noise", "sigma_sc", 3.0);  // [counts]
+  c.chain.set("noise", "sigma_i", 0.05);   // [A]
   BenchSimulator sim(c);
   SimSample s{};
   double sum_sq_s = 0.0;
@@ -219,16 +221,16 @@ TEST(SimBenchSimulator, NoiseHasTheRequestedSigma) {
 
 TEST(SimBenchSimulator, RdBitsComeFromEitherPlace) {
   SimConfig a = quiet_config(0.01, 200.0);
-  a.chain.quantization.rd_bits = 12;
+  a.chain.set("quantization", "rd_bits", 12);
   EXPECT_EQ(BenchSimulator(a).config().rd_bits, 12);
   SimConfig b = quiet_config(0.01, 200.0);
   b.rd_bits = 10;
   BenchSimulator sim(b);
-  EXPECT_EQ(sim.config().chain.quantization.rd_bits, 10);
+  EXPECT_EQ(sim.config().chain.get("quantization", "rd_bits"), 10.0);
   SimSample s{};
   while (sim.next(s)) ASSERT_EQ(s.rd_counts % 64, 0) << "10 bits: the low 6 bits are zero";
   SimConfig both = b;
-  both.chain.quantization.rd_bits = 12;
+  both.chain.set("quantization", "rd_bits", 12);
   EXPECT_THROW(BenchSimulator{both}, std::invalid_argument);
 }
 
@@ -254,7 +256,7 @@ TEST(SimBenchSimulator, BadConfigsNameTheField) {
   expect_invalid(bad, "amplitude_counts");
   bad = c;
   bad.amplitude_counts = 32000;
-  bad.chain.amplitude_imbalance.alpha = 0.05;  // cos peak 33600 counts: clips
+  bad.chain.set("amplitude_imbalance", "alpha", 0.05);  // cos peak 33600 counts: clips
   expect_invalid(bad, "amplitude_counts");
   bad = c;
   bad.i_q_cmd = 40.0;

@@ -1,4 +1,4 @@
-// resolver-sim's command line: every catalog v2 effect is accepted through
+// resolver-sim's command line: every catalog v2 and registry effect is accepted through
 // --effect, lands in the truth file, and a bad value fails naming the parameter.
 // Runs the real executable (RESOLVER_SIM_EXE, set by tests/unit/sim/CMakeLists.txt).
 #include <gtest/gtest.h>
@@ -49,6 +49,13 @@ TEST(SimCli, EveryNewEffectThroughDashDashEffect) {
       {"current_offsets:off_a=0.05,off_b=-0.03", "\"current_offsets\": {\"off_a\": 0.05, \"off_b\": -0.03}"},
       {"current_gain_mismatch:gain_a=0.01", "\"current_gain_mismatch\": {\"gain_a\": 0.01, \"gain_b\": 0}"},
       {"dead_time:t_d=2e-6", "\"dead_time\": {\"t_d\": 2e-06}"},
+      // The registry's effects beyond DESIGN 6 (issue 12).
+      {"delay:d=1e-3", "\"delay\": {\"d\": 0.001}"},
+      {"backlash:h=0.01", "\"backlash\": {\"h\": 0.01}"},
+      {"channel_delay:tau=2e-6", "\"channel_delay\": {\"tau\": 2e-06}"},
+      {"harmonics:k3_opp=2e-4,k20=1e-5", "\"harmonics\": {\"k20\": 1e-05, \"k3_opp\": 0.0002}"},
+      {"mechanical_harmonics:a2=1e-4,b2=-1e-4", "\"mechanical_harmonics\": {\"a2\": 0.0001, \"b2\": -0.0001}"},
+      {"outliers:rate=10,size=2000", "\"outliers\": {\"rate\": 10, \"size\": 2000}"},
   };
   for (const auto& c : cases) {
     const std::filesystem::path log = dir / "x.log";
@@ -62,6 +69,10 @@ TEST(SimCli, EveryNewEffectThroughDashDashEffect) {
   const Result bad = run("--out " + (dir / "bad.log").string() + " --duration 0.05 --effect sampling_skew:tau=0.5");
   EXPECT_EQ(bad.status, 2);
   EXPECT_NE(bad.output.find("tau"), std::string::npos) << bad.output;
+  const Result unknown = run("--out " + (dir / "bad.log").string() + " --duration 0.05 --effect backlash:width=0.01");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_NE(unknown.output.find("'width'"), std::string::npos) << unknown.output;
+  EXPECT_NE(unknown.output.find("valid parameters: h"), std::string::npos) << unknown.output;
   const Result listing = run("--list-effects");
   EXPECT_EQ(listing.status, 0);
   EXPECT_EQ(listing.output.find("not implemented"), std::string::npos) << listing.output;

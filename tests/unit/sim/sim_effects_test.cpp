@@ -1,4 +1,4 @@
-// The simulator honours every catalog effect: each spec changes exactly the
+// The simulator honours every registry effect: each spec changes exactly the
 // signals the effect physically reaches, the truth file names it, and the
 // catalog v2 effects carry their signature in the samples.
 #include <gtest/gtest.h>
@@ -12,80 +12,74 @@
 #include <vector>
 
 #include "daemon/core/angles.h"
-#include "daemon/core/effects/effect_catalog.h"
+#include "daemon/core/effects/current_gain_mismatch.h"
+#include "daemon/core/effects/current_offsets.h"
+#include "daemon/core/effects/dead_time.h"
+#include "daemon/core/effects/eccentricity.h"
+#include "daemon/core/effects/mounting_offset.h"
 #include "daemon/core/effects/quantization.h"
+#include "daemon/core/effects/registry.h"
+#include "daemon/core/effects/sampling_skew.h"
+#include "tests/unit/sim/sim_test_support.h"
 #include "tools/sim/bench_simulator.h"
 #include "tools/sim/sim_truth.h"
 
 namespace resolver {
 namespace {
 
-// Which recorded signals a spec changes.
-constexpr unsigned kSinCos = 1U;
-constexpr unsigned kRd = 2U;
-constexpr unsigned kCurrents = 4U;
-constexpr unsigned kReference = 8U;
-
-std::vector<SimSample> run(const SimConfig& c) {
-  BenchSimulator sim(c);
-  std::vector<SimSample> out;
-  SimSample s{};
-  while (sim.next(s)) out.push_back(s);
-  return out;
-}
-
-unsigned changed_signals(const std::vector<SimSample>& a, const std::vector<SimSample>& b) {
-  unsigned mask = 0;
-  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
-    if (a[i].sin_counts != b[i].sin_counts || a[i].cos_counts != b[i].cos_counts) mask |= kSinCos;
-    if (a[i].rd_counts != b[i].rd_counts) mask |= kRd;
-    if (a[i].i_a_ma != b[i].i_a_ma || a[i].i_b_ma != b[i].i_b_ma || a[i].i_c_ma != b[i].i_c_ma) mask |= kCurrents;
-    if (a[i].ref_counts != b[i].ref_counts) mask |= kReference;
-  }
-  return mask;
-}
+using test::changed_signals;
+using test::kCurrents;
+using test::kRd;
+using test::kSinCos;
+using test::quiet;
+using test::run;
 
 TEST(SimEffects, EverySpecChangesExactlyTheSignalsItReaches) {
-  // One visible spec per catalog effect, and the signals it must (and must only) change.
+  // One visible spec per registry effect, and the signals it must (and must only) change.
   const std::map<std::string, std::pair<std::string, unsigned>> table{
       {"amplitude_imbalance", {"amplitude_imbalance:alpha=0.01", kSinCos | kRd}},
       {"quadrature", {"quadrature:beta=0.01", kSinCos | kRd}},
       {"offsets", {"offsets:o_s=0.01", kSinCos | kRd}},
       {"harmonics", {"harmonics:k3=0.005", kSinCos | kRd}},
       {"sampling_skew", {"sampling_skew:tau=2e-5", kSinCos}},  // the DSP's sampling, not the converter
+      {"channel_delay", {"channel_delay:tau=2e-5", kSinCos | kRd}},  // the analog path: both see it
       {"tracking_loop", {"tracking_loop:omega_n=1000", kRd}},
       {"quantization", {"quantization:rd_bits=12", kRd}},
+      {"backlash", {"backlash:h=0.01", kSinCos | kRd}},  // the reference is on the other side of the play
       {"eccentricity", {"eccentricity:e=1e-3,phase=0.4", kSinCos | kRd}},
+      {"mechanical_harmonics", {"mechanical_harmonics:a2=1e-3", kSinCos | kRd}},
       {"mounting_offset", {"mounting_offset:theta_0=0.1", kSinCos | kRd | kCurrents}},
+      {"delay", {"delay:d=1e-3", kSinCos | kRd}},  // the resolver is late, the reference and currents are not
       {"current_offsets", {"current_offsets:off_a=0.1,off_b=-0.05", kCurrents}},
       {"current_gain_mismatch", {"current_gain_mismatch:gain_a=0.02", kCurrents}},
       {"dead_time", {"dead_time:t_d=2e-6", kCurrents}},
       {"noise", {"noise:sigma_sc=5", kSinCos}},
+      {"outliers", {"outliers:rate=200,size=3000", kSinCos}},
   };
   SimConfig base;  // default chain: noise and tracking loop on, same seed for every run
   // A hold and a ramp: at constant speed a type-II loop tracks an ideal resolver
   // without error, under acceleration it lags by a / omega_n^2.
   base.profile = {{0.05, 1000.0, 1000.0}, {0.05, 1000.0, 2000.0}};
   const std::vector<SimSample> baseline = run(base);
-  for (const EffectInfo& e : effect_catalog()) {
-    const auto it = table.find(std::string(e.name));
-    ASSERT_NE(it, table.end()) << "add a spec for the new catalog effect " << e.name;
-    SimConfig c = base;
-    const auto err = apply_effect_spec(c.chain, it->second.first);
-    ASSERT_FALSE(err.has_value()) << *err;
-    EXPECT_EQ(changed_signals(baseline, run(c)), it->second.second) << it->second.first;
+  // Outliers draw from the simulator's one random engine after the noise of each
+  // sample, so with noise on they re-deal every later noise draw (currents
+  // included: same statistics, other values). Their own reach is checked on a
+  // noise-free base, where nothing else draws.
+  SimConfig noise_free = base;
+  noise_free.chain.set("noise", "sigma_sc", 0.0);
+  noise_free.chain.set("noise", "sigma_i", 0.0);
+  const std::vector<SimSample> noise_free_baseline = run(noise_free);
+  for (const Effect* e : effect_registry()) {
+    const auto it = table.find(std::string(e->name()));
+    ASSERT_NE(it, table.end()) << "add a spec for the new registry effect " << e->name();
+    const bool draws = e->name() == "outliers";
+    SimConfig c = draws ? noise_free : base;
+    ASSERT_NO_THROW(c.chain.apply_spec(it->second.first));
+    EXPECT_EQ(changed_signals(draws ? noise_free_baseline : baseline, run(c)), it->second.second) << it->second.first;
     const std::string json = sim_truth_json(c, 0, "x.log");
     const std::string active = json.substr(json.find("\"effects\""), json.find("\"chain\"") - json.find("\"effects\""));
-    EXPECT_NE(active.find("\"" + std::string(e.name) + "\": {"), std::string::npos) << json;
+    EXPECT_NE(active.find("\"" + std::string(e->name()) + "\": {"), std::string::npos) << json;
   }
-}
-
-SimConfig quiet(double rpm, double seconds) {
-  SimConfig c;
-  c.profile = {{seconds, rpm, rpm}};
-  c.chain.noise = {};
-  c.chain.tracking_loop.omega_n = 0.0;  // ideal converter: only the effect under test
-  return c;
 }
 
 TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
@@ -93,7 +87,7 @@ TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
   std::vector<double> peaks;
   for (const double rpm : {1000.0, 3000.0}) {
     SimConfig c = quiet(rpm, 0.1);
-    ASSERT_FALSE(apply_effect_spec(c.chain, "sampling_skew:tau=2e-5"));
+    c.chain.set("sampling_skew", "tau", tau);
     const double omega = c.p_r * rpm * kTwoPi / 60.0;  // [rad/s] resolver electrical
     const double beta = omega * tau;
     // Quadrature remainder (signatures_test) + rounding of both channels to whole
@@ -103,7 +97,7 @@ TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
     double peak = 0.0;
     for (const SimSample& s : run(c)) {
       const double eps_sc = wrap_pi(s.theta - std::atan2(s.sin_counts, s.cos_counts));
-      ASSERT_NEAR(eps_sc, sampling_skew_error(c.chain.sampling_skew, s.theta, omega), tol) << s.index;
+      ASSERT_NEAR(eps_sc, sampling_skew_error({tau}, s.theta, omega), tol) << s.index;
       // The R/D converter does not see the skew: half a 16-bit LSB.
       ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), 0.0, 0.5 * quantization_lsb(16) + 1e-12) << s.index;
       peak = std::max(peak, std::abs(eps_sc));
@@ -116,10 +110,11 @@ TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
 
 TEST(SimEffects, EccentricityIsOneTimesMechanicalInBothAngles) {
   SimConfig c = quiet(200.0, 0.6);  // two mechanical turns
-  ASSERT_FALSE(apply_effect_spec(c.chain, "eccentricity:e=1e-3,phase=0.4"));
+  c.chain.apply_spec("eccentricity:e=1e-3,phase=0.4");
+  const Eccentricity ecc{1e-3, 0.4};
   double peak = 0.0;
   for (const SimSample& s : run(c)) {
-    const double expected = c.p_r * eccentricity_error(c.chain.eccentricity, s.theta_m);
+    const double expected = c.p_r * eccentricity_error(ecc, s.theta_m);
     ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), expected, 0.5 * quantization_lsb(16) + 1e-9) << s.index;
     ASSERT_NEAR(wrap_pi(s.theta - std::atan2(s.sin_counts, s.cos_counts)), expected, 0.71 / c.amplitude_counts * 1.01);
     peak = std::max(peak, std::abs(expected));
@@ -127,13 +122,7 @@ TEST(SimEffects, EccentricityIsOneTimesMechanicalInBothAngles) {
   EXPECT_NEAR(peak, 3e-3, 1e-5);  // p_r e, reached within the grid
 }
 
-/// Clarke + Park (DESIGN 3) of a sample's decoded currents [A].
-DqCurrents sample_dq(const SimSample& s, double theta_e) {
-  const double i_alpha = s.i_a_ma * 1e-3;
-  const double i_beta = (s.i_b_ma - s.i_c_ma) * 1e-3 / std::numbers::sqrt3;
-  return {i_alpha * std::cos(theta_e) + i_beta * std::sin(theta_e),
-          -i_alpha * std::sin(theta_e) + i_beta * std::cos(theta_e)};
-}
+using test::sample_dq;
 
 // Rounding each phase to 1 mA moves (i_alpha, i_beta) by <= (0.5, 1/sqrt3) mA,
 // so a dq value by <= 0.77 mA, and a Fourier amplitude (2/N sum) by <= 1.53 mA.
@@ -142,7 +131,7 @@ constexpr double kRippleRound = 1.53e-3;  // [A]
 
 TEST(SimEffects, MountingOffsetGivesSteadyIdInTheReferenceFrameOnly) {
   SimConfig c = quiet(200.0, 0.2);
-  ASSERT_FALSE(apply_effect_spec(c.chain, "mounting_offset:theta_0=0.2"));
+  c.chain.apply_spec("mounting_offset:theta_0=0.2");
   ASSERT_EQ(c.p, c.p_r);  // the drive angle is then the R/D angle itself
   for (const SimSample& s : run(c)) {
     const DqCurrents ref = sample_dq(s, s.theta_e);
@@ -151,7 +140,7 @@ TEST(SimEffects, MountingOffsetGivesSteadyIdInTheReferenceFrameOnly) {
     // Drive frame: rounding plus |I| times half a 16-bit LSB of angle.
     const DqCurrents drive = sample_dq(s, s.rd_angle);
     ASSERT_NEAR(drive.d, 0.0, kDqRound + c.i_q_cmd * 0.5 * quantization_lsb(16)) << s.index;
-    ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), mounting_offset_error(c.chain.mounting_offset, c.p_r, c.p),
+    ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), mounting_offset_error({0.2}, c.p_r, c.p),
                 0.5 * quantization_lsb(16) + 1e-9);
   }
 }
@@ -165,7 +154,7 @@ TEST(SimEffects, CurrentEffectsRippleAtTheirOrders) {
                         Case{"dead_time:t_d=2e-6", 6}}) {
     // 200 r/min, p = 3: 10 Hz electrical = 200 samples per turn at 2 kHz; 0.5 s = 5 whole turns.
     SimConfig c = quiet(200.0, 0.5);
-    ASSERT_FALSE(apply_effect_spec(c.chain, k.spec));
+    ASSERT_NO_THROW(c.chain.apply_spec(k.spec));
     std::array<std::complex<double>, 8> d{};
     std::array<std::complex<double>, 8> q{};
     const std::vector<SimSample> samples = run(c);
@@ -178,14 +167,19 @@ TEST(SimEffects, CurrentEffectsRippleAtTheirOrders) {
         q[static_cast<std::size_t>(h)] += dq.q * std::polar(2.0 / n, -h * s.theta_e);
       }
     }
-    // The library's closed-form ripple on i_d / i_q at the effect's order.
+    // The library's closed-form ripple on i_d / i_q at the effect's order, for the values the spec set.
+    const ChainValues& v = c.chain;
     DqCurrents want{};
-    if (k.order == 1) want = {current_offsets_ripple_1x(c.chain.current_offsets), current_offsets_ripple_1x(c.chain.current_offsets)};
+    if (k.order == 1) {
+      const CurrentOffsets off{v.get("current_offsets", "off_a"), v.get("current_offsets", "off_b")};
+      want = {current_offsets_ripple_1x(off), current_offsets_ripple_1x(off)};
+    }
     if (k.order == 2) {
-      const double a = current_gain_mismatch_ripple_2x(c.chain.current_gain_mismatch, c.i_d_cmd, c.i_q_cmd);
+      const CurrentGainMismatch g{v.get("current_gain_mismatch", "gain_a"), v.get("current_gain_mismatch", "gain_b")};
+      const double a = current_gain_mismatch_ripple_2x(g, c.i_d_cmd, c.i_q_cmd);
       want = {a, a};
     }
-    if (k.order == 6) want = dead_time_ripple_6x(c.chain.dead_time, c.i_d_cmd, c.i_q_cmd);
+    if (k.order == 6) want = dead_time_ripple_6x(DeadTime{v.get("dead_time", "t_d")}, c.i_d_cmd, c.i_q_cmd);
     for (int h = 1; h < 8; ++h) {
       const auto i = static_cast<std::size_t>(h);
       const DqCurrents expect = h == k.order ? want : DqCurrents{};
@@ -198,18 +192,28 @@ TEST(SimEffects, CurrentEffectsRippleAtTheirOrders) {
 
 TEST(SimEffects, BadEffectParametersNameTheField) {
   SimConfig c = quiet(200.0, 0.01);
-  c.chain.eccentricity.e = 1.5;  // only reachable through the struct: the catalog caps it at 0.5
+  // Out of range: refused when set (ChainValues), naming the parameter; the simulator never sees it.
   try {
-    BenchSimulator sim(c);
+    c.chain.set("eccentricity", "e", 1.5);
     ADD_FAILURE() << "accepted e = 1.5";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("eccentricity.e"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'e' of eccentricity"), std::string::npos) << e.what();
+  }
+  // In range one by one but not as a whole: the seen angle would turn back
+  // (sum n |a_n| = 0.4 + 2 x 0.4 >= 1); the simulator refuses it naming the effect.
+  c.chain.set("mechanical_harmonics", "a1", 0.4);
+  c.chain.set("mechanical_harmonics", "a2", 0.4);
+  try {
+    BenchSimulator sim(c);
+    ADD_FAILURE() << "accepted a non-monotone seen angle";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("mechanical_harmonics"), std::string::npos) << e.what();
   }
   c = quiet(200.0, 0.01);
   c.i_q_cmd = 32.0;  // fits the i16 mA range alone...
   EXPECT_NO_THROW(BenchSimulator{c});
   // ...but k_dt = 0.2 raises a phase's peak by max(cos psi + 0.4 cos 6psi sin psi) - 1 ~ 6.7 %.
-  c.chain.dead_time.t_d = 2e-5;
+  c.chain.set("dead_time", "t_d", 2e-5);
   try {
     BenchSimulator sim(c);
     ADD_FAILURE() << "accepted a clipping current";

@@ -1,0 +1,80 @@
+#include "daemon/core/discovery/fit_support.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "daemon/core/discovery/coverage.h"
+
+namespace resolver {
+
+std::vector<Nuisance> nuisances_for(const PreparedLog& log) {
+  std::vector<Nuisance> out;
+  if (!log.reference && log.rd) out.push_back(Nuisance::kRdConstant);
+  if (!log.reference && log.sincos) out.push_back(Nuisance::kSaConstant);
+  if (log.sincos) out.push_back(Nuisance::kScGain);
+  if (log.currents) {
+    out.push_back(Nuisance::kIdConstant);
+    out.push_back(Nuisance::kIqConstant);
+  }
+  return out;
+}
+
+std::vector<int> model_columns(const Design& design) {
+  std::vector<int> out;
+  for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) out.push_back(j);
+  for (std::size_t i = 0; i < design.terms().size(); ++i) {
+    if (design.terms()[i].candidate) continue;
+    for (int c : term_columns(design, i)) out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<int> term_columns(const Design& design, std::size_t term) {
+  std::vector<int> out;
+  for (std::size_t k = 0; k < design.terms()[term].params.size(); ++k) {
+    out.push_back(design.term_column(term) + static_cast<int>(k));
+  }
+  return out;
+}
+
+double rms(double rss, std::int64_t n) { return n > 0 ? std::sqrt(rss / static_cast<double>(n)) : 0.0; }
+
+bool groups_explained(const StepSolution& s, const GroupFloors& floors, double ratio) {
+  for (int g = 0; g < kGroups; ++g) {
+    const double f = floors.of(static_cast<Group>(g));
+    if (!(f > 0.0) || s.n[g] == 0) continue;
+    if (rms(s.rss[g], s.n[g]) > ratio * f) return false;
+  }
+  return true;
+}
+
+double bic_of(const StepSolution& s) {
+  double n = 0.0;
+  for (int g = 0; g < kGroups; ++g) n += static_cast<double>(s.n[g]);
+  if (n <= 0.0) return 0.0;
+  return n * std::log(std::max(s.rss_w, 1e-300) / n) + static_cast<double>(s.k) * std::log(n);
+}
+
+void check_model_against_log(const ModelSpec& spec, const PreparedLog& log) {
+  for (const ModelTerm& t : spec.terms) {
+    const std::string name(t.effect->name());
+    if (t.effect->needs_reference() && !log.reference) {
+      throw std::invalid_argument("effect '" + name + "' needs the reference angle, which this log does not have");
+    }
+    if (t.effect->current_side() && !log.currents) {
+      throw std::invalid_argument("effect '" + name + "' acts on the phase currents, which this log does not have "
+                                  "(with a reference angle)");
+    }
+  }
+  const CoverageCheck c = check_coverage(log.rows, needed_orders(spec));
+  if (!c.ok) throw std::invalid_argument(c.missing);
+}
+
+std::string num(double v, const char* format) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+}  // namespace resolver

@@ -1,0 +1,39 @@
+// Shared steps of fit, ranking and narration: the nuisance columns a log needs,
+// the columns of a design's model, residual rms per signal, the verdict test.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/model/least_squares.h"
+
+namespace resolver {
+
+/// The nuisance columns of a log: constants the true angle cannot give (no
+/// reference), the envelopes' amplitude, the dq operating point.
+[[nodiscard]] std::vector<Nuisance> nuisances_for(const PreparedLog& log);
+
+/// Nuisance and model (non-candidate) columns of a design.
+[[nodiscard]] std::vector<int> model_columns(const Design& design);
+
+/// Columns of design term `term` (all of its fitted parameters).
+[[nodiscard]] std::vector<int> term_columns(const Design& design, std::size_t term);
+
+/// sqrt(rss / n), 0 for n = 0.
+[[nodiscard]] double rms(double rss, std::int64_t n);
+
+/// Every fitted group's residual (from a solution) within ratio x its floor.
+[[nodiscard]] bool groups_explained(const StepSolution& s, const GroupFloors& floors, double ratio);
+
+/// BIC of a solution: n ln(RSS_w / n) + k ln n over every weighted row.
+[[nodiscard]] double bic_of(const StepSolution& s);
+
+/// Checks the model's needs against the log (reference, currents, coverage).
+/// Throws std::invalid_argument naming the effect and what the log lacks.
+void check_model_against_log(const ModelSpec& spec, const PreparedLog& log);
+
+/// "%.3g" formatting for messages.
+[[nodiscard]] std::string num(double v, const char* format = "%.3g");
+
+}  // namespace resolver

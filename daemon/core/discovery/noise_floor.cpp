@@ -1,0 +1,228 @@
+#include "daemon/core/discovery/noise_floor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/model/normal_equations.h"
+
+namespace resolver {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr int kSaturatedOrder = 16;
+constexpr int kSpeedBins = 6;
+constexpr std::size_t kMinStretch = 10;
+
+int nyquist_order(double omega_abs_max, double dt) {
+  if (!(omega_abs_max > 0.0) || !(dt > 0.0)) return kSaturatedOrder;
+  const int n = static_cast<int>(std::floor(0.9 * kPi / (omega_abs_max * dt)));
+  return std::clamp(n, 2, kSaturatedOrder);
+}
+
+/// [1, sin n a, cos n a (n <= order)] (+ sin/cos of theta_m, 2 theta_m).
+void saturated_basis(double a, double theta_m, int order, bool mech, Eigen::VectorXd& x) {
+  const double s1 = std::sin(a), c1 = std::cos(a);
+  double sn = s1, cn = c1;
+  int j = 0;
+  x[j++] = 1.0;
+  for (int n = 1; n <= order; ++n) {
+    x[j++] = sn;
+    x[j++] = cn;
+    const double next = sn * c1 + cn * s1;
+    cn = cn * c1 - sn * s1;
+    sn = next;
+  }
+  if (mech) {
+    x[j++] = std::sin(theta_m);
+    x[j++] = std::cos(theta_m);
+    x[j++] = std::sin(2.0 * theta_m);
+    x[j++] = std::cos(2.0 * theta_m);
+  }
+}
+
+enum Sig { kRd, kSa, kSr, kD, kQ, kSigCount };
+
+bool has_sig(const FitRow& r, int s) {
+  if (s == kRd) return r.has(FitRow::kHasRd);
+  if (s == kSa || s == kSr) return r.has(FitRow::kHasSc);
+  return r.has(FitRow::kHasCur);
+}
+double value(const FitRow& r, int s) {
+  switch (s) {
+    case kRd: return r.y_rd;
+    case kSa: return r.y_sa;
+    case kSr: return r.y_sr;
+    case kD: return r.y_d;
+    default: return r.y_q;
+  }
+}
+
+/// Second-difference floor of each signal (NaN where not estimable).
+std::vector<double> second_difference_floors(std::span<const FitRow> rows, double dt, bool reference) {
+  double wmax = 0.0;
+  for (const FitRow& r : rows) {
+    if (r.fitted()) wmax = std::max(wmax, std::abs(r.sig.omega));
+  }
+  std::vector<double> sum(kSigCount, 0.0), dof(kSigCount, 0.0);
+  if (!(wmax > 0.0)) return std::vector<double>(kSigCount, kNaN);
+  auto bin_of = [&](const FitRow& r) {
+    return std::clamp(static_cast<int>(std::abs(r.sig.omega) / wmax * kSpeedBins), 0, kSpeedBins - 1);
+  };
+  const double e_per_r = rows.empty() ? 1.0 : static_cast<double>(rows.front().sig.p) / rows.front().sig.p_r;
+  for (int b = 0; b < kSpeedBins; ++b) {
+    const double bin_wmax = wmax * (b + 1) / kSpeedBins;
+    for (int s = 0; s < kSigCount; ++s) {
+      const bool electrical = s == kD || s == kQ;
+      const int order = nyquist_order(bin_wmax * (electrical ? e_per_r : 1.0), dt);
+      const bool mech = reference && !electrical;
+      const int k = 1 + 2 * order + (mech ? 4 : 0);
+      NormalEquations ne(k);
+      Eigen::VectorXd x0(k), x1(k), x2(k);
+      for (std::size_t i = 1; i + 1 < rows.size(); ++i) {
+        const FitRow& a = rows[i - 1];
+        const FitRow& m = rows[i];
+        const FitRow& c = rows[i + 1];
+        if (!a.fitted() || !m.fitted() || !c.fitted()) continue;
+        if (!has_sig(a, s) || !has_sig(m, s) || !has_sig(c, s)) continue;
+        if (bin_of(a) != b || bin_of(m) != b || bin_of(c) != b) continue;
+        if (c.sig.t - a.sig.t > 3.0 * dt) continue;  // consecutive samples only
+        auto angle = [&](const FitRow& r) { return electrical ? r.sig.theta_e : r.sig.theta; };
+        saturated_basis(angle(a), a.sig.theta_m, order, mech, x0);
+        saturated_basis(angle(m), m.sig.theta_m, order, mech, x1);
+        saturated_basis(angle(c), c.sig.theta_m, order, mech, x2);
+        ne.add(x2 - 2.0 * x1 + x0, value(c, s) - 2.0 * value(m, s) + value(a, s));
+      }
+      if (ne.n() < 4 * k) continue;
+      const Eigen::VectorXd coef = ne.m().completeOrthogonalDecomposition().solve(ne.b());
+      // The differenced constant column is zero: k - 1 effective columns.
+      sum[static_cast<std::size_t>(s)] += ne.rss(coef);
+      dof[static_cast<std::size_t>(s)] += 6.0 * static_cast<double>(ne.n() - (k - 1));
+    }
+  }
+  std::vector<double> out(kSigCount, kNaN);
+  for (int s = 0; s < kSigCount; ++s) {
+    if (dof[static_cast<std::size_t>(s)] > 0.0) out[static_cast<std::size_t>(s)] = std::sqrt(sum[static_cast<std::size_t>(s)] / dof[static_cast<std::size_t>(s)]);
+  }
+  return out;
+}
+
+/// Pooled within-stretch standard deviation of standstill samples, per signal.
+std::vector<double> standstill_floors(std::span<const FitRow> rows, std::int64_t& samples) {
+  std::vector<double> ss(kSigCount, 0.0);
+  std::vector<std::int64_t> n(kSigCount, 0), stretches(kSigCount, 0);
+  samples = 0;
+  std::size_t i = 0;
+  while (i < rows.size()) {
+    auto still = [&](std::size_t k) { return !rows[k].has(FitRow::kMoving) && !rows[k].has(FitRow::kExcluded); };
+    if (!still(i)) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < rows.size() && still(j)) ++j;
+    if (j - i >= kMinStretch) {
+      for (int s = 0; s < kSigCount; ++s) {
+        double sum = 0.0, sum2 = 0.0;
+        std::int64_t m = 0;
+        for (std::size_t k = i; k < j; ++k) {
+          if (rows[k].has(FitRow::kOutlier) || !has_sig(rows[k], s)) continue;
+          const double v = value(rows[k], s);
+          sum += v;
+          sum2 += v * v;
+          ++m;
+        }
+        if (m < 2) continue;
+        ss[static_cast<std::size_t>(s)] += std::max(0.0, sum2 - sum * sum / static_cast<double>(m));
+        n[static_cast<std::size_t>(s)] += m;
+        ++stretches[static_cast<std::size_t>(s)];
+      }
+      samples += static_cast<std::int64_t>(j - i);
+    }
+    i = j;
+  }
+  std::vector<double> out(kSigCount, kNaN);
+  for (int s = 0; s < kSigCount; ++s) {
+    const auto k = static_cast<std::size_t>(s);
+    const std::int64_t dof = n[k] - stretches[k];
+    if (n[k] >= kMinStandstillSamples && dof > 0) out[k] = std::sqrt(ss[k] / static_cast<double>(dof));
+  }
+  return out;
+}
+
+double pair(double a, double b) {
+  if (std::isnan(a) || std::isnan(b)) return std::isnan(a) ? b : a;
+  return std::sqrt(0.5 * (a * a + b * b));
+}
+
+FloorEstimate choose(double second, double standstill, double quantization, std::int64_t ss_samples,
+                     bool use_standstill) {
+  FloorEstimate f;
+  f.second_difference = second;
+  f.quantization = quantization;
+  f.standstill_samples = ss_samples;
+  f.standstill = std::isnan(standstill) ? kNaN : std::sqrt(standstill * standstill + quantization * quantization);
+  if (use_standstill && f.standstill > 0.0) {
+    f.chosen = f.standstill;
+    f.source = "standstill";
+  } else if (second > 0.0) {
+    f.chosen = second;
+    f.source = "second_differences";
+  } else {
+    f.chosen = 0.0;
+    f.source = "none";
+  }
+  return f;
+}
+
+}  // namespace
+
+double channel_quantum(std::span<const double> values) {
+  if (values.size() < 8) return 0.0;
+  // The quantizer's step shows in the differences of consecutive samples: they are
+  // whole multiples of it, so the smallest gap between distinct differences (or the
+  // smallest non-zero difference) is one step. A continuous signal shows a tiny
+  // gap. (Sorting the values themselves would find the sampling lattice when the
+  // speed is commensurate with the sample rate, not the quantizer.)
+  const std::size_t n = std::min<std::size_t>(values.size(), 20001);
+  std::vector<double> d;
+  d.reserve(n);
+  double lo = values[0], hi = values[0];
+  for (std::size_t i = 1; i < n; ++i) {
+    double x = values[i] - values[i - 1];
+    if (x > kPi) x -= kTwoPi;  // wrapped angles: a step across 0 is small
+    if (x < -kPi) x += kTwoPi;
+    d.push_back(x);
+    lo = std::min(lo, values[i]);
+    hi = std::max(hi, values[i]);
+  }
+  const double range = hi - lo;
+  if (!(range > 0.0)) return 0.0;
+  std::sort(d.begin(), d.end());
+  const double tiny = 1e-12 * range;
+  double q = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    if (std::abs(d[i]) > tiny) q = std::min(q, std::abs(d[i]));
+    if (i > 0 && d[i] - d[i - 1] > tiny) q = std::min(q, d[i] - d[i - 1]);
+  }
+  return std::isfinite(q) && q > 1e-9 * range ? q : 0.0;
+}
+
+FloorReport estimate_floors(std::span<const FitRow> rows, double sample_period, bool reference,
+                            const ChannelQuanta& quanta, bool use_standstill) {
+  const std::vector<double> sd = second_difference_floors(rows, sample_period, reference);
+  std::int64_t ss_samples = 0;
+  const std::vector<double> st = standstill_floors(rows, ss_samples);
+  // Quantization while moving: uniform, LSB^2/12 per quantized channel.
+  const double q_rd = std::sqrt((quanta.rd * quanta.rd + quanta.ref * quanta.ref) / 12.0);
+  const double q_sc = quanta.amplitude > 0.0 ? quanta.sincos / quanta.amplitude / std::sqrt(12.0) : 0.0;
+  FloorReport out;
+  out.rd = choose(sd[kRd], st[kRd], q_rd, ss_samples, use_standstill);
+  out.sc = choose(pair(sd[kSa], sd[kSr]), pair(st[kSa], st[kSr]), q_sc, ss_samples, use_standstill);
+  out.cur = choose(pair(sd[kD], sd[kQ]), pair(st[kD], st[kQ]), 0.0, ss_samples, use_standstill);
+  return out;
+}
+
+}  // namespace resolver

@@ -1,0 +1,334 @@
+#include "daemon/core/discovery/prepare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/discovery/self_calibration.h"
+#include "daemon/core/estimation/dq_transform.h"
+
+namespace resolver {
+
+namespace {
+
+/// Share of the samples that must carry a signal before it is used [1].
+constexpr double kSignalPresentShare = 0.9;
+constexpr std::int64_t kMinMovingSamples = 64;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+std::string motion_words(const MotionSummary& m, int p_r) {
+  return fmt::format("{} samples over {:.3g} s: {} moving, {} at standstill, {:.3g} mechanical revolutions "
+                     "({:.3g} electrical) travelled",
+                     m.samples, m.span_s, m.moving, m.standstill, m.travelled / kTwoPi, m.travelled * p_r / kTwoPi);
+}
+
+/// Validation folds (held-back residual): alternate revolutions when there are
+/// enough, else the two directions, else the two halves in time.
+std::string assign_folds(std::vector<FitRow>& rows, const PreparedLog& p) {
+  const double mech_revs = p.motion.travelled / kTwoPi;
+  const double elec_revs = mech_revs * p.p_r;
+  double travel = 0.0;
+  const bool by_mech = mech_revs >= 4.0;
+  const bool by_elec = !by_mech && elec_revs >= 4.0;
+  const bool by_direction = !by_mech && !by_elec && p.motion.forward > 0 && p.motion.backward > 0;
+  std::int64_t moving_seen = 0;
+  const std::int64_t half = p.motion.moving / 2;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    FitRow& r = rows[i];
+    if (i > 0 && r.has(FitRow::kMoving) && rows[i - 1].has(FitRow::kMoving)) {
+      travel += std::abs(r.sig.theta_m - rows[i - 1].sig.theta_m);
+    }
+    bool b = false;
+    if (by_mech) b = static_cast<std::int64_t>(travel / kTwoPi) % 2 == 1;
+    else if (by_elec) b = static_cast<std::int64_t>(travel * p.p_r / kTwoPi) % 2 == 1;
+    else if (by_direction) b = r.sig.direction < 0.0;
+    else b = moving_seen >= half;
+    if (r.has(FitRow::kMoving)) ++moving_seen;
+    if (b) r.flags |= FitRow::kFoldB;
+    r.block = static_cast<std::int32_t>(travel * p.p_r / kTwoPi);
+  }
+  if (by_mech) return "alternate mechanical revolutions";
+  if (by_elec) return "alternate electrical revolutions";
+  if (by_direction) return "forward against backward";
+  return "first half against second half of the moving samples";
+}
+
+}  // namespace
+
+std::int64_t PreparedLog::fitted_rows() const {
+  return std::count_if(rows.begin(), rows.end(), [](const FitRow& r) { return r.fitted(); });
+}
+
+std::int64_t PreparedLog::outlier_rows() const {
+  return std::count_if(rows.begin(), rows.end(), [](const FitRow& r) { return r.has(FitRow::kOutlier); });
+}
+
+double PreparedLog::electrical_revolutions() const { return motion.travelled * p_r / kTwoPi; }
+
+PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
+  if (in.p_r < 1 || in.p < 1) {
+    throw std::invalid_argument(fmt::format("pole pairs p_r = {} and p = {} must be >= 1", in.p_r, in.p));
+  }
+  PreparedLog p;
+  p.p_r = in.p_r;
+  p.p = in.p;
+  p.samples_in = static_cast<std::int64_t>(in.samples.size());
+  std::size_t with_rd = 0, with_sc = 0, with_ref = 0, with_cur = 0;
+  for (const Sample& s : in.samples) {
+    with_rd += s.has_rd ? 1 : 0;
+    with_sc += s.has_sincos ? 1 : 0;
+    with_ref += s.has_ref ? 1 : 0;
+    with_cur += s.has_currents ? 1 : 0;
+  }
+  const double total = static_cast<double>(std::max<std::size_t>(in.samples.size(), 1));
+  p.rd = static_cast<double>(with_rd) >= kSignalPresentShare * total;
+  p.sincos = static_cast<double>(with_sc) >= kSignalPresentShare * total;
+  p.reference = static_cast<double>(with_ref) >= kSignalPresentShare * total;
+  const bool currents = static_cast<double>(with_cur) >= kSignalPresentShare * total;
+  if (!p.rd && !p.sincos) {
+    throw std::invalid_argument(fmt::format(
+        "no angle signal: of {} samples {} carry an R/D angle and {} sin/cos envelopes (a signal is used when at "
+        "least 90 % of the samples carry it); check the layout's signal map",
+        in.samples.size(), with_rd, with_sc));
+  }
+  if (!p.reference) {
+    p.notes.emplace_back(
+        "no reference angle: fitting against the self-calibrated ideal angle (constant errors, delay, backlash, "
+        "mounting offset and mechanical orders are not identifiable)");
+  }
+  if (!p.sincos) p.notes.emplace_back("no sin/cos envelopes: only the R/D angle is fitted (k3 and alpha, k2 and "
+                                      "offsets, land on the same orders and are told apart only by sin/cos)");
+  if (!p.rd) p.notes.emplace_back("no R/D angle: the position error is the sin/cos angle's");
+  if (!currents) p.notes.emplace_back("no phase currents in the log: current-side effects are not evaluated");
+  else if (!p.reference) p.notes.emplace_back("phase currents present but not fitted without a reference angle (dq needs the true theta_e)");
+
+  // The samples the fit can use: a primary angle, and the reference in reference mode.
+  std::vector<const Sample*> s;
+  s.reserve(in.samples.size());
+  for (const Sample& x : in.samples) {
+    const bool angle = p.rd ? x.has_rd : x.has_sincos;
+    if (!angle) {
+      ++p.without_angle;
+      continue;
+    }
+    if (p.reference && !x.has_ref) {
+      ++p.without_reference;
+      continue;
+    }
+    s.push_back(&x);
+  }
+  const std::size_t n = s.size();
+  if (n < static_cast<std::size_t>(kMinMovingSamples)) {
+    throw std::invalid_argument(fmt::format("too few samples with an angle ({}): nothing to fit", n));
+  }
+  std::vector<double> t(n), dts;
+  for (std::size_t i = 0; i < n; ++i) t[i] = s[i]->t - s.front()->t;
+  dts.reserve(n);
+  for (std::size_t i = 1; i < n; ++i) dts.push_back(t[i] - t[i - 1]);
+  p.sample_period = std::max(median(dts), 1e-9);
+
+  // Envelope amplitude [counts]: the median radius (robust to outliers and clipping).
+  if (p.sincos) {
+    std::vector<double> radius;
+    radius.reserve(n);
+    for (const Sample* x : s) {
+      if (x->has_sincos) radius.push_back(std::hypot(x->sin, x->cos));
+    }
+    p.amplitude = median(radius);
+    if (!(p.amplitude > 0.0)) {
+      p.sincos = false;
+      p.notes.emplace_back("sin/cos envelopes are zero: loss of signal; the sin/cos rows are not fitted");
+    }
+  }
+  // Primary measured angle (wrapped) per sample.
+  std::vector<double> primary(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    primary[i] = p.rd ? wrap_2pi(s[i]->theta_rd) : wrap_2pi(std::atan2(s[i]->sin, s[i]->cos));
+  }
+  // True angle and motion.
+  std::vector<double> theta(n), theta_m(n);
+  std::vector<MotionSample> motion;
+  std::vector<bool> usable(n, true);
+  if (p.reference) {
+    AngleUnwrapper un;
+    for (std::size_t i = 0; i < n; ++i) {
+      theta_m[i] = un.update(wrap_2pi(s[i]->theta_m_ref));
+      theta[i] = p.p_r * theta_m[i];
+    }
+    motion = analyse_motion(t, theta_m, p.motion);
+  } else {
+    std::vector<double> cont(n), mech(n);
+    AngleUnwrapper un;
+    for (std::size_t i = 0; i < n; ++i) {
+      cont[i] = un.update(primary[i]);
+      mech[i] = cont[i] / p.p_r;
+    }
+    MotionSummary raw_motion;
+    motion = analyse_motion(t, mech, raw_motion);
+    const SelfCalibration cal = self_calibrate(t, cont, primary, motion, p.sample_period);
+    p.unusable_self_calibration = cal.unusable;
+    for (std::size_t i = 0; i < n; ++i) {
+      theta[i] = cal.ideal[i];
+      theta_m[i] = theta[i] / p.p_r;
+      usable[i] = cal.usable[i];
+    }
+    motion = analyse_motion(t, theta_m, p.motion);
+    if (cal.unusable > 0) {
+      p.notes.push_back(fmt::format("{} moving samples are in stretches shorter than one electrical revolution: "
+                                    "without a reference they cannot be self-calibrated and are not fitted",
+                                    cal.unusable));
+    }
+  }
+  if (p.motion.moving < kMinMovingSamples) {
+    throw std::invalid_argument(fmt::format("the rotor hardly moves: {}; at least {} moving samples are needed",
+                                            motion_words(p.motion, p.p_r), kMinMovingSamples));
+  }
+  // Travel since the last reversal, from its turning point (backlash's take-up).
+  std::vector<double> since(n, std::numeric_limits<double>::infinity());
+  {
+    double held = motion.empty() ? 1.0 : motion.front().direction;
+    double extremum = theta_m.empty() ? 0.0 : theta_m.front();
+    double turning = 0.0;
+    bool reversed = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (motion[i].direction != held) {
+        turning = extremum;
+        reversed = true;
+        held = motion[i].direction;
+        extremum = theta_m[i];
+      }
+      extremum = held > 0.0 ? std::max(extremum, theta_m[i]) : std::min(extremum, theta_m[i]);
+      if (reversed) since[i] = std::abs(theta_m[i] - turning);
+    }
+  }
+  // Rows.
+  p.rows.resize(n);
+  double i_d0 = 0.0, i_q0 = 0.0;
+  std::int64_t n_cur = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    FitRow& r = p.rows[i];
+    const Sample& x = *s[i];
+    r.sig.t = t[i];
+    r.sig.theta = theta[i];
+    r.sig.theta_m = theta_m[i];
+    r.sig.omega = motion[i].omega * p.p_r;
+    r.sig.accel = motion[i].accel * p.p_r;
+    r.sig.direction = motion[i].direction;
+    r.sig.since_reversal = since[i];
+    r.sig.p_r = p.p_r;
+    r.sig.p = p.p;
+    if (motion[i].moving && usable[i]) r.flags |= FitRow::kMoving;
+    const bool wrong_way = (opt.direction == DirectionFilter::kForward && motion[i].direction < 0.0) ||
+                           (opt.direction == DirectionFilter::kBackward && motion[i].direction > 0.0);
+    if (wrong_way && r.has(FitRow::kMoving)) {
+      r.flags &= static_cast<std::uint16_t>(~FitRow::kMoving);
+      r.flags |= FitRow::kExcluded;
+      ++p.excluded_direction;
+    }
+    if (opt.moving_only && !r.has(FitRow::kMoving)) r.flags |= FitRow::kExcluded;
+    if (!usable[i]) r.flags |= FitRow::kExcluded;
+    if (p.rd && x.has_rd) {
+      r.y_rd = wrap_pi(theta[i] - x.theta_rd);
+      r.flags |= FitRow::kHasRd;
+    }
+    if (p.sincos && x.has_sincos) {
+      r.y_sa = wrap_pi(theta[i] - std::atan2(x.sin, x.cos));
+      r.y_sr = std::hypot(x.sin, x.cos) / p.amplitude - 1.0;
+      r.flags |= FitRow::kHasSc;
+    }
+    if (currents && p.reference && x.has_currents) {
+      r.sig.theta_e = p.p * theta_m[i];
+      const ClarkeTransform ab(x.i_a, x.i_b, x.i_c);
+      const ParkTransform dq(ab.alpha, ab.beta, r.sig.theta_e);
+      r.y_d = dq.d;
+      r.y_q = dq.q;
+      r.flags |= FitRow::kHasCur;
+      if (r.has(FitRow::kMoving)) {
+        i_d0 += dq.d;
+        i_q0 += dq.q;
+        ++n_cur;
+      }
+    }
+  }
+  p.currents = n_cur > 0;
+  if (n_cur > 0) {
+    i_d0 /= static_cast<double>(n_cur);
+    i_q0 /= static_cast<double>(n_cur);
+    for (FitRow& r : p.rows) {
+      r.sig.i_d0 = i_d0;
+      r.sig.i_q0 = i_q0;
+    }
+  }
+  // Outliers, per signal over consecutive samples.
+  std::vector<bool> flags(n, false), ok(n);
+  std::vector<double> y(n);
+  auto scan = [&](FitRow::Flag has, double FitRow::*field, const std::string& name) {
+    for (std::size_t i = 0; i < n; ++i) {
+      ok[i] = p.rows[i].has(has) && !p.rows[i].has(FitRow::kExcluded);
+      y[i] = p.rows[i].*field;
+    }
+    OutlierSignal o = find_outliers(t, y, ok, flags, name);
+    if (o.count == 0) return;
+    bool merged = false;
+    for (OutlierSignal& e : p.outliers) {
+      if (e.signal != o.signal) continue;
+      e.count += o.count;
+      e.largest = std::max(e.largest, o.largest);
+      merged = true;
+    }
+    if (!merged) p.outliers.push_back(std::move(o));
+  };
+  if (p.rd) scan(FitRow::kHasRd, &FitRow::y_rd, "position_error");
+  if (p.sincos) {
+    scan(FitRow::kHasSc, &FitRow::y_sa, "sin_cos");
+    scan(FitRow::kHasSc, &FitRow::y_sr, "sin_cos");
+  }
+  if (p.currents) {
+    scan(FitRow::kHasCur, &FitRow::y_d, "i_dq");
+    scan(FitRow::kHasCur, &FitRow::y_q, "i_dq");
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (flags[i]) p.rows[i].flags |= FitRow::kOutlier;
+  }
+  p.fold_rule = assign_folds(p.rows, p);
+  // Quanta of the raw channels and the floors.
+  std::vector<double> v;
+  v.reserve(n);
+  auto quantum = [&](auto get) {
+    v.clear();
+    for (const Sample* x : s) v.push_back(get(*x));
+    return channel_quantum(v);
+  };
+  if (p.rd) p.quanta.rd = quantum([](const Sample& x) { return wrap_2pi(x.theta_rd); });
+  if (p.reference) p.quanta.ref = p.p_r * quantum([](const Sample& x) { return wrap_2pi(x.theta_m_ref); });
+  if (p.sincos) {
+    p.quanta.sincos = quantum([](const Sample& x) { return x.sin; });
+    p.quanta.amplitude = p.amplitude;
+  }
+  p.floors = estimate_floors(p.rows, p.sample_period, p.reference, p.quanta, !opt.moving_only);
+  if (p.rd && !(p.floors.rd.chosen > 0.0)) {
+    throw std::invalid_argument("could not estimate the noise floor of the position error (too few consecutive "
+                                "moving samples per speed)");
+  }
+  if (p.sincos && !(p.floors.sc.chosen > 0.0)) {
+    p.sincos = false;
+    p.notes.emplace_back("sin/cos floor could not be estimated: sin/cos not fitted");
+  }
+  if (p.currents && !(p.floors.cur.chosen > 0.0)) {
+    p.currents = false;
+    p.notes.emplace_back("phase currents present but their noise floor could not be estimated: not fitted");
+  }
+  return p;
+}
+
+}  // namespace resolver

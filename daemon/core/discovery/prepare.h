@@ -1,0 +1,75 @@
+// From a log's samples to the rows a fit uses (discovery's first step; pure).
+//
+//   samples ─► signals present (>= 90 % of the samples carry them)
+//          ─► true angle: the reference encoder (unwrapped, x p_r), or without one
+//             the self-calibrated ideal angle (self_calibration.h)
+//          ─► motion: speed, acceleration, standstill, direction (motion.h)
+//          ─► rows: R/D angle error, sin/cos angle error and radius, dq currents in
+//             the true frame (fit_row.h); flags: moving, outlier (outliers.h),
+//             validation fold, revolution block
+//          ─► noise floors (noise_floor.h)
+// Standstill samples enter no fit and never count as revolutions; they give the
+// noise floor. Any motion works: out-and-back sweeps, reversals, steps, ramps,
+// slow turns, p_r = 1. What the fit needs of the motion is checked per design
+// (coverage.h), not here.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "daemon/core/discovery/motion.h"
+#include "daemon/core/discovery/noise_floor.h"
+#include "daemon/core/discovery/outliers.h"
+#include "daemon/core/model/fit_row.h"
+#include "daemon/core/sample.h"
+
+namespace resolver {
+
+struct DiscoveryInput {
+  int p_r = 3;  ///< resolver pole pairs
+  int p = 3;    ///< motor pole pairs
+  std::vector<Sample> samples;
+};
+
+enum class DirectionFilter : std::uint8_t { kBoth, kForward, kBackward };
+
+struct PrepareOptions {
+  DirectionFilter direction = DirectionFilter::kBoth;
+  /// Standstill samples are not used at all (no standstill floor either).
+  bool moving_only = false;
+};
+
+struct PreparedLog {
+  int p_r = 3, p = 3;
+  bool reference = false;  ///< true angle from the reference encoder
+  bool rd = false;         ///< R/D angle rows
+  bool sincos = false;     ///< sin/cos rows
+  bool currents = false;   ///< dq rows (needs the reference)
+  double amplitude = 0.0;      ///< [counts] median sin/cos radius
+  double sample_period = 0.0;  ///< [s] median
+  std::vector<FitRow> rows;
+  MotionSummary motion;        ///< of the mechanical angle (true, or self-calibrated / p_r)
+  FloorReport floors;
+  ChannelQuanta quanta;
+  std::vector<OutlierSignal> outliers;
+  std::int64_t samples_in = 0;            ///< samples given
+  std::int64_t without_angle = 0;         ///< no R/D angle or sin/cos
+  std::int64_t without_reference = 0;     ///< dropped in reference mode
+  std::int64_t excluded_direction = 0;    ///< moving the other way (--direction)
+  std::int64_t unusable_self_calibration = 0;
+  std::string fold_rule;                  ///< how the validation folds were drawn
+  std::vector<std::string> notes;         ///< what the log lacks, assumptions
+
+  [[nodiscard]] std::int64_t fitted_rows() const;
+  [[nodiscard]] std::int64_t outlier_rows() const;
+  /// [rev] electrical revolutions travelled while moving.
+  [[nodiscard]] double electrical_revolutions() const;
+};
+
+/// Builds the rows. Throws std::invalid_argument saying what is missing: no
+/// angle signal (R/D or sin/cos) on 90 % of the samples, pole pairs < 1, fewer
+/// than 64 moving samples (the message gives the motion seen).
+[[nodiscard]] PreparedLog prepare_log(const DiscoveryInput& input, const PrepareOptions& options = {});
+
+}  // namespace resolver

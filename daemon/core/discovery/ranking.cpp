@@ -1,0 +1,296 @@
+#include "daemon/core/discovery/ranking.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "daemon/core/discovery/coverage.h"
+#include "daemon/core/discovery/fit_support.h"
+#include "daemon/core/effects/harmonics.h"
+#include "daemon/core/effects/registry.h"
+#include "daemon/core/model/custom_effect.h"
+#include "daemon/core/model/least_squares.h"
+
+namespace resolver {
+
+namespace {
+
+/// Orders of the residual the harmonic families are tried at: the largest ones
+/// above 4 standard errors of a harmonic amplitude (floor sqrt(2 / n)), at most this many.
+constexpr int kOrdersTried = 3;
+constexpr double kSignificance = 4.0;
+/// Nonlinear candidates refitted to convergence (the best by their linearised score).
+constexpr int kNonlinearRefits = 2;
+/// Candidates within this BIC of each other, or whose improvements differ by less
+/// than this share, are not told apart by the log (e.g. K_3 and a 6th mechanical
+/// harmonic with p_r = 3: the same 2 theta in the angle, and alpha takes up the
+/// radius; channel delay and quadrature at one speed).
+constexpr double kIndistinguishableBic = 10.0;
+constexpr double kIndistinguishableShare = 0.02;
+
+std::vector<int> significant_orders(const std::vector<HarmonicResidual>& h, double floor, std::int64_t n, int lowest) {
+  std::vector<HarmonicResidual> v;
+  const double se = floor * std::sqrt(2.0 / std::max<double>(1.0, static_cast<double>(n)));
+  for (const HarmonicResidual& x : h) {
+    if (x.order >= lowest && x.amplitude > kSignificance * se) v.push_back(x);
+  }
+  std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.amplitude > b.amplitude; });
+  std::vector<int> out;
+  for (std::size_t i = 0; i < v.size() && static_cast<int>(i) < kOrdersTried; ++i) out.push_back(v[i].order);
+  return out;
+}
+
+bool in_model(const ModelSpec& spec, const Effect& e, int param) {
+  const ModelTerm* t = spec.find(e);
+  return t != nullptr && std::find(t->params.begin(), t->params.end(), param) != t->params.end();
+}
+
+/// The candidate terms: defaults of every fittable effect not in the model, the
+/// harmonic families at the residual's orders, the config's custom effects.
+std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& opt,
+                                       std::vector<std::string>& not_evaluated) {
+  std::vector<ModelTerm> out;
+  const ModelSpec& spec = fit.model.spec();
+  auto usable = [&](const ModelTerm& t) {
+    const std::string name = t.reference();
+    if (t.effect->needs_reference() && !log.reference) {
+      not_evaluated.push_back(name + ": needs the reference angle");
+      return false;
+    }
+    if (t.effect->current_side() && !log.currents) {
+      not_evaluated.push_back(name + ": needs the phase currents (and the reference angle)");
+      return false;
+    }
+    const CoverageCheck c = check_coverage(log.rows, needed_orders(t));
+    if (!c.ok) {
+      not_evaluated.push_back(name + ": " + c.missing);
+      return false;
+    }
+    return true;
+  };
+  const std::int64_t n = fit.account.fitted;
+  for (const Effect* e : effect_registry()) {
+    if (!e->fittable()) continue;
+    const std::string_view name = e->name();
+    if (name == "harmonics") {
+      // Residual at order m of theta: K_{m+1} (same sign) or K_{m-1} opposite (m >= 3), K_0 / K_2 at m = 1.
+      for (int m : significant_orders(fit.harmonics, fit.noise_floor_rad, n, 1)) {
+        std::vector<std::string> params;
+        if (m == 1) params = {"k2", "k0"};
+        else params = {fmt::format("k{}", m + 1), m - 1 >= 2 ? fmt::format("k{}_opp", m - 1) : ""};
+        for (const std::string& p : params) {
+          const int i = p.empty() ? -1 : find_param(*e, p);
+          if (i < 0 || in_model(spec, *e, i)) continue;
+          const ModelTerm t{e, {i}};
+          if (usable(t)) out.push_back(t);
+        }
+      }
+      continue;
+    }
+    if (name == "mechanical_harmonics") {
+      // Order 1 is eccentricity's (a candidate of its own).
+      for (int m : significant_orders(fit.harmonics_mech, fit.noise_floor_rad, n, 2)) {
+        const int a = find_param(*e, fmt::format("a{}", m));
+        if (a < 0 || in_model(spec, *e, a)) continue;
+        const ModelTerm t{e, {a, a + 1}};
+        if (usable(t)) out.push_back(t);
+      }
+      continue;
+    }
+    if (spec.find(*e) != nullptr) continue;
+    const ModelTerm t{e, default_params(*e)};
+    if (!t.params.empty() && usable(t)) out.push_back(t);
+  }
+  if (opt.customs != nullptr) {
+    for (const auto& c : opt.customs->all()) {
+      if (spec.find(*c) != nullptr) continue;
+      std::vector<int> all;
+      for (int i = 0; i < static_cast<int>(c->params().size()); ++i) all.push_back(i);
+      const ModelTerm t{c.get(), all};
+      if (usable(t)) out.push_back(t);
+    }
+  }
+  return out;
+}
+
+std::string reason_of(const ModelTerm& t, const std::vector<ParamValue>& params) {
+  std::string vals;
+  const std::string prefix = std::string(t.effect->name()) + ".";
+  for (const ParamValue& p : params) {
+    vals += (vals.empty() ? "" : ", ") + p.name.substr(prefix.size()) + " = " + num(p.value) + " +- " +
+            num(p.std_error, "%.2g");
+  }
+  return std::string(t.effect->physics()) + " (fit: " + vals + ").";
+}
+
+/// The candidate's parameters in value coordinates from a solution (internal step dz
+/// from the candidate's neutral point; standard errors from the inverse).
+std::vector<ParamValue> candidate_params(const Design& union_design, std::size_t term, const StepSolution& s) {
+  Design moved = union_design;
+  DesignTerm& dt = moved.terms()[term];
+  dt.candidate = false;  // let step() move it
+  moved.step(s.dz);
+  std::vector<ParamValue> out;
+  const double s2 = s.rss_w / std::max(1.0, static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k));
+  for (std::size_t k = 0; k < dt.params.size(); ++k) {
+    const auto p = static_cast<std::size_t>(dt.params[k]);
+    const ParamInfo& info = dt.effect->params()[p];
+    const int col = union_design.term_column(term) + static_cast<int>(k);
+    double se = std::sqrt(std::max(0.0, s2 * s.inverse(col, col)));
+    if (info.nonlinear && info.scale == FitScale::kInverseSquare) {
+      const double z = std::max(s.dz[col], 1e-300);
+      se *= 0.5 * std::pow(z, -1.5);
+    }
+    out.push_back({std::string(dt.effect->name()) + "." + std::string(info.name),
+                   moved.terms()[term].values[p], se, std::string(info.unit)});
+  }
+  return out;
+}
+
+}  // namespace
+
+Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
+  Ranking out;
+  const std::vector<ModelTerm> terms = candidate_terms(log, fit, options, out.not_evaluated);
+  for (const Effect* e : effect_registry()) {
+    if (!e->fittable()) {
+      out.not_evaluated.push_back(std::string(e->name()) + ": sets the noise floor, not a candidate");
+    }
+  }
+  if (terms.empty()) return out;
+  const GroupFloors floors = fit.floors.floors();
+  Design d = fit.model.design(nuisances_for(log));
+  const std::size_t first_candidate = d.terms().size();
+  for (const ModelTerm& t : terms) d.add_candidate(t);
+  PassStatistics stats(d.columns());
+  accumulate(d, log.rows, floors, stats);
+  ++out.passes;
+  const std::vector<int> base_cols = model_columns(d);
+  const StepSolution base = solve_step(stats.all, floors, base_cols);
+  const double base_bic = bic_of(base);
+  const double excess_base = base.rss_w;
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    const std::size_t term = first_candidate + i;
+    std::vector<int> cols = base_cols;
+    for (int c : term_columns(d, term)) cols.push_back(c);
+    const StepSolution s = solve_step(stats.all, floors, cols);
+    if (!s.ok) {
+      out.not_evaluated.push_back(terms[i].reference() + ": not separable from the model with the signals in this log" +
+                                  (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));
+      continue;
+    }
+    Candidate c;
+    c.effect = terms[i].reference();
+    c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
+    c.sincos_residual_after = rms(s.rss[1], s.n[1]);
+    c.dq_residual_after = rms(s.rss[2], s.n[2]);
+    c.weighted_rss = s.rss_w;
+    c.score = bic_of(s);
+    c.bic_drop = base_bic - c.score;
+    c.err = excess_base > 0.0 ? (excess_base - s.rss_w) / excess_base : 0.0;
+    c.proposed = c.bic_drop > options.proposal_bic_drop;
+    c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
+    c.params = candidate_params(d, term, s);
+    c.reason = reason_of(terms[i], c.params);
+    out.candidates.push_back(std::move(c));
+    if (options.progress) options.progress(0.5 + 0.3 * static_cast<double>(i + 1) / static_cast<double>(terms.size()));
+  }
+  std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
+  // Nonlinear candidates: the linearised step is only the start; refit the best ones.
+  int refits = 0;
+  for (Candidate& c : out.candidates) {
+    if (refits >= kNonlinearRefits || !c.proposed) continue;
+    const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
+    bool nonlinear = false;
+    for (int p : one.terms.front().params) {
+      nonlinear = nonlinear || one.terms.front().effect->params()[static_cast<std::size_t>(p)].nonlinear;
+    }
+    if (!nonlinear) continue;
+    ++refits;
+    ModelSpec with = fit.model.spec();
+    with.add(one.terms.front());
+    Model m(with, log.p_r, log.p);
+    std::vector<std::vector<double>> values = fit.model.values();
+    Design dm = Design(with, values, nuisances_for(log));
+    const FitResult fr = fit_design(dm, log.rows, floors);
+    out.passes += fr.passes;
+    if (!fr.ok) continue;
+    const StepSolution& s = fr.last;
+    c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
+    c.sincos_residual_after = rms(s.rss[1], s.n[1]);
+    c.dq_residual_after = rms(s.rss[2], s.n[2]);
+    c.weighted_rss = s.rss_w;
+    c.score = bic_of(s);
+    c.bic_drop = base_bic - c.score;
+    c.err = excess_base > 0.0 ? (excess_base - s.rss_w) / excess_base : 0.0;
+    c.proposed = c.bic_drop > options.proposal_bic_drop;
+    c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
+    const std::size_t last = dm.terms().size() - 1;
+    c.params.clear();
+    const auto& t = dm.terms()[last];
+    for (int p : t.params) {
+      const ParamInfo& info = t.effect->params()[static_cast<std::size_t>(p)];
+      c.params.push_back({std::string(t.effect->name()) + "." + std::string(info.name),
+                          t.values[static_cast<std::size_t>(p)], std::nan(""), std::string(info.unit)});
+    }
+    c.reason = reason_of(one.terms.front(), c.params);
+  }
+  std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
+  // Candidates this log cannot tell apart.
+  auto alike = [&](const Candidate& a, const Candidate& b) {
+    const double gain = std::max(excess_base - a.weighted_rss, excess_base - b.weighted_rss);
+    return std::abs(a.score - b.score) < kIndistinguishableBic ||
+           (gain > 0.0 && std::abs(a.weighted_rss - b.weighted_rss) < kIndistinguishableShare * gain);
+  };
+  for (Candidate& c : out.candidates) {
+    if (!c.proposed) continue;
+    for (const Candidate& o : out.candidates) {
+      if (&o == &c || !o.proposed) continue;
+      if (alike(c, o)) c.fits_as_well.push_back(o.effect);
+    }
+  }
+  // Among candidates the log cannot tell apart, name the simplest first: fewer
+  // parameters, then one that needs no change of speed (constant at one speed is the
+  // plainer explanation), then the lower BIC.
+  auto simpler = [&options](const Candidate& a, const Candidate& b) {
+    const ModelSpec sa = ModelSpec::parse(std::vector<std::string>{a.effect}, options.customs);
+    if (a.params.size() != b.params.size()) return a.params.size() < b.params.size();
+    const ModelSpec sb = ModelSpec::parse(std::vector<std::string>{b.effect}, options.customs);
+    const bool va = sa.terms.front().effect->needs_speed_change(), vb = sb.terms.front().effect->needs_speed_change();
+    if (va != vb) return !va;
+    return a.score < b.score;
+  };
+  for (std::size_t i = 0; i < out.candidates.size(); ++i) {
+    for (std::size_t j = i + 1; j < out.candidates.size(); ++j) {
+      const Candidate& a = out.candidates[i];
+      const Candidate& b = out.candidates[j];
+      if (a.proposed && b.proposed && alike(a, b) && simpler(b, a)) std::swap(out.candidates[i], out.candidates[j]);
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
+                                           const std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
+  std::vector<const Candidate*> top;
+  for (const Candidate& c : candidates) {
+    if (c.proposed && top.size() < 3) top.push_back(&c);
+  }
+  for (std::size_t i = 0; i < top.size(); ++i) {
+    for (std::size_t j = i + 1; j < top.size(); ++j) {
+      std::vector<std::string> refs = fit.model.spec().references();
+      refs.push_back(top[i]->effect);
+      refs.push_back(top[j]->effect);
+      try {
+        const ModelFit f = fit_prepared(log, refs, options);
+        if (f.explained) return {top[i]->effect, top[j]->effect};
+      } catch (const std::invalid_argument&) {
+        // not separable together: not the pair
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace resolver

@@ -1,0 +1,45 @@
+#include "daemon/core/effects/delay.h"
+
+#include <array>
+#include <cmath>
+
+#include "daemon/core/effects/effect.h"
+
+namespace resolver {
+namespace {
+
+constexpr std::array kParams{
+    ParamInfo{.name = "d", .unit = "[s]", .description = "delay of the resolver signals behind the reference",
+              .min = -1.0, .max = 1.0, .nonlinear = true},
+};
+
+class DelayEffect final : public BasicEffect {
+ public:
+  DelayEffect()
+      : BasicEffect({"delay",
+                     "resolver signals of time t - d: eps = omega d, and every error harmonic shifted by omega d",
+                     "delay.h",
+                     "the resolver signals arrive late against the reference (bus, scope or filter latency): a "
+                     "position error proportional to speed that flips with the direction"},
+                    kParams, EffectStage::kMotion) {}
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  [[nodiscard]] bool needs_speed_change() const override { return true; }
+  [[nodiscard]] double resolver_time_shift(Values v) const override { return v[0]; }
+  void configure_basis(Values v, BasisTransform& t) const override { t.delay = v[0]; }
+  [[nodiscard]] bool linear_in_params() const override { return false; }
+  void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
+    const double d = v[0];
+    out.rd += row.omega * d - 0.5 * row.accel * d * d;
+    // The envelopes carry the late angle exactly: a rotation, radius unchanged.
+    out.sa += row.theta - b.env_angle();
+  }
+};
+
+}  // namespace
+
+const Effect& delay_effect() {
+  static const DelayEffect effect;
+  return effect;
+}
+
+}  // namespace resolver

@@ -1,0 +1,252 @@
+// One effect of the sensor chain, self-described: the unit the effect registry
+// (registry.h) lists and everything else is generated from — the catalog table,
+// the spec parser, --list-effects, the simulator's forward model and validation,
+// truth files, discovery's columns, compensation and docs/EFFECTS.md.
+//
+// Architecture of the model library (daemon/core/model/, pure maths: no I/O,
+// no clocks, no globals but the registry's constant list):
+//
+//   Effect (this file) ── one subclass per physical effect, one file pair each in
+//   │                     daemon/core/effects/, one line in registry.cpp
+//   ├─ forward hooks:     the simulator's chain calls them at the stage where the
+//   │                     effect acts (forward_chain.h):
+//   │                       motion      what the resolver sees of the true angle (delay, eccentricity, backlash)
+//   │                       windings    the envelopes of the resolver angle (quadrature, harmonics, gain, offsets)
+//   │                       channels    when each channel is taken (channel delay, sampling skew)
+//   │                       converter   the R/D loop and its resolution
+//   │                       currents    drive frame, inverter, current sensors
+//   │                       noise       the ADCs
+//   └─ signature:         per parameter, the derivative of every signal the fit
+//                         sees (signature.h): position error of the R/D angle,
+//                         sin/cos envelopes, i_d/i_q. A generic test checks each
+//                         one against the finite-difference derivative of the
+//                         forward chain, so a sign or scale slip fails.
+//   Model (model.h) ────── active effects + values + covariance: fit, estimate_t,
+//                         compensation, persisted calibration, export, reports.
+//
+// Errors: functions that can fail say so and throw std::invalid_argument with a
+// message naming the effect, parameter, value and the valid range (the one error
+// style of the library); everything else cannot fail.
+//
+// Units: angles [rad] (resolver electrical unless a name says mechanical or motor
+// electrical), time [s], currents [A], envelopes as a fraction of their nominal
+// amplitude (sin_cos.h). Conventions: daemon/core/angles.h (DESIGN 3).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "daemon/core/effects/phase_currents.h"
+#include "daemon/core/effects/sin_cos.h"
+#include "daemon/core/effects/signature.h"
+
+namespace resolver {
+
+/// How the fit parameterises a nonlinear parameter internally.
+enum class FitScale : std::uint8_t {
+  kLinear,         ///< the value itself
+  kInverseSquare,  ///< 1 / value^2 (tracking_loop omega_n: 0 = ideal converter is 1/omega_n^2 = 0)
+};
+
+/// Two parameters that form an amplitude and a phase (eccentricity e, phase): the
+/// forward model and every output use them, the signature's two columns are the
+/// derivatives with respect to the Cartesian pair x = amplitude cos(phase),
+/// y = amplitude sin(phase), which the fit solves for (a phase is not identifiable
+/// at amplitude 0).
+enum class Polar : std::uint8_t { kNone, kAmplitude, kPhase };
+
+/// One parameter of an effect, listed once.
+struct ParamInfo {
+  std::string_view name;
+  std::string_view unit;         ///< e.g. "[rad]", "[1]", "[s]"
+  std::string_view description;  ///< one line
+  double min = 0.0;              ///< smallest accepted value (inclusive)
+  double max = 0.0;              ///< largest accepted value (inclusive)
+  double neutral = 0.0;          ///< the value at which the effect does nothing
+  bool integer = false;          ///< must be a whole number
+  bool listed = true;            ///< shown in --list-effects (false for the long tail, e.g. k6..k20)
+  /// Enters the signals nonlinearly (tracking_loop omega_n, delay d): fitted by
+  /// Gauss-Newton / Levenberg-Marquardt with numeric derivatives; the others are
+  /// linear coefficients of the effect's signature columns.
+  bool nonlinear = false;
+  FitScale scale = FitScale::kLinear;  ///< nonlinear parameters only
+  Polar polar = Polar::kNone;
+  /// Part of the effect when a model names it without a parameter list (e.g.
+  /// "harmonics" fits k3; "harmonics(k5,k3_opp)" chooses others).
+  bool default_fit = true;
+};
+
+/// Where in the chain an effect acts (for the catalog and for which signals it can change).
+enum class EffectStage : std::uint8_t {
+  kMotion,      ///< the angle the resolver sees (delay, eccentricity, mounting, backlash)
+  kWindings,    ///< the resolver's envelopes
+  kChannels,    ///< timing of the channels (channel delay, sampling skew)
+  kConverter,   ///< the R/D converter (tracking loop, quantization)
+  kCurrents,    ///< phase currents (drive, inverter, sensors)
+  kNoise,       ///< measurement noise and impairments (sets the floor, never fitted)
+};
+
+/// Sub-stages of the windings, applied in this order to every effect's hook.
+enum class WindingStage : std::uint8_t {
+  kFundamental,  ///< replace the fundamental pair (quadrature)
+  kAdditive,     ///< add to both channels (harmonics)
+  kGain,         ///< scale a channel (amplitude imbalance)
+  kOffset,       ///< add constants after demodulation (offsets)
+};
+
+/// Sub-stages of the current chain, applied in this order.
+enum class CurrentStage : std::uint8_t {
+  kInverter,  ///< distortion of the machine currents (dead time)
+  kSensorGain,
+  kSensorOffset,
+};
+
+/// When the cos channel is taken relative to the sin channel [s] (> 0: later).
+struct ChannelTiming {
+  double converter_cos_dt = 0.0;  ///< the R/D converter's cos input (analog path)
+  double dsp_cos_dt = 0.0;        ///< the DSP's sampled cos envelope
+};
+
+/// The R/D converter the chain simulates.
+struct ConverterSpec {
+  double omega_n = 0.0;  ///< [rad/s] type-II loop natural frequency; 0 = ideal (atan2)
+  double zeta = 0.7;     ///< [1] loop damping
+  int rd_bits = 16;      ///< [bits] resolution of the rd_angle field
+};
+
+/// Measurement impairments the chain adds (never fitted; they set the floor).
+struct Impairments {
+  double sigma_sc = 0.0;         ///< [counts] white noise on each sin/cos ADC sample
+  double sigma_i = 0.0;          ///< [A] white noise on each phase current sample
+  double outlier_rate = 0.0;     ///< [1/s] impulsive samples on the sin channel
+  double outlier_size = 0.0;     ///< [counts] their size (sign random)
+};
+
+/// The highest harmonic orders an effect's columns use, of the resolver angle theta,
+/// the mechanical angle theta_m and the motor angle theta_e: a fit needs the log to
+/// cover every one of 2N bins of each angle (discovery's coverage check).
+struct HarmonicOrders {
+  int theta = 0;
+  int theta_m = 0;
+  int theta_e = 0;
+};
+
+/// The parameter values of one effect, in the order of its params().
+using Values = std::span<const double>;
+
+/// State a motion hook may keep between samples (backlash's play).
+struct MotionState {
+  bool started = false;
+  double value = 0.0;
+};
+
+class Effect {
+ public:
+  Effect() = default;
+  virtual ~Effect() = default;
+  Effect(const Effect&) = delete;
+  Effect& operator=(const Effect&) = delete;
+  Effect(Effect&&) = delete;
+  Effect& operator=(Effect&&) = delete;
+
+  // ---- self-description ----------------------------------------------------
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  /// One line: forward model and signature.
+  [[nodiscard]] virtual std::string_view description() const = 0;
+  /// Paper equations or the header that derives it.
+  [[nodiscard]] virtual std::string_view source() const = 0;
+  /// One sentence of physics for "what is missing" explanations.
+  [[nodiscard]] virtual std::string_view physics() const = 0;
+  [[nodiscard]] virtual std::span<const ParamInfo> params() const = 0;
+  [[nodiscard]] virtual EffectStage stage() const = 0;
+  /// False for effects that only set the floor (noise, quantization, outliers).
+  [[nodiscard]] virtual bool fittable() const { return true; }
+  /// The signature needs the reference angle (an absolute or mechanical quantity).
+  [[nodiscard]] virtual bool needs_reference() const { return false; }
+  /// Acts on the phase currents only.
+  [[nodiscard]] virtual bool current_side() const { return stage() == EffectStage::kCurrents; }
+  /// Only a log with changing speed or reversals separates it from the others
+  /// (tracking loop, delay and backlash look like constants at one speed).
+  [[nodiscard]] virtual bool needs_speed_change() const { return false; }
+  /// The harmonic orders the columns of the fitted parameters `params` use.
+  /// Default by stage: windings/channels/converter 2 theta, motion 0, currents 1 theta_e.
+  [[nodiscard]] virtual HarmonicOrders orders(std::span<const int> params) const;
+  /// Checks a whole parameter set beyond the per-parameter ranges (e.g. the play
+  /// must be smaller than a turn). Throws std::invalid_argument naming the effect
+  /// and parameter. Default: nothing more to check.
+  virtual void validate(Values /*v*/) const {}
+  /// True when the values change the chain from ideal. Default: a parameter is
+  /// away from its neutral value.
+  [[nodiscard]] virtual bool active(Values v) const;
+
+  // ---- forward hooks (forward_chain.h calls them; defaults do nothing) -------
+  /// [s] the resolver's signals are those of time t - shift (delay).
+  [[nodiscard]] virtual double resolver_time_shift(Values /*v*/) const { return 0.0; }
+  /// The mechanical angle [rad, continuous] the resolver sees, given what the
+  /// earlier motion effects made of the true angle, and the mechanical speed [rad/s].
+  /// `commit`: this is the sample instant, so the effect may update `state` (the
+  /// chain also asks at intermediate instants of the converter's integration).
+  [[nodiscard]] virtual double seen_mech_angle(Values /*v*/, double theta_m, double /*omega_m*/,
+                                               MotionState& /*state*/, bool /*commit*/) const {
+    return theta_m;
+  }
+  /// [rad, resolver electrical] added to the resolver angle (mounting offset: p_r theta_0 / p).
+  [[nodiscard]] virtual double resolver_angle_shift(Values /*v*/, int /*p_r*/, int /*p*/) const { return 0.0; }
+  /// Modifies the unit envelopes at resolver angle theta [rad] at one sub-stage.
+  virtual void windings(Values /*v*/, WindingStage /*stage*/, double /*theta*/, SinCos& /*env*/) const {}
+  /// Adds to the channel timing.
+  virtual void channel_timing(Values /*v*/, ChannelTiming& /*timing*/) const {}
+  /// Sets the converter's dynamics or resolution.
+  virtual void converter(Values /*v*/, ConverterSpec& /*spec*/) const {}
+  /// [rad, motor electrical] the drive's current frame leads the rotor by this (mounting offset).
+  [[nodiscard]] virtual double drive_frame_offset(Values /*v*/) const { return 0.0; }
+  /// Modifies the phase currents at one sub-stage; theta_e [rad] is the true motor angle.
+  virtual void currents(Values /*v*/, CurrentStage /*stage*/, double /*theta_e*/, PhaseCurrents& /*i*/) const {}
+  /// Adds measurement impairments.
+  virtual void impairments(Values /*v*/, Impairments& /*imp*/) const {}
+
+  // ---- signature (the fit) ---------------------------------------------------
+  /// For each parameter i, the derivative of every signal with respect to it at
+  /// the values `v`, into out.col(i). Only for fittable effects.
+  virtual void signature(const SignatureRow& row, const AngleBasis& basis, Values v, SignatureColumns& out) const;
+  /// True when contribution() is exactly sum(column x value) with columns that do
+  /// not depend on the values: the fit then skips contribution() (a speed-up only).
+  /// Effects that override contribution() must return false.
+  [[nodiscard]] virtual bool linear_in_params() const { return true; }
+  /// The effect's own contribution to every signal at values `v` (the part of the
+  /// prediction it adds). Default: sum over parameters of column x value, right
+  /// for effects whose signature is linear in their parameters.
+  virtual void contribution(const SignatureRow& row, const AngleBasis& basis, Values v, SignalValues& out) const;
+  /// Nonlinear converter-stage effects set the transform every other effect's
+  /// angle harmonics go through (tracking loop: H(j k omega); delay: theta - omega d).
+  virtual void configure_basis(Values /*v*/, BasisTransform& /*t*/) const {}
+};
+
+/// The self-description every effect has, as data.
+struct EffectText {
+  std::string_view name;
+  std::string_view description;  ///< one line: forward model and signature
+  std::string_view source;       ///< paper equations or the header that derives it
+  std::string_view physics;      ///< one sentence for "what is missing"
+};
+
+/// Base for the registry's effects: the self-description from data, the hooks overridden.
+class BasicEffect : public Effect {
+ public:
+  BasicEffect(const EffectText& text, std::span<const ParamInfo> params, EffectStage stage)
+      : text_(text), params_(params), stage_(stage) {}
+  [[nodiscard]] std::string_view name() const final { return text_.name; }
+  [[nodiscard]] std::string_view description() const final { return text_.description; }
+  [[nodiscard]] std::string_view source() const final { return text_.source; }
+  [[nodiscard]] std::string_view physics() const final { return text_.physics; }
+  [[nodiscard]] std::span<const ParamInfo> params() const final { return params_; }
+  [[nodiscard]] EffectStage stage() const final { return stage_; }
+
+ private:
+  EffectText text_;
+  std::span<const ParamInfo> params_;
+  EffectStage stage_;
+};
+
+}  // namespace resolver

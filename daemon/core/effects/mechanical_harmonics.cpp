@@ -1,0 +1,84 @@
+#include "daemon/core/effects/mechanical_harmonics.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <string_view>
+
+#include "daemon/core/effects/effect.h"
+
+namespace resolver {
+namespace {
+
+constexpr std::array<std::string_view, 2 * kMaxMechanicalOrder> kNames{
+    "a1",  "b1",  "a2",  "b2",  "a3",  "b3",  "a4",  "b4",  "a5",  "b5",  "a6",
+    "b6",  "a7",  "b7",  "a8",  "b8",  "a9",  "b9",  "a10", "b10", "a11", "b11",
+    "a12", "b12", "a13", "b13", "a14", "b14", "a15", "b15", "a16", "b16"};
+
+/// Parameter order a1, b1, a2, b2, ...; a model that names the effect alone fits order 2.
+constexpr std::array<ParamInfo, 2 * kMaxMechanicalOrder> make_params() {
+  std::array<ParamInfo, 2 * kMaxMechanicalOrder> out{};
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const int order = static_cast<int>(i / 2) + 1;
+    out[i] = ParamInfo{.name = kNames[i], .unit = "[rad]",
+                       .description = i % 2 == 0 ? "sin(n theta_m) part of the seen-angle error (mechanical rad)"
+                                                 : "cos(n theta_m) part of the seen-angle error (mechanical rad)",
+                       .min = -0.5, .max = 0.5, .listed = order <= 2, .default_fit = order == 2};
+  }
+  return out;
+}
+constexpr auto kParams = make_params();
+
+class MechanicalHarmonicsEffect final : public BasicEffect {
+ public:
+  MechanicalHarmonicsEffect()
+      : BasicEffect({"mechanical_harmonics",
+                     "resolver sees theta_m + sum a_n sin(n theta_m) + b_n cos(n theta_m): eps at orders n/p_r of "
+                     "theta (order 1 = eccentricity, 2 = coupling misalignment)",
+                     "mechanical_harmonics.h",
+                     "the shaft or coupling makes the resolver see a mechanical harmonic of the angle: a position "
+                     "error at a whole order of the mechanical turn, only visible against the reference encoder"},
+                    kParams, EffectStage::kMotion) {}
+  [[nodiscard]] HarmonicOrders orders(std::span<const int> params) const override {
+    int top = 0;
+    for (int p : params) top = std::max(top, p / 2 + 1);
+    return {.theta_m = top};
+  }
+  [[nodiscard]] bool needs_reference() const override { return true; }
+  void validate(Values v) const override {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < v.size(); ++i) sum += static_cast<double>(i / 2 + 1) * std::abs(v[i]);
+    if (!(sum < 1.0)) {
+      throw std::invalid_argument(
+          "mechanical_harmonics: sum of n (|a_n| + |b_n|) must be < 1 so the resolver keeps turning one way");
+    }
+  }
+  [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double /*omega_m*/, MotionState& /*state*/,
+                                       bool /*commit*/) const override {
+    double out = theta_m;
+    for (std::size_t i = 0; i + 1 < v.size(); i += 2) {
+      if (v[i] == 0.0 && v[i + 1] == 0.0) continue;
+      const double n = static_cast<double>(i / 2 + 1);
+      out += v[i] * std::sin(n * theta_m) + v[i + 1] * std::cos(n * theta_m);
+    }
+    return out;
+  }
+  void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
+    const double pr = row.p_r;
+    for (int n = 1; n <= kMaxMechanicalOrder; ++n) {
+      const auto i = static_cast<std::size_t>(2 * (n - 1));
+      out.col(i) = shift_column(-pr * b.rd_mech_sin(n), pr * b.env_mech_sin(n));
+      out.col(i + 1) = shift_column(-pr * b.rd_mech_cos(n), pr * b.env_mech_cos(n));
+    }
+  }
+};
+
+}  // namespace
+
+const Effect& mechanical_harmonics_effect() {
+  static const MechanicalHarmonicsEffect effect;
+  return effect;
+}
+
+}  // namespace resolver

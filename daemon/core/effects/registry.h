@@ -1,0 +1,44 @@
+// The effect registry: every effect of the sensor chain, one line each in
+// registry.cpp. The catalog table (--list-effects), the spec parser
+// (chain_values.h), the simulator's forward chain (forward_chain.h), truth files,
+// discovery's candidates and docs/EFFECTS.md all come from this list.
+//
+// Adding an effect: one file pair in this folder (an Effect subclass, see
+// effect.h), one line in registry.cpp, one hidden-effect row in
+// tests/hidden_effect. Effect and parameter names are part of the project's
+// interface (CLI, TOML, truth files, reports, scripts): keep them stable.
+#pragma once
+
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "daemon/core/effects/effect.h"
+
+namespace resolver {
+
+/// Every effect, in catalog order (DESIGN 6, then the later ones). Cannot fail.
+[[nodiscard]] std::span<const Effect* const> effect_registry();
+
+/// The effect called `name`, or nullptr.
+[[nodiscard]] const Effect* find_effect(std::string_view name);
+
+/// Position of `effect` in effect_registry(). The effect must be registered.
+[[nodiscard]] std::size_t registry_index(const Effect& effect);
+
+/// Index of the parameter `param` of `effect`, or -1.
+[[nodiscard]] int find_param(const Effect& effect, std::string_view param);
+
+/// "a, b, c": the names of the effects (fittable ones only if asked).
+[[nodiscard]] std::string effect_names(bool fittable_only);
+
+/// "p1, p2": the listed parameters of an effect (all of them if `all`).
+[[nodiscard]] std::string parameter_names(const Effect& effect, bool all);
+
+/// The catalog as a human-readable table for --list-effects and --help.
+[[nodiscard]] std::string format_effect_catalog();
+
+/// The catalog as Markdown (docs/EFFECTS.md is generated from it).
+[[nodiscard]] std::string effects_markdown();
+
+}  // namespace resolver

@@ -1,0 +1,77 @@
+#include "daemon/core/effects/signature.h"
+
+#include <cmath>
+#include <complex>
+
+namespace resolver {
+
+void AngleBasis::Series::grow(int k) const {
+  if (s.empty()) {
+    s.push_back(0.0);
+    c.push_back(1.0);
+  }
+  // Rotation by the first harmonic: error ~n ulp at order n, far below any floor
+  // for the orders (<= ~40) used here, and one sincos per row instead of n.
+  while (static_cast<int>(s.size()) <= k) {
+    if (s.size() == 1) {
+      s.push_back(std::sin(angle));
+      c.push_back(std::cos(angle));
+      continue;
+    }
+    const double s1 = s[1], c1 = c[1];
+    const double sn = s.back(), cn = c.back();
+    s.push_back(sn * c1 + cn * s1);
+    c.push_back(cn * c1 - sn * s1);
+  }
+}
+
+void AngleBasis::set(const SignatureRow& row, const BasisTransform& transform) {
+  row_ = row;
+  transform_ = transform;
+  const double d = transform.delay;
+  env_.reset(row.theta - row.omega * d);
+  mech_.reset(row.theta_m - row.omega / static_cast<double>(row.p_r) * d);
+}
+
+double AngleBasis::loop_gain(double w) const {
+  if (!(transform_.omega_n > 0.0)) return 1.0;
+  // H(jw) = (wn^2 + j 2 zeta wn w) / (wn^2 - w^2 + j 2 zeta wn w), tracking_loop.h.
+  const double wn = transform_.omega_n;
+  const std::complex<double> num(wn * wn, 2.0 * transform_.zeta * wn * w);
+  const std::complex<double> den(wn * wn - w * w, 2.0 * transform_.zeta * wn * w);
+  return std::abs(num / den);
+}
+
+double AngleBasis::loop_phase(double w) const {
+  if (!(transform_.omega_n > 0.0)) return 0.0;
+  const double wn = transform_.omega_n;
+  const std::complex<double> num(wn * wn, 2.0 * transform_.zeta * wn * w);
+  const std::complex<double> den(wn * wn - w * w, 2.0 * transform_.zeta * wn * w);
+  return std::arg(num / den);
+}
+
+double AngleBasis::filtered(const Series& series, int k, double w, bool sine) const {
+  const double sk = series.sin_k(k), ck = series.cos_k(k);
+  if (k == 0 || !(transform_.omega_n > 0.0)) return sine ? sk : ck;
+  const double wn = transform_.omega_n;
+  const std::complex<double> num(wn * wn, 2.0 * transform_.zeta * wn * w);
+  const std::complex<double> den(wn * wn - w * w, 2.0 * transform_.zeta * wn * w);
+  const std::complex<double> h = num / den;
+  // g sin(x + phi) = Re(h) sin x + Im(h) cos x;  g cos(x + phi) = Re(h) cos x - Im(h) sin x.
+  return sine ? h.real() * sk + h.imag() * ck : h.real() * ck - h.imag() * sk;
+}
+
+double AngleBasis::rd_sin(int k) const { return filtered(env_, k, k * row_.omega, true); }
+double AngleBasis::rd_cos(int k) const { return filtered(env_, k, k * row_.omega, false); }
+double AngleBasis::rd_mech_sin(int n) const {
+  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), true);
+}
+double AngleBasis::rd_mech_cos(int n) const {
+  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), false);
+}
+double AngleBasis::env_sin(int k) const { return env_.sin_k(k); }
+double AngleBasis::env_cos(int k) const { return env_.cos_k(k); }
+double AngleBasis::env_mech_sin(int n) const { return mech_.sin_k(n); }
+double AngleBasis::env_mech_cos(int n) const { return mech_.cos_k(n); }
+
+}  // namespace resolver

@@ -1,0 +1,165 @@
+// What an effect's signature sees of one sample, and what it returns.
+//
+// The fit compares five signals with the model (all deviations from an ideal chain):
+//   rd     position error of the R/D angle       eps = theta_true - theta_rd             [rad]
+//   sa     position error of the sin/cos angle   theta_true - atan2(s, c)                [rad]
+//   sr     radius deviation of the envelopes     sqrt(s^2 + c^2) / A - 1                 [1]
+//   d, q   dq currents in the frame of the true motor angle theta_e = p theta_m         [A]
+// The envelopes enter as angle and radius, not as s and c: a constant rotation
+// (mounting offset, delay at one speed, backlash) is then exactly a constant of sa
+// however large, where the s/c deviations would be linear only for small angles.
+// To first order an envelope deviation (ds, dc) at angle theta is
+//   sa = sin(theta) dc - cos(theta) ds,   sr = sin(theta) ds + cos(theta) dc.
+// Each effect gives, per parameter, the derivative of each signal (its column),
+// evaluated at the true angles of the row (first order in the small parameters,
+// as the effect headers derive them).
+//
+// The R/D converter sits between the envelopes and the rd signal: an error
+// harmonic of the envelope angle reaches the R/D angle through the converter's
+// closed loop H(s) (tracking_loop.h) and late by the chain's delay d. AngleBasis
+// applies both, so an effect writes its rd column with basis.rd_sin(k) etc. and
+// never needs to know which converter or delay the model has:
+//   rd_sin(k) = |H(j k omega)| sin(k (theta - omega d) + arg H(j k omega))
+// The envelopes carry the delay but not the loop: env_sin(k) = sin(k (theta - omega d)).
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <span>
+#include <vector>
+
+namespace resolver {
+
+/// One sample as the signatures see it (true angles from the reference, or the
+/// speed-smoothed ideal angle without one).
+struct SignatureRow {
+  double t = 0.0;          ///< [s] sample time from the log's first sample
+  double theta = 0.0;      ///< [rad] true resolver electrical angle (continuous)
+  double theta_m = 0.0;    ///< [rad] true mechanical angle (continuous; with a reference)
+  double omega = 0.0;      ///< [rad/s] resolver electrical speed (signed)
+  double accel = 0.0;      ///< [rad/s^2] resolver electrical acceleration
+  double direction = 1.0;  ///< +1 / -1: direction of motion (held through a standstill)
+  /// [rad, mechanical] travel since the last reversal of direction (from its turning
+  /// point); infinity when the rotor has not reversed. Backlash's take-up needs it.
+  double since_reversal = std::numeric_limits<double>::infinity();
+  double theta_e = 0.0;    ///< [rad] true motor electrical angle (currents only)
+  double i_d0 = 0.0;       ///< [A] operating point: mean measured d current
+  double i_q0 = 0.0;       ///< [A] mean measured q current
+  int p_r = 1;             ///< resolver pole pairs
+  int p = 1;               ///< motor pole pairs
+};
+
+/// The five signals' values (a prediction or one column).
+struct SignalValues {
+  double rd = 0.0;  ///< [rad]
+  double sa = 0.0;  ///< [rad]
+  double sr = 0.0;  ///< [1]
+  double d = 0.0;   ///< [A]
+  double q = 0.0;   ///< [A]
+  SignalValues& operator+=(const SignalValues& o) {
+    rd += o.rd;
+    sa += o.sa;
+    sr += o.sr;
+    d += o.d;
+    q += o.q;
+    return *this;
+  }
+};
+
+/// One column per parameter of one effect (storage owned by the caller, sized to
+/// the effect's parameter count: no fixed-size buffers).
+class SignatureColumns {
+ public:
+  explicit SignatureColumns(std::span<SignalValues> storage) : cols_(storage) {}
+  [[nodiscard]] std::size_t size() const { return cols_.size(); }
+  SignalValues& col(std::size_t i) { return cols_[i]; }
+  [[nodiscard]] const SignalValues& col(std::size_t i) const { return cols_[i]; }
+  void clear() {
+    for (auto& c : cols_) c = SignalValues{};
+  }
+
+ private:
+  std::span<SignalValues> cols_;
+};
+
+/// The converter-stage transform the nonlinear effects set.
+struct BasisTransform {
+  double omega_n = 0.0;  ///< [rad/s] tracking loop; 0 = ideal converter (no filtering)
+  double zeta = 0.7;     ///< [1]
+  double delay = 0.0;    ///< [s] the resolver signals are those of t - delay
+};
+
+/// Harmonics of the true angles as each signal sees them (see the header comment).
+/// Reused across rows: set() recomputes only what is asked for.
+class AngleBasis {
+ public:
+  AngleBasis() = default;
+  /// Prepares the basis for `row` under `transform`. Cannot fail.
+  void set(const SignatureRow& row, const BasisTransform& transform);
+
+  /// sin / cos (k theta) as the R/D angle sees an error harmonic of order k >= 0.
+  [[nodiscard]] double rd_sin(int k) const;
+  [[nodiscard]] double rd_cos(int k) const;
+  /// sin / cos (n theta_m) as the R/D angle sees a mechanical error harmonic of order n >= 0.
+  [[nodiscard]] double rd_mech_sin(int n) const;
+  [[nodiscard]] double rd_mech_cos(int n) const;
+  /// sin / cos (k theta') of the envelopes' angle theta' = theta - omega d.
+  [[nodiscard]] double env_sin(int k) const;
+  [[nodiscard]] double env_cos(int k) const;
+  /// sin / cos (n theta_m') of the mechanical angle the envelopes carry.
+  [[nodiscard]] double env_mech_sin(int n) const;
+  [[nodiscard]] double env_mech_cos(int n) const;
+  /// [rad] the envelopes' resolver angle theta - omega d and mechanical angle theta_m - omega_m d.
+  [[nodiscard]] double env_angle() const { return env_.angle; }
+  [[nodiscard]] double env_mech_angle() const { return mech_.angle; }
+  /// The closed loop's gain and phase at angular frequency w [rad/s] (1, 0 without a loop).
+  [[nodiscard]] double loop_gain(double w) const;
+  [[nodiscard]] double loop_phase(double w) const;
+
+  [[nodiscard]] const SignatureRow& row() const { return row_; }
+  [[nodiscard]] const BasisTransform& transform() const { return transform_; }
+
+ private:
+  struct Series {  // sin/cos(k a) for k = 0..n by rotation, computed lazily
+    double angle = 0.0;
+    mutable std::vector<double> s, c;
+    void reset(double a) {
+      angle = a;
+      s.clear();
+      c.clear();
+    }
+    void grow(int k) const;
+    [[nodiscard]] double sin_k(int k) const {
+      grow(k);
+      return s[static_cast<std::size_t>(k)];
+    }
+    [[nodiscard]] double cos_k(int k) const {
+      grow(k);
+      return c[static_cast<std::size_t>(k)];
+    }
+  };
+  /// g sin(k a + phi) or g cos(k a + phi) with g e^{j phi} = H(j k w).
+  [[nodiscard]] double filtered(const Series& series, int k, double w, bool sine) const;
+
+  SignatureRow row_;
+  BasisTransform transform_;
+  Series env_;   // theta - omega d
+  Series mech_;  // theta_m - omega_m d
+};
+
+/// The column of a parameter that shifts the angle the resolver sees by `shift`
+/// [rad, resolver electrical, per unit parameter]: the envelopes turn with it (sa
+/// = -shift, radius unchanged) and the R/D angle's error is `rd` (-shift, through
+/// the converter when the shift varies with the angle).
+[[nodiscard]] inline SignalValues shift_column(double rd, double shift) {
+  return SignalValues{.rd = rd, .sa = -shift, .sr = 0.0};
+}
+
+/// The column of a parameter that changes the envelopes by (ds, dc) [1, per unit
+/// parameter] at the envelopes' angle, with R/D angle error `rd` (see the header).
+[[nodiscard]] inline SignalValues envelope_column(const AngleBasis& b, double rd, double ds, double dc) {
+  const double sn = b.env_sin(1), cs = b.env_cos(1);
+  return SignalValues{.rd = rd, .sa = sn * dc - cs * ds, .sr = sn * ds + cs * dc};
+}
+
+}  // namespace resolver

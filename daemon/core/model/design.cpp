@@ -1,0 +1,261 @@
+#include "daemon/core/model/design.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace resolver {
+
+std::string_view nuisance_name(Nuisance n) {
+  switch (n) {
+    case Nuisance::kRdConstant: return "nuisance.rd_constant";
+    case Nuisance::kSaConstant: return "nuisance.sincos_angle_constant";
+    case Nuisance::kScGain: return "nuisance.sincos_gain";
+    case Nuisance::kIdConstant: return "nuisance.i_d";
+    case Nuisance::kIqConstant: return "nuisance.i_q";
+  }
+  return "nuisance.?";
+}
+
+double to_internal(const ParamInfo& p, double value) {
+  if (p.nonlinear && p.scale == FitScale::kInverseSquare) return value > 0.0 ? 1.0 / (value * value) : 0.0;
+  return value;
+}
+
+double from_internal(const ParamInfo& p, double z) {
+  if (p.nonlinear && p.scale == FitScale::kInverseSquare) return z > 0.0 ? 1.0 / std::sqrt(z) : 0.0;
+  return z;
+}
+
+void RowJacobian::resize(int k) {
+  rd.resize(k);
+  sa.resize(k);
+  sr.resize(k);
+  d.resize(k);
+  q.resize(k);
+}
+
+void RowJacobian::set_zero() {
+  rd.setZero();
+  sa.setZero();
+  sr.setZero();
+  d.setZero();
+  q.setZero();
+}
+
+namespace {
+
+std::vector<double> neutral_values(const Effect& e) {
+  std::vector<double> v;
+  for (const ParamInfo& p : e.params()) v.push_back(p.neutral);
+  return v;
+}
+
+/// Finite-difference step of a nonlinear parameter's internal coordinate z.
+double fd_step(const ParamInfo& p, double z) {
+  if (p.scale == FitScale::kInverseSquare) {
+    // z = 1/omega_n^2: from the ideal converter, a loop 10x faster than the range's top.
+    const double floor_step = 1.0 / (p.max * p.max) * 100.0;
+    return std::max(1e-3 * std::abs(z), floor_step);
+  }
+  return std::max(1e-4 * std::abs(z), 1e-7 * (p.max - p.min));
+}
+
+}  // namespace
+
+Design::Design(const ModelSpec& spec, const std::vector<std::vector<double>>& values, std::vector<Nuisance> nuisances)
+    : nuisances_(std::move(nuisances)) {
+  for (std::size_t i = 0; i < spec.terms.size(); ++i) {
+    const ModelTerm& t = spec.terms[i];
+    DesignTerm d{t.effect, t.params, i < values.size() && !values[i].empty() ? values[i] : neutral_values(*t.effect),
+                 false};
+    if (d.values.size() != t.effect->params().size()) {
+      throw std::invalid_argument("design: values of " + std::string(t.effect->name()) + " have the wrong size");
+    }
+    terms_.push_back(std::move(d));
+  }
+  rebuild();
+}
+
+void Design::add_candidate(const ModelTerm& term) {
+  terms_.push_back(DesignTerm{term.effect, term.params, neutral_values(*term.effect), true});
+  rebuild();
+}
+
+void Design::rebuild() {
+  term_first_.clear();
+  int k = static_cast<int>(nuisances_.size());
+  std::size_t widest = 0;
+  for (const DesignTerm& t : terms_) {
+    term_first_.push_back(k);
+    k += static_cast<int>(t.params.size());
+    widest = std::max(widest, t.effect->params().size());
+  }
+  columns_ = k;
+  scratch_.resize(widest);
+}
+
+std::vector<std::string> Design::column_names() const {
+  std::vector<std::string> out;
+  for (Nuisance n : nuisances_) out.emplace_back(nuisance_name(n));
+  for (const DesignTerm& t : terms_) {
+    for (int p : t.params) {
+      out.push_back(std::string(t.effect->name()) + "." +
+                    std::string(t.effect->params()[static_cast<std::size_t>(p)].name));
+    }
+  }
+  return out;
+}
+
+bool Design::nonlinear() const {
+  for (const DesignTerm& t : terms_) {
+    if (t.candidate) continue;
+    for (int p : t.params) {
+      if (t.effect->params()[static_cast<std::size_t>(p)].nonlinear) return true;
+    }
+  }
+  return false;
+}
+
+Eigen::VectorXd Design::z() const {
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(columns_);
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    const auto ps = t.effect->params();
+    for (std::size_t k = 0; k < t.params.size(); ++k) {
+      const auto p = static_cast<std::size_t>(t.params[k]);
+      const int col = term_first_[i] + static_cast<int>(k);
+      if (ps[p].polar == Polar::kAmplitude) {
+        z[col] = t.values[p] * std::cos(t.values[p + 1]);
+      } else if (ps[p].polar == Polar::kPhase) {
+        z[col] = t.values[p - 1] * std::sin(t.values[p]);
+      } else {
+        z[col] = to_internal(ps[p], t.values[p]);
+      }
+    }
+  }
+  return z;
+}
+
+void Design::step(const Eigen::VectorXd& dz) {
+  const Eigen::VectorXd z0 = z();
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    DesignTerm& t = terms_[i];
+    if (t.candidate) continue;
+    const auto ps = t.effect->params();
+    for (std::size_t k = 0; k < t.params.size(); ++k) {
+      const auto p = static_cast<std::size_t>(t.params[k]);
+      const int col = term_first_[i] + static_cast<int>(k);
+      if (ps[p].polar == Polar::kAmplitude) {
+        const double x = z0[col] + dz[col];
+        const double y = z0[col + 1] + dz[col + 1];  // the phase is the next column (params ascending)
+        t.values[p] = std::hypot(x, y);
+        t.values[p + 1] = std::atan2(y, x);
+      } else if (ps[p].polar == Polar::kPhase) {
+        continue;  // set with its amplitude
+      } else {
+        double z = z0[col] + dz[col];
+        if (ps[p].nonlinear && ps[p].scale == FitScale::kInverseSquare) z = std::max(z, 0.0);
+        t.values[p] = std::clamp(from_internal(ps[p], z), ps[p].min, ps[p].max);
+      }
+    }
+  }
+}
+
+std::vector<double> Design::values_with(std::size_t term, int column_in_term, double dz) const {
+  const DesignTerm& t = terms_[term];
+  std::vector<double> v = t.values;
+  const auto p = static_cast<std::size_t>(t.params[static_cast<std::size_t>(column_in_term)]);
+  const ParamInfo& info = t.effect->params()[p];
+  v[p] = from_internal(info, to_internal(info, v[p]) + dz);
+  return v;
+}
+
+BasisTransform Design::transform(std::size_t extra_term, const std::vector<double>* extra_values) const {
+  BasisTransform tr;
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    const bool override = extra_values != nullptr && i == extra_term;
+    if (t.candidate && !override) continue;
+    t.effect->configure_basis(override ? *extra_values : t.values, tr);
+  }
+  return tr;
+}
+
+SignalValues Design::predict_with(const SignatureRow& row, AngleBasis& basis, std::size_t override_term,
+                                  const std::vector<double>* override_values) const {
+  basis.set(row, transform(override_term, override_values));
+  SignalValues pred;
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    const bool override = override_values != nullptr && i == override_term;
+    if (t.candidate && !override) continue;
+    const std::vector<double>& v = override ? *override_values : t.values;
+    if (!t.effect->linear_in_params()) {
+      t.effect->contribution(row, basis, v, pred);
+      continue;
+    }
+    SignatureColumns cols(std::span<SignalValues>(scratch_.data(), t.effect->params().size()));
+    cols.clear();
+    t.effect->signature(row, basis, v, cols);
+    for (int p : t.params) {
+      const SignalValues& c = cols.col(static_cast<std::size_t>(p));
+      const double x = v[static_cast<std::size_t>(p)];
+      pred.rd += c.rd * x;
+      pred.sa += c.sa * x;
+      pred.sr += c.sr * x;
+      pred.d += c.d * x;
+      pred.q += c.q * x;
+    }
+  }
+  return pred;
+}
+
+SignalValues Design::predict(const FitRow& row, AngleBasis& basis) const {
+  return predict_with(row.sig, basis, terms_.size(), nullptr);
+}
+
+void Design::evaluate(const FitRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const {
+  if (jac.rd.size() != columns_) jac.resize(columns_);
+  jac.set_zero();
+  prediction = predict_with(row.sig, basis, terms_.size(), nullptr);
+  int col = 0;
+  for (Nuisance n : nuisances_) {
+    switch (n) {
+      case Nuisance::kRdConstant: jac.rd[col] = 1.0; break;
+      case Nuisance::kSaConstant: jac.sa[col] = 1.0; break;
+      case Nuisance::kScGain: jac.sr[col] = 1.0; break;
+      case Nuisance::kIdConstant: jac.d[col] = 1.0; break;
+      case Nuisance::kIqConstant: jac.q[col] = 1.0; break;
+    }
+    ++col;
+  }
+  AngleBasis shifted;  // numeric derivatives move the basis; `basis` stays at the model's
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    const auto ps = t.effect->params();
+    SignatureColumns cols(std::span<SignalValues>(scratch_.data(), ps.size()));
+    cols.clear();
+    t.effect->signature(row.sig, basis, t.values, cols);
+    for (std::size_t k = 0; k < t.params.size(); ++k, ++col) {
+      const auto p = static_cast<std::size_t>(t.params[k]);
+      SignalValues c = cols.col(p);
+      if (ps[p].nonlinear) {
+        const double z = to_internal(ps[p], t.values[p]);
+        const double h = fd_step(ps[p], z);
+        const std::vector<double> moved = values_with(i, static_cast<int>(k), h);
+        const SignalValues shifted_pred = predict_with(row.sig, shifted, i, &moved);
+        c = SignalValues{.rd = (shifted_pred.rd - prediction.rd) / h, .sa = (shifted_pred.sa - prediction.sa) / h,
+                         .sr = (shifted_pred.sr - prediction.sr) / h, .d = (shifted_pred.d - prediction.d) / h,
+                         .q = (shifted_pred.q - prediction.q) / h};
+      }
+      jac.rd[col] = c.rd;
+      jac.sa[col] = c.sa;
+      jac.sr[col] = c.sr;
+      jac.d[col] = c.d;
+      jac.q[col] = c.q;
+    }
+  }
+}
+
+}  // namespace resolver

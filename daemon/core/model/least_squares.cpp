@@ -1,0 +1,198 @@
+#include "daemon/core/model/least_squares.h"
+
+#include <cmath>
+#include <limits>
+
+namespace resolver {
+
+PassStatistics::PassStatistics(int columns) {
+  for (int g = 0; g < kGroups; ++g) {
+    all.emplace_back(columns);
+    fold_a.emplace_back(columns);
+  }
+}
+
+void PassStatistics::merge(const PassStatistics& other) {
+  for (int g = 0; g < kGroups; ++g) {
+    all[static_cast<std::size_t>(g)].merge(other.all[static_cast<std::size_t>(g)]);
+    fold_a[static_cast<std::size_t>(g)].merge(other.fold_a[static_cast<std::size_t>(g)]);
+  }
+}
+
+NormalEquations PassStatistics::fold_b(Group g) const {
+  const auto i = static_cast<std::size_t>(g);
+  NormalEquations out;
+  out.set(all[i].m() - fold_a[i].m(), all[i].b() - fold_a[i].b(), all[i].yy() - fold_a[i].yy(),
+          all[i].n() - fold_a[i].n());
+  return out;
+}
+
+void accumulate(const Design& design, std::span<const FitRow> rows, const GroupFloors& floors, PassStatistics& out) {
+  if (out.all.empty() || out.all.front().columns() != design.columns()) out = PassStatistics(design.columns());
+  AngleBasis basis;
+  SignalValues pred;
+  RowJacobian jac;
+  jac.resize(design.columns());
+  const bool use_rd = floors.rd > 0.0, use_sc = floors.sc > 0.0, use_cur = floors.cur > 0.0;
+  for (const FitRow& r : rows) {
+    if (!r.fitted()) continue;
+    design.evaluate(r, basis, pred, jac);
+    const bool b = r.has(FitRow::kFoldB);
+    auto add = [&](Group g, const Eigen::VectorXd& x, double y) {
+      const auto i = static_cast<std::size_t>(g);
+      out.all[i].add(x, y);
+      if (!b) out.fold_a[i].add(x, y);
+    };
+    if (use_rd && r.has(FitRow::kHasRd)) add(Group::kRd, jac.rd, r.y_rd - pred.rd);
+    if (use_sc && r.has(FitRow::kHasSc)) {
+      add(Group::kSc, jac.sa, r.y_sa - pred.sa);
+      add(Group::kSc, jac.sr, r.y_sr - pred.sr);
+    }
+    if (use_cur && r.has(FitRow::kHasCur)) {
+      add(Group::kCur, jac.d, r.y_d - pred.d);
+      add(Group::kCur, jac.q, r.y_q - pred.q);
+    }
+  }
+  for (auto& g : out.all) g.flush();
+  for (auto& g : out.fold_a) g.flush();
+}
+
+StepSolution solve_step(const std::vector<NormalEquations>& groups, const GroupFloors& floors,
+                        std::span<const int> columns, double lambda) {
+  StepSolution out;
+  const int full = groups.front().columns();
+  std::vector<int> cols(columns.begin(), columns.end());
+  if (cols.empty()) {
+    for (int j = 0; j < full; ++j) cols.push_back(j);
+  }
+  const auto k = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(k);
+  double yy_w = 0.0;
+  for (int g = 0; g < kGroups; ++g) {
+    const double f = floors.of(static_cast<Group>(g));
+    const NormalEquations& ne = groups[static_cast<std::size_t>(g)];
+    if (!(f > 0.0) || ne.n() == 0) continue;
+    const double w = 1.0 / (f * f);
+    for (Eigen::Index a = 0; a < k; ++a) {
+      b[a] += w * ne.b()[cols[static_cast<std::size_t>(a)]];
+      for (Eigen::Index c = 0; c < k; ++c) {
+        m(a, c) += w * ne.m()(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]);
+      }
+    }
+    yy_w += w * ne.yy();
+  }
+  out.dz = Eigen::VectorXd::Zero(full);
+  out.inverse = Eigen::MatrixXd::Zero(full, full);
+  out.k = static_cast<int>(k);
+  Eigen::VectorXd step = Eigen::VectorXd::Zero(k);
+  if (k > 0) {
+    // Scale to unit diagonal so the rank test is about collinearity, not units.
+    const Eigen::VectorXd dg = m.diagonal().cwiseMax(1e-300).cwiseSqrt();
+    const Eigen::VectorXd inv = dg.cwiseInverse();
+    Eigen::MatrixXd ms = inv.asDiagonal() * m * inv.asDiagonal();
+    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(ms);
+    cod.setThreshold(1e-9);
+    if (cod.rank() < k) return out;
+    if (lambda > 0.0) ms.diagonal().array() += lambda;
+    const Eigen::MatrixXd ms_inv = ms.inverse();
+    step = inv.asDiagonal() * (ms_inv * (inv.asDiagonal() * b));
+    const Eigen::MatrixXd minv = inv.asDiagonal() * cod.pseudoInverse() * inv.asDiagonal();
+    for (Eigen::Index a = 0; a < k; ++a) {
+      out.dz[cols[static_cast<std::size_t>(a)]] = step[a];
+      for (Eigen::Index c = 0; c < k; ++c) {
+        out.inverse(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(c)]) = minv(a, c);
+      }
+    }
+  }
+  // Per-group RSS after the step, from the statistics (linearised).
+  out.rss_w = 0.0;
+  for (int g = 0; g < kGroups; ++g) {
+    const NormalEquations& ne = groups[static_cast<std::size_t>(g)];
+    out.n[g] = ne.n();
+    if (ne.n() == 0) continue;
+    out.rss[g] = ne.rss(out.dz);
+    const double f = floors.of(static_cast<Group>(g));
+    if (f > 0.0) out.rss_w += out.rss[g] / (f * f);
+  }
+  out.ok = true;
+  (void)yy_w;
+  return out;
+}
+
+namespace {
+
+double cost_at_start(const PassStatistics& s, const GroupFloors& floors) {
+  double c = 0.0;
+  for (int g = 0; g < kGroups; ++g) {
+    const double f = floors.of(static_cast<Group>(g));
+    if (f > 0.0) c += s.all[static_cast<std::size_t>(g)].yy() / (f * f);
+  }
+  return c;
+}
+
+/// True when every term's prediction is linear in its fitted parameters: one pass solves it.
+bool strictly_linear(const Design& d) {
+  for (const DesignTerm& t : d.terms()) {
+    if (t.candidate) continue;
+    if (!t.effect->linear_in_params()) return false;
+  }
+  return !d.nonlinear();
+}
+
+}  // namespace
+
+FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
+                     const std::function<void()>& progress) {
+  FitResult out;
+  // Model columns only: candidates are evaluated at the model's solution later.
+  std::vector<int> model_cols;
+  for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) model_cols.push_back(j);
+  for (std::size_t i = 0; i < design.terms().size(); ++i) {
+    if (design.terms()[i].candidate) continue;
+    for (std::size_t k = 0; k < design.terms()[i].params.size(); ++k) {
+      model_cols.push_back(design.term_column(i) + static_cast<int>(k));
+    }
+  }
+  const bool linear = strictly_linear(design);
+  double lambda = 0.0;
+  double cost = std::numeric_limits<double>::infinity();
+  Design last_good = design;
+  for (int pass = 0; pass < max_passes; ++pass) {
+    PassStatistics stats(design.columns());
+    accumulate(design, rows, floors, stats);
+    ++out.passes;
+    if (progress) progress();
+    const double here = cost_at_start(stats, floors);
+    if (here > cost * (1.0 + 1e-12) && lambda < 1e6) {
+      // The last step made it worse (nonlinear): go back, damp harder.
+      design = last_good;
+      lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
+      continue;
+    }
+    lambda = lambda / 10.0 < 1e-9 ? 0.0 : lambda / 10.0;
+    cost = here;
+    last_good = design;
+    StepSolution sol = solve_step(stats.all, floors, model_cols, lambda);
+    out.stats = std::move(stats);
+    out.last = sol;
+    if (!sol.ok) return out;
+    // Converged when the step lowers the cost by a negligible amount (1e-9 relative
+    // or less than 1e-6 of one row's noise): the statistics are at the solution.
+    const double gain = here - sol.rss_w;
+    if (gain <= 1e-9 * here + 1e-6 && pass > 0) {
+      out.ok = true;
+      return out;
+    }
+    design.step(sol.dz);
+    if (linear) {
+      // One linearised step is exact; the statistics move with it (RSS(dz) above).
+      out.ok = true;
+      return out;
+    }
+  }
+  out.ok = out.last.ok;
+  return out;
+}
+
+}  // namespace resolver
