@@ -240,26 +240,36 @@ class ScopeCsv(unittest.TestCase):
         self.assertEqual([a["utime"] for a in angles], [b["utime"] for b in self.clean.angles])
 
     def test_estimates_match_the_candump_original(self):
-        report, _, _ = replay(self.csv, "scope_est", "--config", self.config)
-        # Hwang's integral reads the R/D angle only, and time from the stamps: the FILETIME stamps are exact
-        # multiples of the period, so t is the same; only the 1.7e-11 rad printing error differs.
+        # Hwang's integral reads the R/D angle only (the default estimator fits every signal a log has,
+        # and the export holds fewer), and time from the stamps: the FILETIME stamps are exact multiples
+        # of the period, so t is the same; only the 1.7e-11 rad printing error differs.
+        hwang = work("scope_hwang.toml")
+        with open(hwang, "w") as f:
+            f.write(SCOPE_TOML.format(extra="") + '[estimator]\nmethod = "hwang_integral"\n')
+        hwang_bench = work("hwang.toml")
+        with open(hwang_bench, "w") as f:
+            f.write('[estimator]\nmethod = "hwang_integral"\n')
+        report, _, _ = replay(self.csv, "scope_est", "--config", hwang)
+        clean, _, _ = replay(self.clean.log, "clean_hwang", "--config", hwang_bench)
         self.assertTrue(report["converged"])
-        self.assertAlmostEqual(report["alpha"], self.clean.report["alpha"], delta=1e-9)
+        self.assertAlmostEqual(report["alpha"], clean["alpha"], delta=1e-9)
         # The error statistics start when the estimate converges, at a revolution boundary; an R/D angle
         # exactly on the boundary (0 counts) read 1e-11 rad apart may put one sample on the other side.
         # One sample of N = 7200 moves an RMS by at most about 1/N of itself.
         n = SAMPLES - SAMPLE_RATE * 0.4  # the Hwang estimate converges after 0.4 s (min_revolutions = 3 at 200 r/min)
         for key in ("eps_rms_raw_rad", "eps_rms_comp_rad"):
-            self.assertAlmostEqual(report[key], self.clean.report[key], delta=self.clean.report[key] / n)
+            self.assertAlmostEqual(report[key], clean[key], delta=clean[key] / n)
         model = fit(self.csv, "--config", self.config)
         pos = [s for s in model["signals"] if s["signal"] == "position_error"][0]
         pos_clean = [s for s in self.clean.fit["signals"] if s["signal"] == "position_error"][0]
         # resolver-model fits alpha to every signal a log has: here the position error alone, in the
-        # original also sin/cos and the dq currents. The two alphas agree within their std. errors, and
-        # the position residual within 1 % of its floor (the 16-bit quantization, LSB / sqrt(12)).
+        # original also sin/cos and the dq currents. With the sample grid locked to the revolution the
+        # 16-bit R/D quantization error repeats every revolution and biases an alpha taken from the
+        # position error by up to ~0.8 % (test_replay_pipeline.py), which no std. error shows: the two
+        # alphas agree within 1 %, and the position residual within 1 % of its floor (LSB / sqrt(12)).
         a = model["params"]["amplitude_imbalance.alpha"]
         b = self.clean.fit["params"]["amplitude_imbalance.alpha"]
-        self.assertAlmostEqual(a["value"], b["value"], delta=3 * math.hypot(a["stderr"], b["stderr"]))
+        self.assertAlmostEqual(a["value"], b["value"], delta=0.01 * abs(b["value"]))
         self.assertAlmostEqual(pos["rms"], pos_clean["rms"], delta=0.01 * pos_clean["floor"])
 
     def test_bad_rows_are_counted_with_file_line_column(self):
