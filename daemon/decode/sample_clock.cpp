@@ -68,7 +68,11 @@ ClockReading SampleClock::read(std::int64_t stamp_us, std::optional<std::int64_t
         if (r.samples_lost > 0) r.event = ClockEvent::kGap;
       }
     } else if (period > 0.0 && r.step_s - expected_s > kMaxUnexplainedPeriods * period) {
-      r.event = consecutive ? ClockEvent::kJump : ClockEvent::kOutage;
+      if (!consecutive) {
+        r.event = ClockEvent::kOutage;
+      } else if (r.step_s - expected_s > kMinJumpSeconds) {
+        r.event = ClockEvent::kJump;
+      }
     }
     r.index = last_index_ + r.index_step + r.samples_lost;
     const double frame_t = anchor_t_ + static_cast<double>(stamp_us - anchor_stamp_us_) / 1e6;

@@ -15,9 +15,12 @@
 //   kStepBack  the stamp went back. With a counter that continues, time
 //              continues from the counter; else t continues one period after
 //              the previous sample (the two pieces are joined end to end).
-//   kJump      the stamp jumped forward by more than kMaxUnexplainedPeriods
-//              periods while the counter says the samples are consecutive: a
-//              clock jump; time continues from the counter. Without a counter
+//   kJump      the stamp jumped forward by more than kMinJumpSeconds (and
+//              kMaxUnexplainedPeriods periods) while the counter says the
+//              samples are consecutive: a clock set, or a sender that paused;
+//              time continues from the counter. (A shorter lead is a reader or
+//              player that stalled and delivers late: the counter already
+//              gives the time, nothing to count.) Without a counter
 //              only a step beyond kMaxGapSeconds is read as a jump (t continues
 //              one period on): shorter silences are real (a recorder pausing).
 //   kOutage    the stamp jumped forward and the counter jumped too: samples
@@ -69,6 +72,10 @@ class SampleClock {
   /// (the ServoProject export in tests/data/corpus stops for 1.1 s every 5 s and
   /// once for 7.8 s), benches that log an hour of nothing do not.
   static constexpr double kMaxGapSeconds = 3600.0;
+  /// [s] With a consecutive counter, a stamp ahead of it by less than this is
+  /// late delivery (canplayer under emulation stalls 70-130 ms, a loaded
+  /// reader more), not a clock jump worth a count.
+  static constexpr double kMinJumpSeconds = 1.0;
   /// Stamp steps a learned period is the median of.
   static constexpr int kPeriodSamples = 64;
 

@@ -60,6 +60,16 @@ TEST(SampleClock, JumpWithAConsecutiveCounterIsAClockJump) {
   EXPECT_NEAR(clock.read(kT0 + kPeriodUs * 11 + day, 11).t, 11.0 / kRate, kExact);
 }
 
+TEST(SampleClock, LateDeliveryWithAConsecutiveCounterIsNoEvent) {
+  // A player or reader that stalls 100 ms (200 periods) delivers late; the
+  // counter says the samples are consecutive and sets the time.
+  SampleClock clock = counter_clock();
+  for (std::int64_t k = 0; k < 10; ++k) clock.read(kT0 + kPeriodUs * k, k);
+  const ClockReading r = clock.read(kT0 + kPeriodUs * 10 + 100'000, 10);
+  EXPECT_EQ(r.event, ClockEvent::kNone);
+  EXPECT_NEAR(r.t, 10.0 / kRate, kExact);
+}
+
 TEST(SampleClock, JumpWithACounterThatJumpedTooIsAnOutage) {
   SampleClock clock = counter_clock();
   for (std::int64_t k = 0; k < 10; ++k) clock.read(kT0 + kPeriodUs * k, k);
