@@ -1,6 +1,7 @@
 #include "daemon/app/daemon_config.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -11,6 +12,8 @@
 #include <toml++/toml.h>
 
 #include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/angles.h"
+#include "daemon/decode/signal_units.h"
 
 namespace resolver {
 
@@ -223,7 +226,198 @@ void read_health_section(const toml::table& t, DaemonConfig& c, const std::strin
   in(h.block_s, 0.0, 10.0, "block_s", "in (0, 10] seconds");
 }
 
+/// A column reference: a name (string) or a 1-based index (integer).
+ColumnRef read_column(const toml::node& node, const std::string& what, bool have_names, const std::string& s) {
+  if (node.is_integer()) {
+    const std::int64_t i = *node.value<std::int64_t>();
+    if (i < 1 || i > 100000) throw ConfigError(where(s, node) + ": " + what + ": a column index counts from 1, got " + std::to_string(i));
+    return ColumnRef{"", static_cast<int>(i)};
+  }
+  const auto name = node.value<std::string>();
+  if (!name || name->empty()) {
+    throw ConfigError(where(s, node) + ": " + what + " must be a column name (string) or a 1-based column index (integer)");
+  }
+  if (!have_names) {
+    throw ConfigError(where(s, node) + ": " + what + " = \"" + *name +
+                      "\" names a column, but [input.csv] column_names = false: give its 1-based index instead");
+  }
+  return ColumnRef{*name, 0};
+}
+
+bool is_angle_role(Role r) { return r == Role::kRdAngle || r == Role::kRefAngle; }
+bool is_current_role(Role r) { return r == Role::kIA || r == Role::kIB || r == Role::kIC; }
+
+RowRole read_csv_column(Role role, const toml::node& node, bool have_names, const std::string& s) {
+  const std::string what = "[input.csv.columns] " + std::string(role_name(role));
+  const toml::table* t = node.as_table();
+  if (t == nullptr) {
+    throw ConfigError(where(s, node) + ": " + what + " must be an inline table, e.g. { column = \"Resolver\", unit = \"deg\" }");
+  }
+  check_keys(*t, "input.csv.columns." + std::string(role_name(role)), {"column", "unit", "scale", "offset", "full_scale", "divide"}, s);
+  RowRole r;
+  const toml::node* col = t->get("column");
+  if (col == nullptr) throw ConfigError(where(s, node) + ": " + what + " needs column = name or 1-based index");
+  r.column = read_column(*col, what + " column", have_names, s);
+  read(*t, "unit", r.unit, s, "input.csv.columns");
+  read(*t, "scale", r.scale, s, "input.csv.columns");
+  read(*t, "offset", r.offset, s, "input.csv.columns");
+  double full_scale = 0.0;
+  read(*t, "full_scale", full_scale, s, "input.csv.columns");
+  read(*t, "divide", r.divide, s, "input.csv.columns");
+  if (!std::isfinite(r.scale) || r.scale == 0.0 || !std::isfinite(r.offset)) {
+    throw ConfigError(where(s, node) + ": " + what + ": scale must be a finite non-zero number and offset finite");
+  }
+  const bool sincos = role == Role::kSin || role == Role::kCos;
+  if (t->get("full_scale") != nullptr && r.unit != "counts" && !sincos) {
+    throw ConfigError(where(s, node) + ": " + what + ": full_scale goes with unit = \"counts\" (or sin, cos)");
+  }
+  if (sincos) {
+    if (t->get("full_scale") != nullptr && (!(full_scale > 0.0) || !std::isfinite(full_scale))) {
+      throw ConfigError(where(s, node) + ": " + what + ": full_scale (the largest |value| the ADC reaches) must be > 0");
+    }
+    r.full_scale = full_scale;
+  }
+  if (t->get("divide") != nullptr && (!is_angle_role(role) || !(r.divide > 0.0) || !std::isfinite(r.divide))) {
+    throw ConfigError(where(s, node) + ": " + what +
+                      ": divide = N (an angle unwrapped and divided by N, > 0) is for rd_angle and ref_angle only");
+  }
+  if (is_angle_role(role)) {
+    if (r.unit == "counts") {
+      if (!(full_scale > 0.0) || !std::isfinite(full_scale)) {
+        throw ConfigError(where(s, node) + ": " + what + ": unit = \"counts\" needs full_scale = counts per revolution (e.g. 65536)");
+      }
+      r.to_role_unit = kTwoPi / full_scale;
+    } else if (const auto f = angle_unit_to_rad(r.unit)) {
+      r.to_role_unit = *f;
+    } else {
+      throw ConfigError(where(s, node) + ": " + what + ": unit " + quote_unit(r.unit) + " is not an angle unit; one of: " +
+                        std::string(kAngleUnitList) + ", counts (with full_scale)");
+    }
+  } else if (is_current_role(role)) {
+    const auto f = current_unit_to_amps(r.unit);
+    if (!f) {
+      throw ConfigError(where(s, node) + ": " + what + ": unit " + quote_unit(r.unit) + " is not a current unit; one of: " +
+                        std::string(kCurrentUnitList));
+    }
+    r.to_role_unit = *f;
+  }
+  return r;
+}
+
+void read_csv_section(const toml::table& t, CsvInputConfig& c, const std::string& s) {
+  check_keys(t, "input.csv",
+             {"delimiter", "decimal", "header_lines", "column_names", "time_column", "time_unit", "row_rate_hz", "columns"},
+             s);
+  std::string delimiter = "auto";
+  read(t, "delimiter", delimiter, s, "input.csv");
+  if (delimiter == "auto") c.format.delimiter = CsvFormat::Delimiter::kAuto;
+  else if (delimiter == ",") c.format.delimiter = CsvFormat::Delimiter::kComma;
+  else if (delimiter == ";") c.format.delimiter = CsvFormat::Delimiter::kSemicolon;
+  else if (delimiter == "tab" || delimiter == "\t") c.format.delimiter = CsvFormat::Delimiter::kTab;
+  else if (delimiter == "space" || delimiter == " ") c.format.delimiter = CsvFormat::Delimiter::kSpace;
+  else throw ConfigError(s + ": [input.csv] delimiter must be \",\", \";\", \"tab\", \"space\" or \"auto\", got \"" + delimiter + "\"");
+  std::string decimal = ".";
+  read(t, "decimal", decimal, s, "input.csv");
+  if (decimal != "." && decimal != ",") throw ConfigError(s + ": [input.csv] decimal must be \".\" or \",\", got \"" + decimal + "\"");
+  c.format.decimal = decimal[0];
+  if (c.format.decimal == ',' && c.format.delimiter == CsvFormat::Delimiter::kComma) {
+    throw ConfigError(s + ": [input.csv] decimal = \",\" with delimiter = \",\" cannot be told apart; the export uses \";\" or tabs");
+  }
+  if (const toml::node* h = t.get("header_lines")) {
+    if (const auto text = h->value<std::string>(); text && *text == "auto") {
+      c.format.skip_until_numbers = true;
+    } else {
+      read(t, "header_lines", c.format.header_lines, s, "input.csv");
+      if (c.format.header_lines < 0) throw ConfigError(where(s, *h) + ": [input.csv] header_lines must be >= 0 or \"auto\"");
+    }
+  }
+  read(t, "column_names", c.format.column_names, s, "input.csv");
+  if (const toml::node* tc = t.get("time_column")) {
+    if (const auto text = tc->value<std::string>(); !(text && text->empty())) {
+      c.map.time = read_column(*tc, "[input.csv] time_column", c.format.column_names, s);
+    }
+  }
+  std::string unit = "s";
+  read(t, "time_unit", unit, s, "input.csv");
+  if (unit == "s") c.map.time_unit = TimeUnit::kSeconds;
+  else if (unit == "ms") c.map.time_unit = TimeUnit::kMilliseconds;
+  else if (unit == "us") c.map.time_unit = TimeUnit::kMicroseconds;
+  else if (unit == "filetime") c.map.time_unit = TimeUnit::kFiletime;
+  else throw ConfigError(s + ": [input.csv] time_unit must be \"s\", \"ms\", \"us\" or \"filetime\", got \"" + unit + "\"");
+  read(t, "row_rate_hz", c.map.row_rate_hz, s, "input.csv");
+  if (!(c.map.row_rate_hz >= 0.0) || !std::isfinite(c.map.row_rate_hz)) {
+    throw ConfigError(s + ": [input.csv] row_rate_hz must be a finite number >= 0");
+  }
+  if (c.map.time && c.map.row_rate_hz > 0.0) {
+    throw ConfigError(s + ": [input.csv] row_rate_hz is for exports without a time column; this one names time_column");
+  }
+  if (const toml::node* cols = t.get("columns")) {
+    const toml::table* table = cols->as_table();
+    if (table == nullptr) throw ConfigError(where(s, *cols) + ": [input.csv.columns] must be a table");
+    for (const auto& [key, node] : *table) {
+      const auto role = role_from_name(key.str());
+      if (!role) {
+        throw ConfigError(where(s, node) + ": [input.csv.columns] unknown role '" + std::string(key.str()) +
+                          "'; valid roles: sin, cos, rd_angle, i_a, i_b, i_c, ref_angle");
+      }
+      c.map.roles[static_cast<std::size_t>(*role)] = read_csv_column(*role, node, c.format.column_names, s);
+    }
+    const bool has_rd = c.map.roles[static_cast<std::size_t>(Role::kRdAngle)].has_value();
+    const bool has_sincos = c.map.roles[static_cast<std::size_t>(Role::kSin)].has_value() &&
+                            c.map.roles[static_cast<std::size_t>(Role::kCos)].has_value();
+    if (!has_rd && !has_sincos) {
+      throw ConfigError(s + ": [input.csv.columns] needs rd_angle, or both sin and cos: nothing to estimate an angle from");
+    }
+    if (!c.map.time && !(c.map.row_rate_hz > 0.0)) {
+      throw ConfigError(s + ": [input.csv] has no time_column: set row_rate_hz (rows per second) so samples have a time");
+    }
+  }
+}
+
+void read_input_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "input", {"format", "csv"}, s);
+  std::string format = "auto";
+  read(t, "format", format, s, "input");
+  if (format != "auto") {
+    c.input_format = log_format_from_name(format);
+    if (!c.input_format) {
+      throw ConfigError(s + ": [input] format must be \"auto\", \"candump\", \"asc\" or \"csv\", got \"" + format + "\"");
+    }
+  }
+  if (const toml::node* csv = t.get("csv")) {
+    if (!csv->is_table()) throw ConfigError(where(s, *csv) + ": [input.csv] must be a table");
+    read_csv_section(*csv->as_table(), c.csv, s);
+  }
+}
+
 }  // namespace
+
+std::optional<LogFormat> log_format_from_name(std::string_view name) {
+  if (name == "candump") return LogFormat::kCandump;
+  if (name == "asc") return LogFormat::kAsc;
+  if (name == "csv") return LogFormat::kCsv;
+  return std::nullopt;
+}
+
+std::string_view log_format_name(LogFormat format) {
+  switch (format) {
+    case LogFormat::kCandump: return "candump";
+    case LogFormat::kAsc: return "asc";
+    case LogFormat::kCsv: return "csv";
+  }
+  return "candump";
+}
+
+LogFormat log_format_for_path(std::string_view path) {
+  const auto dot = path.rfind('.');
+  const auto slash = path.rfind('/');
+  if (dot == std::string_view::npos || (slash != std::string_view::npos && dot < slash)) return LogFormat::kCandump;
+  std::string ext(path.substr(dot + 1));
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext == "asc") return LogFormat::kAsc;
+  if (ext == "csv" || ext == "txt" || ext == "tsv" || ext == "dat") return LogFormat::kCsv;
+  return LogFormat::kCandump;
+}
 
 DaemonConfig parse_daemon_config(std::string_view text, const std::string& source_name) {
   toml::table root;
@@ -237,7 +431,8 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   c.source = source_name;
   const std::string& s = source_name;
   check_keys(root, "top level",
-             {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation", "model", "health"},
+             {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation", "model", "health",
+              "input"},
              s);
 
   auto section = [&root, &s](const char* name) -> const toml::table* {
@@ -394,6 +589,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
   }
   if (const auto* t = section("model")) read_model_section(*t, c.model, s);
   if (const auto* t = section("health")) read_health_section(*t, c, s);
+  if (const auto* t = section("input")) read_input_section(*t, c, s);
   if (c.compensation_domain == CompensationDomain::kSignal && c.method != EstimatorMethod::kSinCosLeastSquares) {
     throw ConfigError(s + ": [compensation] domain = \"signal\" needs [estimator] method = \"sincos_least_squares\" "
                           "(only it estimates the sin/cos signal parameters)");

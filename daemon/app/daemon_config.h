@@ -48,6 +48,19 @@
 //   effects = ["amplitude_imbalance"]   # the active model; SIGHUP reloads it
 //   window_revolutions = 16    # resolver electrical revolutions per window
 //   candidates = true          # also rank the catalog effects not in the model
+//   [input]
+//   format = "auto"            # replayed files: "candump", "asc", "csv"; auto = by extension
+//   [input.csv]                # CSV / scope exports (daemon/decode/row_decoder.h)
+//   delimiter = "auto"         # ",", ";", "tab", "space" (runs of spaces), "auto"
+//   decimal = "."              # or ","
+//   header_lines = 0           # lines skipped before the column-name line; "auto" = until a line of numbers
+//   column_names = true        # the first line after them names the columns
+//   time_column = "Time"       # name or 1-based index; "" = none (rows at row_rate_hz)
+//   time_unit = "s"            # "ms", "us", "filetime" (100 ns ticks since 1601-01-01)
+//   row_rate_hz = 0            # only without a time column
+//   [input.csv.columns]        # role = { column = name|index, unit, scale = 1, offset = 0,
+//   rd_angle = { column = "Resolver", unit = "deg" }   #  full_scale (unit "counts"; sin/cos: the ADC's
+//                              #  largest |value|, else health judges levels relatively), divide (angles) }
 //   [[model.custom]]           # effects users add without recompiling (custom_effect.h)
 //   name = "slow_drift"
 //   signal = "position_error"  # position_error | rd_angle | sin | cos | i_d | i_q
@@ -66,18 +79,20 @@
 //   block_s = 0.1                      # [s] evaluation block of sample time
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include <memory>
-
+#include "daemon/app/log_format.h"
 #include "daemon/core/estimation/hwang_integral.h"
 #include "daemon/core/model/custom_effect.h"
 #include "daemon/core/health/signal_health.h"
 #include "daemon/core/estimation/sample_processor.h"
+#include "daemon/decode/row_decoder.h"
 #include "daemon/decode/signal_map.h"
+#include "drivers/csv/csv_format.h"
 
 namespace resolver {
 
@@ -131,6 +146,12 @@ struct ModelFitOptions {
   bool candidates = true;            ///< rank the missing catalog effects (explain) or only fit
 };
 
+/// A CSV / scope export's layout and column map ([input.csv]).
+struct CsvInputConfig {
+  CsvFormat format;
+  RowMap map;  ///< empty: no [input.csv.columns] (a CSV cannot be read)
+};
+
 struct DaemonConfig {
   std::string source;  ///< file the config came from ("" = built-in defaults)
   std::string lcm_url;  ///< "" = LCM's default (udpm multicast)
@@ -155,6 +176,8 @@ struct DaemonConfig {
   /// health_full_scale_set; otherwise the pipeline takes it from the DBC.
   SignalHealthConfig health;
   bool health_full_scale_set = false;
+  std::optional<LogFormat> input_format;  ///< [input] format; nullopt = from the extension
+  CsvInputConfig csv;
 };
 
 /// Thrown for unreadable or invalid configuration; what() names the file,

@@ -39,6 +39,9 @@ Examples:
   resolverd --replay demo.log --once --fast --lcm 'file:///tmp/out.lcmlog?mode=w'
   # replay in the log's own timing, publishing on the default LCM multicast
   resolverd --replay demo.log
+  # a Vector ASC log, or a scope export mapped by [input.csv] in the config; seconds 2..10 only
+  resolverd --replay bench.asc --once --fast --from 2 --to 10
+  resolverd --replay scope.csv --config scope.toml --once --fast
   # live from SocketCAN
   resolverd --can can0 --config /etc/resolverd/resolverd.toml
   # four times the log's speed: lcm-logger keeps up where --fast would make it drop
@@ -116,7 +119,8 @@ static int run(int argc, char** argv) {
   double rate = 1.0;
   app.footer(exit_code::kHelpText);
   app.add_option("--config", config_path, "TOML config file (see README; every key optional)");
-  auto* replay = app.add_option("--replay", replay_path, "replay a candump -l log file instead of reading CAN");
+  auto* replay = app.add_option("--replay", replay_path,
+                                "replay a log file instead of reading CAN: candump -l, Vector ASC or a CSV/scope export");
   auto* can = app.add_option("--can", can_iface, "read live frames from this SocketCAN interface (can0, vcan0)");
   replay->excludes(can);
   app.add_flag("--once", once, "with --replay: stop at the end of the log (default: loop it)")->needs(replay);
@@ -128,6 +132,19 @@ static int run(int argc, char** argv) {
       ->needs(replay)
       ->excludes(fast_opt)
       ->check(CLI::PositiveNumber);
+  std::string format_name;
+  SampleSlice slice;
+  app.add_option("--format", format_name,
+                 "with --replay: candump, asc (Vector ASC) or csv (scope export, [input.csv] in --config); "
+                 "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
+      ->check(CLI::IsMember({"candump", "asc", "csv"}))
+      ->needs(replay);
+  app.add_option("--from", slice.from_s, "with --replay: process samples from this time on [s, 0 = the log's first sample]")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(replay);
+  app.add_option("--to", slice.to_s, "with --replay: stop after this time [s, from the log's first sample]")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(replay);
   app.add_option("--lcm", lcm_url,
                  "LCM URL, overrides the config (default: LCM's udpm multicast; "
                  "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
@@ -135,7 +152,7 @@ static int run(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "no progress lines on stderr");
   std::string calibration_file;
   app.add_option("--calibration", calibration_file,
-                 "compensate with a table exported by 'resolver-model export LOG --format csv' instead of the live "
+                 "compensate with a table exported by 'resolver-model export LOG --table-format csv' instead of the live "
                  "estimate (the estimator still runs and publishes)")
       ->check(CLI::ExistingFile);
   std::string state_dir;
@@ -143,6 +160,10 @@ static int run(int argc, char** argv) {
                  "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
                  "saved at exit when the estimate has converged");
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
+  if (slice.to_s < slice.from_s) {
+    std::cerr << "resolverd: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
+    return exit_code::kUsage;
+  }
   // From here a SIGTERM is a request the run loop honours (it finds the flag set at
   // its first look), not the default death by signal, however early it comes.
   StopFlags flags;
@@ -183,7 +204,7 @@ static int run(int argc, char** argv) {
     return exit_code::kIo;
   }
   try {
-    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty());
+    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty(), slice);
   } catch (const std::exception& e) {
     std::cerr << "resolverd: " << e.what() << "\n";
     return exit_code::kUsage;
@@ -255,6 +276,7 @@ static int run(int argc, char** argv) {
     if (!replay_path.empty()) {
       ReplayOptions ro;
       ro.path = replay_path;
+      ro.format = log_format_from_name(format_name);
       ro.fast = fast;
       ro.once = once;
       ro.rate = rate;
@@ -268,6 +290,9 @@ static int run(int argc, char** argv) {
       info.source = can_iface;
       info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }
+  } catch (const ConfigError& e) {  // e.g. a CSV column map that does not fit the export
+    std::cerr << "resolverd: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     // Opening or reading the input failed (the log vanished, a read error).
     std::cerr << "resolverd: " << e.what() << "\n";

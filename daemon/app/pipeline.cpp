@@ -25,6 +25,26 @@ std::shared_ptr<const FrameDecoder> make_frame_decoder(const DaemonConfig& confi
   }
 }
 
+SampleStreamConfig sample_stream_config(const DaemonConfig& config, const SampleSlice& slice) {
+  SampleStreamConfig c;
+  c.clock.counter_time = config.bench.time_from_counter;
+  c.clock.sample_rate_hz = config.bench.sample_rate_hz;
+  c.clock.max_counter_delta = config.max_counter_delta;
+  c.use_bench_info = config.bench.use_bench_info;
+  c.row_rate_hz = config.csv.map.row_rate_hz;
+  c.slice = slice;
+  return c;
+}
+
+std::string describe_layout(const DaemonConfig& config, const FrameDecoder& decoder) {
+  if (config.dbc_path.empty() && config.source.empty()) {
+    return "the default bench layout (" + default_dbc_path() + ": " + decoder.describe_layout() + ")";
+  }
+  return "the layout of " + (config.dbc_path.empty() ? default_dbc_path() : config.dbc_path) + " as " +
+         (config.source.empty() ? std::string("the built-in config") : config.source) + " maps it (" +
+         decoder.describe_layout() + ")";
+}
+
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -44,97 +64,72 @@ ProcessorConfig processor_config(const DaemonConfig& c) {
   return p;
 }
 
-SampleInput to_input(const BenchSample& s, double t) {
-  SampleInput in;
-  in.t = t;
-  in.index = s.index;
-  in.utime = s.timestamp_us;
-  in.has_rd = s.has(Role::kRdAngle);
-  in.theta_rd = s.get(Role::kRdAngle);
-  in.has_sincos = s.has(Role::kSin) && s.has(Role::kCos);
-  in.sin = s.get(Role::kSin);
-  in.cos = s.get(Role::kCos);
-  in.has_currents = s.has(Role::kIA) && s.has(Role::kIB) && s.has(Role::kIC);
-  in.i_a = s.get(Role::kIA);
-  in.i_b = s.get(Role::kIB);
-  in.i_c = s.get(Role::kIC);
-  in.has_ref = s.has(Role::kRefAngle);
-  in.theta_m_ref = s.get(Role::kRefAngle);
-  return in;
-}
-
 void copy3(double (&dst)[3], const std::array<double, 3>& src, bool valid) {
   for (std::size_t k = 0; k < 3; ++k) dst[k] = valid ? src[k] : kNaN;
 }
 
 }  // namespace
 
-Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics, bool realtime)
+Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics, bool realtime,
+                   const SampleSlice& slice)
     : config_(config),
       sink_(sink),
       problems_(diagnostics, "resolverd: "),
-      intake_(make_frame_decoder(config), config.max_counter_delta,
-              FrameIntake::Callbacks{
-                  [this](const BenchSample& s) { on_sample(s); },
+      stream_(make_frame_decoder(config), sample_stream_config(config, slice),
+              SampleStream::Callbacks{
+                  [this](const Sample& s, std::uint8_t counter) { on_sample(s, counter); },
                   [this](const BenchInfo& i) { on_bench_info(i); },
                   [this](std::string_view reason, const std::string& msg) { problems_.report(reason, msg); }}),
       processor_(processor_config(config)),
-      sample_rate_hz_(config.bench.sample_rate_hz),
       model_fit_(config.model.enabled ? std::make_unique<LiveModelFit>(config.model, sink, diagnostics, realtime)
                                       : nullptr),
-      signal_health_(health_config_for(config, intake_.decoder()), config.bench.p_r, config.bench.sample_rate_hz,
+      signal_health_(health_config_for(config, stream_.intake().decoder()), config.bench.p_r, config.bench.sample_rate_hz,
                      diagnostics) {
-  for (const std::string& w : intake_.decoder().warnings()) diagnostics << "resolverd: warning: " << w << "\n";
-}
-
-double Pipeline::sample_time(const BenchSample& sample) {
-  const double frame_t = static_cast<double>(sample.timestamp_us) * 1e-6;
-  if (!config_.bench.time_from_counter || !(sample_rate_hz_ > 0.0)) return frame_t;
-  // The counter is u8, so consecutive samples can only be told apart while
-  // fewer than 256 periods pass between them. When more frame time passed
-  // than the index step explains by over 128 periods (a stall or an outage:
-  // the counter may have wrapped unseen), counting cannot bridge the gap and
-  // the time base re-anchors. Slow or bursty delivery (a replay under
-  // emulation, canplayer's bursts) only shifts frame time against sample
-  // time and is not a reason to re-anchor.
-  constexpr double kMaxUnexplainedPeriods = 128.0;
-  if (anchored_) {
-    const double explained = static_cast<double>(sample.index - last_index_);
-    const double elapsed = (frame_t - last_frame_t_) * sample_rate_hz_;
-    last_index_ = sample.index;
-    last_frame_t_ = frame_t;
-    if (elapsed - explained <= kMaxUnexplainedPeriods) {
-      return anchor_t_ + static_cast<double>(sample.index - anchor_index_) / sample_rate_hz_;
-    }
-    problems_.report("sample_clock_reanchored",
-                     "sample index " + std::to_string(sample.index) + " arrived " + std::to_string(elapsed) +
-                         " sample periods after the previous one, more than its counter step explains: time base re-anchored");
-    intake_.count_problem_silently("sample_clock_reanchored");
-  }
-  anchored_ = true;
-  anchor_index_ = sample.index;
-  anchor_t_ = frame_t;
-  last_index_ = sample.index;
-  last_frame_t_ = frame_t;
-  return frame_t;
+  for (const std::string& w : stream_.intake().decoder().warnings()) diagnostics << "resolverd: warning: " << w << "\n";
 }
 
 void Pipeline::count_problem(std::string_view reason, const std::string& message) {
-  intake_.count_problem(reason, message);
+  stream_.count_problem(reason, message);
+}
+
+void Pipeline::advance_health_clock(std::int64_t now_us) {
+  // The input's own clock stepping back (a log appended, a clock set) starts
+  // the window again, so health keeps coming every second of input time; a
+  // jump publishes once. Compared with the previous frame, not with the
+  // window start: live, tick() starts windows on the wall clock, and frames
+  // that waited in the socket are older than that without any step.
+  const bool stepped_back = have_frame_time_ && now_us < last_frame_us_;
+  have_frame_time_ = true;
+  last_frame_us_ = now_us;
+  if (health_window_start_us_ < 0 || stepped_back) health_window_start_us_ = now_us;
+  if (now_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(now_us);
 }
 
 void Pipeline::feed_untimed(const CanFrame& frame, std::uint64_t line) {
-  last_frame_us_ = frame.timestamp_us;
-  if (health_window_start_us_ < 0) health_window_start_us_ = frame.timestamp_us;
-  const std::int64_t complete_before = intake_.stats().samples_complete;
-  intake_.feed(frame, line);
+  const std::int64_t complete_before = stream_.intake().stats().samples_complete;
+  stream_.feed(frame, line);
   // Only a sample completed by one of its own frames says which frame
   // completes samples; one emitted because a newer counter began (while the
   // joiner learns the layout, or with a frame missing) does not.
-  if (intake_.stats().samples_complete != complete_before && intake_.last_frame_counter() == last_counter_) {
+  if (stream_.intake().stats().samples_complete != complete_before &&
+      stream_.intake().last_frame_counter() == last_counter_) {
     note_completing_frame(frame);
   }
-  if (frame.timestamp_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(frame.timestamp_us);
+  advance_health_clock(frame.timestamp_us);
+}
+
+void Pipeline::feed_row(const RowSample& row, std::uint64_t line) {
+  if (!rows_seen_) {
+    // A CSV's sin/cos have no DBC range: their full scale is the column's
+    // full_scale, else unknown (health then judges levels relatively).
+    rows_seen_ = true;
+    if (!config_.health_full_scale_set) signal_health_.set_full_scale(csv_sincos_full_scale(config_.csv.map), 0.0);
+  }
+  stream_.feed_row(row, line);
+  // Rows without a time column: health runs on row number / row rate.
+  const double rate = config_.csv.map.row_rate_hz;
+  advance_health_clock(row.has_time ? row.time_us
+                                    : std::llround(static_cast<double>(row.sequence) * 1e6 / (rate > 0.0 ? rate : 1.0)));
 }
 
 void Pipeline::feed(const CanFrame& frame, std::uint64_t line, Clock::time_point arrival) {
@@ -149,7 +144,7 @@ void Pipeline::note_completing_frame(const CanFrame& frame) {
   if (wake_ids_.empty() || std::find(wake_ids_.begin(), wake_ids_.end(), frame.id) != wake_ids_.end()) return;
   // The frame came through the quiet socket, so the sample waited for the
   // next waking frame: the latency is a sample period or the read timeout.
-  intake_.count_problem("completed_by_quiet_frame",
+  stream_.count_problem("completed_by_quiet_frame",
                         fmt::format("a sample was completed by frame 0x{:X}, which does not wake the reader "
                                     "([can] wake_ids), so it waited for the next wake-up; with wake_ids = \"auto\" "
                                     "resolverd goes back to every frame if this repeats, with a fixed list name the "
@@ -166,18 +161,17 @@ void Pipeline::tick(std::int64_t now_us) {
 }
 
 void Pipeline::finish() {
-  intake_.flush();
+  stream_.flush();
   if (model_fit_) {
     model_fit_->finish();
     if (auto fitted = model_fit_->take_model()) {
       processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
       // No sample follows to carry it: publish the final estimate now.
       if (processor_.config().method == EstimatorMethod::kModel) {
-        BenchSample last;
-        last.timestamp_us = last_frame_us_;
+        Sample last;
+        last.utime = last_utime_;
         last.index = last_sample_index_;
-        last.counter = last_counter_;
-        publish_estimate(last_frame_us_, last);
+        publish_estimate(last, last_counter_);
       }
     }
   }
@@ -193,11 +187,7 @@ void Pipeline::on_bench_info(const BenchInfo& info) {
                                                ", p=" + std::to_string(info.p) + " ignored (pole pairs must be >= 1)");
     return;
   }
-  if (info.sample_rate_hz > 0.0 && info.sample_rate_hz != sample_rate_hz_) {
-    sample_rate_hz_ = info.sample_rate_hz;
-    anchored_ = false;
-    signal_health_.set_sample_rate(info.sample_rate_hz);
-  }
+  if (info.sample_rate_hz > 0.0) signal_health_.set_sample_rate(info.sample_rate_hz);
   if (info.p_r != pc.p_r || info.p != pc.p) {
     if (bench_info_seen_ || samples_ > 0) {
       problems_.report("bench_info_changed", "BENCH_INFO changed pole pairs to p_r=" + std::to_string(info.p_r) +
@@ -209,26 +199,33 @@ void Pipeline::on_bench_info(const BenchInfo& info) {
   bench_info_seen_ = true;
 }
 
-void Pipeline::on_sample(const BenchSample& sample) {
+void Pipeline::on_sample(const Sample& sample, std::uint8_t counter) {
   ++samples_;
   last_sample_index_ = sample.index;
-  last_counter_ = sample.counter;
-  const SampleInput in = to_input(sample, sample_time(sample));
-  const SampleOutput out = processor_.process(in);
-  signal_health_.add(in);
-  if (model_fit_) feed_model_fit(in, sample);
-  summary_.add(out, processor_, in.t);
+  last_counter_ = counter;
+  last_utime_ = sample.utime;
+  if (observer_) observer_(sample);
+  const SampleOutput out = processor_.process(sample);
+  signal_health_.add(sample);
+  if (model_fit_) {
+    const ProcessorConfig& pc = processor_.config();
+    model_fit_->add(sample, pc.p_r, pc.p, {sample.utime, sample.index, counter});
+    if (auto fitted = model_fit_->take_model()) {
+      processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+    }
+  }
+  summary_.add(out, processor_, sample.t);
   if (!out.has_angle) return;
 
   const bool angle_due = sample.index % config_.angle_decimation == 0;
   if (angle_due) {
     angle_t a;
-    a.utime = sample.timestamp_us;
+    a.utime = sample.utime;
     a.sample_index = sample.index;
-    a.counter = sample.counter;
+    a.counter = counter;
     a.theta_rd = out.theta_rd;
     // No amplitude, no angle: atan2 of noise published as an angle would be believed.
-    a.theta_sincos = signal_health_.sincos_lost(in) ? kNaN : out.theta_sincos;
+    a.theta_sincos = signal_health_.sincos_lost(sample) ? kNaN : out.theta_sincos;
     a.theta_comp = out.theta_comp;
     a.theta_ref = out.theta_ref;
     a.speed_mech_rad_s = out.speed_mech;
@@ -239,9 +236,9 @@ void Pipeline::on_sample(const BenchSample& sample) {
   if (out.has_dq && sample.index % config_.dq_decimation == 0) {
     const RippleSet& r = processor_.ripple();
     dq_t d;
-    d.utime = sample.timestamp_us;
+    d.utime = sample.utime;
     d.sample_index = sample.index;
-    d.counter = sample.counter;
+    d.counter = counter;
     d.electrical_freq_hz = out.electrical_freq_hz;
     d.i_d_raw = out.i_d_raw;
     d.i_q_raw = out.i_q_raw;
@@ -259,36 +256,15 @@ void Pipeline::on_sample(const BenchSample& sample) {
     d.ripple_valid = r.raw_valid;
     sink_.publish(d);
   }
-  if (out.estimate_updated) publish_estimate(sample.timestamp_us, sample);
+  if (out.estimate_updated) publish_estimate(sample, counter);
 }
 
-void Pipeline::feed_model_fit(const SampleInput& in, const BenchSample& sample) {
-  Sample d;
-  d.t = in.t;
-  d.has_rd = in.has_rd;
-  d.theta_rd = in.theta_rd;
-  d.has_sincos = in.has_sincos;
-  d.sin = in.sin;
-  d.cos = in.cos;
-  d.has_ref = in.has_ref;
-  d.theta_m_ref = in.theta_m_ref;
-  d.has_currents = in.has_currents;
-  d.i_a = in.i_a;
-  d.i_b = in.i_b;
-  d.i_c = in.i_c;
-  const ProcessorConfig& pc = processor_.config();
-  model_fit_->add(d, pc.p_r, pc.p, {sample.timestamp_us, sample.index, sample.counter});
-  if (auto fitted = model_fit_->take_model()) {
-    processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
-  }
-}
-
-void Pipeline::publish_estimate(std::int64_t utime, const BenchSample& sample) {
+void Pipeline::publish_estimate(const Sample& sample, std::uint8_t counter) {
   const ModelEstimate est = processor_.estimate();
   estimate_t e;
-  e.utime = utime;
+  e.utime = sample.utime;
   e.sample_index = sample.index;
-  e.counter = sample.counter;
+  e.counter = counter;
   e.method = est.method;
   for (const ParamEstimate& p : est.params) {
     e.param_name.push_back(p.name);
@@ -303,14 +279,14 @@ void Pipeline::publish_estimate(std::int64_t utime, const BenchSample& sample) {
 }
 
 void Pipeline::publish_health(std::int64_t utime) {
-  const IntakeStats& st = intake_.stats();
+  const IntakeStats& st = stream_.intake().stats();
   health_t h;
   h.utime = utime;
   h.sample_index = last_sample_index_;
   h.counter = last_counter_;
   h.frames_seen = st.frames_seen;
   h.frames_decoded = st.frames_decoded;
-  for (const auto& [reason, count] : intake_.rejects().all()) {
+  for (const auto& [reason, count] : stream_.intake().rejects().all()) {
     h.reject_reason.push_back(reason);
     h.reject_count.push_back(count);
   }

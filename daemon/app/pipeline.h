@@ -1,10 +1,11 @@
 // resolverd's data flow — start reading here.
 //
-//   source (candump log replay | SocketCAN)          daemon/app/main.cpp
-//     │ CanFrame
+//   source (candump / ASC / CSV log replay | SocketCAN) daemon/app/main.cpp, log_input.h
+//     │ CanFrame (or RowSample for a CSV row)
 //     ▼
-//   FrameIntake: DBC decode, CRC, counters, join     daemon/decode/
-//     │ BenchSample (one control period)
+//   SampleStream: DBC decode, units, CRC, counters,  daemon/decode/sample_stream.h
+//     join, sample clock, slice
+//     │ Sample (one control period; the same as resolver-model reads)
 //     ▼
 //   SampleProcessor: estimate, compensate, dq, ripple daemon/core/estimation/ (pure)
 //     │ SampleOutput
@@ -16,12 +17,15 @@
 //   OutputSink (LcmOutput on LCM, or a recorder in tests)
 //
 // The pipeline is single-threaded and purely reactive: every call to feed()
-// runs the whole chain for that frame. Time is frame time (log or kernel
-// timestamps); the caller passes the frame's arrival time only for latency.
+// runs the whole chain for that frame. Sample time is the sample clock's
+// (counter time where there is one, daemon/decode/sample_clock.h); health_t
+// runs on frame (or row) time; the caller passes the frame's arrival time only
+// for latency.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <ostream>
 #include <utility>
@@ -36,13 +40,18 @@
 #include "daemon/app/run_summary.h"
 #include "daemon/app/signal_health_log.h"
 #include "daemon/core/estimation/sample_processor.h"
-#include "daemon/decode/frame_intake.h"
+#include "daemon/decode/sample_stream.h"
 
 namespace resolver {
 
 /// The config's DBC (or the built-in one) with its signal map. Throws ConfigError
 /// naming the DBC and config at fault. Also used by resolver-model --config.
 [[nodiscard]] std::shared_ptr<const FrameDecoder> make_frame_decoder(const DaemonConfig& config);
+/// The sample stream's settings from the config ([bench], [layout], [input.csv]) and a slice.
+[[nodiscard]] SampleStreamConfig sample_stream_config(const DaemonConfig& config, const SampleSlice& slice = {});
+/// How messages name the layout in use: "the default bench layout (proto/resolver_bench.dbc ...: RESOLVER_SAMPLE
+/// 0x100 (sin = sin, ...), ...)" or "the layout of my.dbc from cfg.toml (...)".
+[[nodiscard]] std::string describe_layout(const DaemonConfig& config, const FrameDecoder& decoder);
 
 class Pipeline {
  public:
@@ -50,7 +59,9 @@ class Pipeline {
 
   /// Loads the DBC and builds the chain. Throws ConfigError (bad DBC, signal map).
   /// `realtime`: live input (the model fit never holds up the reader; see live_model_fit.h).
-  Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics, bool realtime = false);
+  /// `slice`: only samples with t in [from, to] are processed (--from/--to).
+  Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& diagnostics, bool realtime = false,
+           const SampleSlice& slice = {});
 
   /// Runs one frame through the chain. `line` is its log line (0 live),
   /// `arrival` when it was read (for latency). Cannot fail.
@@ -59,15 +70,15 @@ class Pipeline {
   /// (two clock reads were ~9 % of a fast replay): replay times one frame in
   /// kReplayLatencyEvery and feeds the others through here.
   void feed_untimed(const CanFrame& frame, std::uint64_t line);
+  /// Runs one row of a frameless input (CSV) through the chain: health_t then
+  /// counts rows as frames (seen, decoded, rejected by reason). Cannot fail.
+  void feed_row(const RowSample& row, std::uint64_t line);
   /// Counts a problem found before a frame existed (malformed log line).
   void count_problem(std::string_view reason, const std::string& message);
   /// End of input: emit the open sample, publish a final health_t.
   void finish();
   /// Log loop: counters and joins restart, estimates and statistics stay.
-  void restart_sequence() {
-    intake_.restart_sequence();
-    anchored_ = false;
-  }
+  void restart_sequence() { stream_.restart_sequence(); }
   /// Live idle time: publishes health_t when a second has passed since the
   /// last one even if no frame arrived. now_us [us] on the frames' clock.
   void tick(std::int64_t now_us);
@@ -80,7 +91,11 @@ class Pipeline {
   /// Cumulative frames dropped by the kernel (SO_RXQ_OVFL), for health_t.
   void set_kernel_drops(std::int64_t drops) { kernel_drops_ = drops; }
 
-  [[nodiscard]] const FrameIntake& intake() const { return intake_; }
+  [[nodiscard]] const FrameIntake& intake() const { return stream_.intake(); }
+  [[nodiscard]] const SampleStream& stream() const { return stream_; }
+  /// True once the input has passed --to: the rest of the log is not needed.
+  [[nodiscard]] bool past_slice_end() const { return stream_.past_slice_end(); }
+  [[nodiscard]] const DaemonConfig& config() const { return config_; }
   [[nodiscard]] const SampleProcessor& processor() const { return processor_; }
   [[nodiscard]] const RunSummary& summary() const { return summary_; }
   [[nodiscard]] const LatencyHistogram& latency_total() const { return latency_total_; }
@@ -90,23 +105,28 @@ class Pipeline {
   /// The frames that wake the live reader now (empty = every frame): a sample
   /// completed by another frame waited for a wake-up and is counted.
   void set_wake_ids(std::vector<std::uint32_t> ids) { wake_ids_ = std::move(ids); }
+  /// Sees every sample the processor gets, as it gets it: the samples and times
+  /// resolver-model reads from the same log must be exactly these (a test checks).
+  void set_sample_observer(std::function<void(const Sample&)> observer) { observer_ = std::move(observer); }
   /// nullptr when [model] enabled = false.
   [[nodiscard]] const LiveModelFit* model_fit() const { return model_fit_.get(); }
   /// Signal faults (LOS, DOS, LOT, ...) and the sin/cos amplitude.
   [[nodiscard]] const SignalHealthLog& signal_health() const { return signal_health_; }
 
  private:
-  void on_sample(const BenchSample& sample);
+  void on_sample(const Sample& sample, std::uint8_t counter);
   void on_bench_info(const BenchInfo& info);
-  void publish_estimate(std::int64_t utime, const BenchSample& sample);
-  void feed_model_fit(const SampleInput& in, const BenchSample& sample);
+  void publish_estimate(const Sample& sample, std::uint8_t counter);
+  void advance_health_clock(std::int64_t now_us);
   void publish_health(std::int64_t utime);
   void note_completing_frame(const CanFrame& frame);
+
+  bool rows_seen_ = false;  ///< a CSV row arrived: health uses the CSV full scale
 
   DaemonConfig config_;
   OutputSink& sink_;
   ProblemLog problems_;
-  FrameIntake intake_;
+  SampleStream stream_;
   SampleProcessor processor_;
   RunSummary summary_;
   LatencyHistogram latency_window_;
@@ -114,23 +134,18 @@ class Pipeline {
   std::int64_t samples_ = 0;
   CompletingFrames completing_frames_;
   std::vector<std::uint32_t> wake_ids_;
-  std::int64_t last_frame_us_ = 0;
+  std::int64_t last_frame_us_ = 0;  ///< [us] stamp of the last frame or row
+  bool have_frame_time_ = false;
   std::int64_t health_window_start_us_ = -1;
   std::int64_t frames_at_window_start_ = 0;
   std::int64_t last_sample_index_ = 0;
   std::uint8_t last_counter_ = 0;
+  std::int64_t last_utime_ = 0;  ///< [us] of the last sample
   bool bench_info_seen_ = false;
-  // Sample clock: time = anchor_t + (index - anchor_index) / sample_rate.
-  double sample_rate_hz_ = 0.0;
-  bool anchored_ = false;
-  std::int64_t anchor_index_ = 0;
-  double anchor_t_ = 0.0;
-  std::int64_t last_index_ = 0;   ///< index of the previous sample
-  double last_frame_t_ = 0.0;     ///< [s] frame time of the previous sample
-  double sample_time(const BenchSample& sample);
   std::int64_t kernel_drops_ = 0;
   std::unique_ptr<LiveModelFit> model_fit_;
   SignalHealthLog signal_health_;
+  std::function<void(const Sample&)> observer_;
 };
 
 }  // namespace resolver

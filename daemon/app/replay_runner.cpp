@@ -7,8 +7,7 @@
 #include <chrono>
 #include <thread>
 
-#include "drivers/candump/candump_line.h"
-#include "drivers/candump/candump_reader.h"
+#include "daemon/app/log_input.h"
 
 namespace resolver {
 
@@ -47,65 +46,75 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
   std::int64_t loop_span_us = 0;
   std::int64_t offset_us = 0;
 
+  const LogFormat format = resolve_log_format(options.path, options.format, current().config());
   while (!flags.stop.load()) {
-    CandumpReader reader(options.path);
-    reader.set_stop_flag(&flags.stop);
+    const std::unique_ptr<LogInput> reader = open_log_input(options.path, format, current().config());
+    reader->set_stop_flag(&flags.stop);
     ++result.passes;
     if (result.passes > 1) {
       current().restart_sequence();
       offset_us += loop_span_us;
     }
-    CanFrame frame;
+    LogRecord record;
     bool have_t0 = false;
-    std::int64_t log_t0 = 0;
+    std::int64_t log_t0 = 0, last_us = 0;
     Clock::time_point wall_t0;
     std::int64_t first_us = 0, max_us = 0, pass_frames = 0;
-    while (!flags.stop.load()) {
+    while (!flags.stop.load() && !current().past_slice_end()) {
       if (flags.reload.load(std::memory_order_relaxed) && flags.reload.exchange(false)) on_reload();
-      const auto status = reader.next(frame);
-      if (status == CandumpReader::Status::kEnd) break;
+      const auto status = reader->next(record);
+      if (status == LogInput::Status::kEnd) break;
       Pipeline& pipeline = current();
-      if (status == CandumpReader::Status::kBadLine) {
+      if (status == LogInput::Status::kBadLine) {
         ++result.bad_lines;
-        const LogLineProblem& pr = reader.problem();
-        pipeline.count_problem(to_string(pr.kind), fmt::format("{}:{}:{}: {}", options.path, reader.line_number(),
-                                                                pr.column, pr.message));
+        const TextProblem& pr = reader->problem();
+        pipeline.count_problem(pr.reason, fmt::format("{}:{}:{}: {}", options.path, reader->line_number(),
+                                                       pr.column, pr.message));
         continue;
       }
-      if (pass_frames++ == 0) first_us = max_us = frame.timestamp_us;
-      max_us = std::max(max_us, frame.timestamp_us);
+      if (pass_frames++ == 0) first_us = max_us = record.timestamp_us;
+      max_us = std::max(max_us, record.timestamp_us);
       if (!options.fast) {
-        if (!have_t0) {
+        // A stamp that steps back or jumps far re-anchors the pacing (it is no
+        // reason to wait a day); the sample clock deals with what time means.
+        const std::int64_t step = record.timestamp_us - last_us;
+        if (!have_t0 || step < 0 || step > kMaxPacedGapUs) {
           have_t0 = true;
-          log_t0 = frame.timestamp_us;
+          log_t0 = record.timestamp_us;
           wall_t0 = Clock::now();
         }
+        last_us = record.timestamp_us;
         const auto due = wall_t0 + std::chrono::microseconds(static_cast<std::int64_t>(
-                                       static_cast<double>(frame.timestamp_us - log_t0) / rate));
+                                       static_cast<double>(record.timestamp_us - log_t0) / rate));
         // A reload request interrupts the wait; it is served before the next frame.
         while (!sleep_until_or_signal(due, flags) && !flags.stop.load()) {
           if (flags.reload.exchange(false)) on_reload();
         }
         if (flags.stop.load()) break;
       }
-      frame.timestamp_us += offset_us;
       ++result.frames;
-      // Paced replay times every frame, like live input. Fast replay times one
-      // frame in kReplayLatencyEvery: the percentiles stay representative and
-      // the other frames skip the clock read.
       Pipeline& target = current();
-      if (!options.fast || result.frames % kReplayLatencyEvery == 1) {
-        target.feed(frame, reader.line_number(), Clock::now());
+      if (record.is_row) {
+        if (record.row.has_time) record.row.time_us += offset_us;
+        target.feed_row(record.row, reader->line_number());
       } else {
-        target.feed_untimed(frame, reader.line_number());
+        record.frame.timestamp_us += offset_us;
+        // Paced replay times every frame, like live input. Fast replay times one
+        // frame in kReplayLatencyEvery: the percentiles stay representative and
+        // the other frames skip the clock read.
+        if (!options.fast || result.frames % kReplayLatencyEvery == 1) {
+          target.feed(record.frame, reader->line_number(), Clock::now());
+        } else {
+          target.feed_untimed(record.frame, reader->line_number());
+        }
       }
       if (options.progress && (result.frames & 0xFFFU) == 0) {
         const auto now = Clock::now();
         if (now >= next_progress) {
           next_progress = now + kProgressEvery;
           const double s = std::chrono::duration<double>(now - wall_start).count();
-          const double pct = reader.total_bytes() > 0
-                                 ? 100.0 * static_cast<double>(reader.bytes_read()) / static_cast<double>(reader.total_bytes())
+          const double pct = reader->total_bytes() > 0
+                                 ? 100.0 * static_cast<double>(reader->bytes_read()) / static_cast<double>(reader->total_bytes())
                                  : 0.0;
           err << fmt::format("{}resolverd: {:5.1f}% of {} ({} frames, {:.0f} frames/s){}", tty ? "\r" : "", pct,
                              options.path, result.frames, static_cast<double>(result.frames) / s, tty ? "" : "\n");
@@ -114,7 +123,7 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
         }
       }
     }
-    if (options.once || reader.stopped()) break;
+    if (options.once || reader->stopped() || current().past_slice_end()) break;
     if (pass_frames == 0) {
       // Nothing to loop over: an empty (or all-bad) log would spin here forever.
       err << "resolverd: " << options.path << " has no frames to loop over; stopping after one pass\n";

@@ -101,6 +101,10 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
                      st.frames_seen, st.frames_decoded, st.bus_errors,
                      info.wall_seconds > 0 ? static_cast<double>(st.frames_seen) / info.wall_seconds : 0.0);
   out << fmt::format("  samples    {} complete, {} incomplete\n", st.samples_complete, st.samples_incomplete);
+  if (const SampleSlice& sl = p.stream().slice(); sl.limited()) {
+    out << fmt::format("  slice      --from {} s --to {} s: {} samples used, {} read outside it\n", sl.from_s, sl.to_s,
+                       p.samples(), p.stream().samples_outside_slice());
+  }
   print_completing_frames(out, p.completing_frames());
   if (p.intake().rejects().all().empty()) {
     out << "  rejected   none\n";
@@ -192,6 +196,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   j += fmt::format("\"source\":{},\"wall_seconds\":{},", json_string(info.source), json_number(info.wall_seconds));
   j += fmt::format("\"frames_seen\":{},\"frames_decoded\":{},\"bus_errors\":{},\"samples_complete\":{},\"samples_incomplete\":{},",
                    st.frames_seen, st.frames_decoded, st.bus_errors, st.samples_complete, st.samples_incomplete);
+  j += fmt::format("\"samples_used\":{},\"samples_outside_slice\":{},", p.samples(), p.stream().samples_outside_slice());
   j += "\"rejects\":{";
   bool first = true;
   for (const auto& [reason, n] : p.intake().rejects().all()) {

@@ -37,11 +37,11 @@ SignalHealthConfig health_config_for(const DaemonConfig& config, const FrameDeco
   if (config.health_full_scale_set) return h;
   double full_scale = 0.0, lsb = 0.0;
   for (const auto& slot : decoder.slots()) {
-    for (const auto& [role, sig] : slot.roles) {
-      if (role != Role::kSin && role != Role::kCos) continue;
-      const double fs = signal_full_scale(*sig);
+    for (const auto& r : slot.roles) {
+      if (r.role != Role::kSin && r.role != Role::kCos) continue;
+      const double fs = signal_full_scale(*r.signal);
       full_scale = full_scale > 0.0 ? std::min(full_scale, fs) : fs;
-      lsb = std::max(lsb, std::abs(sig->factor));
+      lsb = std::max(lsb, std::abs(r.signal->factor));
     }
   }
   if (full_scale > 0.0) {

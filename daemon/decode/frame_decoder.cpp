@@ -1,11 +1,15 @@
 #include "daemon/decode/frame_decoder.h"
 
 #include <bitset>
+#include <cstdio>
+#include <optional>
 #include <span>
 #include <stdexcept>
 
+#include "daemon/core/angles.h"
 #include "daemon/dbc/dbc_codec.h"
 #include "daemon/decode/crc8_j1850.h"
+#include "daemon/decode/signal_units.h"
 
 namespace resolver {
 
@@ -51,7 +55,7 @@ bool can_share_a_frame(const dbc::Signal& a, const dbc::Signal& b) {
 void FrameDecoder::check_overlaps(const Slot& slot, const std::function<void(const std::string&)>& problem) {
   // What resolverd reads from the message: its roles, the counter and the CRC.
   std::vector<const dbc::Signal*> used;
-  for (const auto& [role, sig] : slot.roles) used.push_back(sig);
+  for (const RoleSignal& r : slot.roles) used.push_back(r.signal);
   if (slot.counter != nullptr) used.push_back(slot.counter);
   if (slot.crc != nullptr) used.push_back(slot.crc);
   auto is_used = [&used](const dbc::Signal* s) { return std::find(used.begin(), used.end(), s) != used.end(); };
@@ -86,6 +90,27 @@ std::string_view to_string(FrameReject reject) {
   return "unknown";
 }
 
+namespace {
+
+bool is_angle(Role role) { return role == Role::kRdAngle || role == Role::kRefAngle; }
+bool is_current(Role role) { return role == Role::kIA || role == Role::kIB || role == Role::kIC; }
+
+/// The factor from the signal's DBC unit to the role's unit, or a problem
+/// naming the signal, its unit and the accepted ones.
+std::optional<double> role_unit_factor(Role role, const std::string& message, const dbc::Signal& sig,
+                                       std::string& problem) {
+  if (!is_angle(role) && !is_current(role)) return 1.0;  // sin/cos: any consistent unit
+  const auto factor = is_angle(role) ? angle_unit_to_rad(sig.unit) : current_unit_to_amps(sig.unit);
+  if (factor) return factor;
+  problem = "role '" + std::string(role_name(role)) + "' (" + message + "." + sig.name + "): " +
+            (sig.unit.empty() ? std::string("the DBC signal has no unit") : "unit " + quote_unit(sig.unit) + " is unknown") +
+            "; an " + (is_angle(role) ? "angle" : "current") + " signal must say its unit, one of: " +
+            std::string(is_angle(role) ? kAngleUnitList : kCurrentUnitList) + " (set it in the DBC's SG_ line)";
+  return std::nullopt;
+}
+
+}  // namespace
+
 FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map)
     : db_(std::move(db)), map_(map) {
   std::string problems;
@@ -111,10 +136,11 @@ FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const Signal
     if (it == slot_by_id_.end()) {
       Slot slot;
       slot.message = msg;
-      slot.counter = msg->find_signal(map_.counter_signal);
-      if (slot.counter == nullptr) {
+      slot.counter = has_counter() ? msg->find_signal(map_.counter_signal) : nullptr;
+      if (has_counter() && slot.counter == nullptr) {
         problem("message '" + msg->name + "' carries role '" + std::string(role_name(role)) +
-                "' but has no counter signal '" + map_.counter_signal + "' (set layout.counter_signal)");
+                "' but has no counter signal '" + map_.counter_signal +
+                "' (set layout.counter_signal, or counter_signal = \"\" for a layout without one)");
       }
       if (!map_.crc_signal.empty() && map_.crc != CrcAlgorithm::kNone) {
         slot.crc = msg->find_signal(map_.crc_signal);
@@ -129,7 +155,10 @@ FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const Signal
     } else {
       slot_index = it->second;
     }
-    slots_[static_cast<std::size_t>(slot_index)].roles.emplace_back(role, sig);
+    std::string unit_problem;
+    const auto factor = role_unit_factor(role, msg->name, *sig, unit_problem);
+    if (!factor) problem(unit_problem);
+    slots_[static_cast<std::size_t>(slot_index)].roles.push_back(RoleSignal{role, sig, factor.value_or(1.0), is_angle(role)});
     mapped_roles_ = static_cast<std::uint16_t>(mapped_roles_ | role_bit(role));
   }
   for (const Slot& slot : slots_) check_overlaps(slot, problem);
@@ -188,15 +217,36 @@ DecodeResult FrameDecoder::decode(const CanFrame& frame, DecodedPart& part, Benc
 
   const Slot& slot = slots_[static_cast<std::size_t>(it->second)];
   part.slot = it->second;
-  part.counter = static_cast<std::uint8_t>(dbc::extract_raw(*slot.counter, data));
+  part.has_counter = slot.counter != nullptr;
+  part.counter = part.has_counter ? static_cast<std::uint8_t>(dbc::extract_raw(*slot.counter, data)) : 0;
   part.roles = 0;
   part.timestamp_us = frame.timestamp_us;
-  for (const auto& [role, sig] : slot.roles) {
-    part.values[static_cast<std::size_t>(role)] = dbc::decode_physical(*sig, data);
-    part.roles = static_cast<std::uint16_t>(part.roles | role_bit(role));
+  for (const RoleSignal& r : slot.roles) {
+    const double value = dbc::decode_physical(*r.signal, data) * r.to_role_unit;
+    part.values[static_cast<std::size_t>(r.role)] = r.wrap ? wrap_2pi(value) : value;
+    part.roles = static_cast<std::uint16_t>(part.roles | role_bit(r.role));
   }
   result.status = DecodeStatus::kPart;
   return result;
+}
+
+}  // namespace resolver
+
+namespace resolver {
+
+std::string FrameDecoder::describe_layout() const {
+  std::string out;
+  for (const Slot& slot : slots_) {
+    char id[16];
+    std::snprintf(id, sizeof id, slot.message->extended ? "0x%08X" : "0x%03X", slot.message->id);
+    out += (out.empty() ? "" : ", ") + slot.message->name + " " + id + " (";
+    for (std::size_t i = 0; i < slot.roles.size(); ++i) {
+      out += (i == 0 ? "" : ", ") + std::string(role_name(slot.roles[i].role)) + " = " + slot.roles[i].signal->name;
+    }
+    out += ")";
+  }
+  out += has_counter() ? ", counter '" + map_.counter_signal + "'" : ", no counter";
+  return out;
 }
 
 }  // namespace resolver

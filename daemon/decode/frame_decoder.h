@@ -2,7 +2,9 @@
 //
 // Each DBC message that carries at least one role is a "slot". Decoding a
 // frame checks, in order: error/remote frames, known ID, length against the
-// DBC's DLC, CRC; then extracts the counter and every role the slot carries.
+// DBC's DLC, CRC; then extracts the counter (when the layout has one) and
+// every role the slot carries, converted from the signal's DBC unit to the
+// role's unit (signal_units.h: angles to radians in [0, 2pi), currents to A).
 // A frame that fails a check is rejected with a reason and never touches a
 // sample.
 #pragma once
@@ -34,6 +36,7 @@ enum class FrameReject : std::uint8_t {
 /// One decoded frame that belongs to a sample.
 struct DecodedPart {
   int slot = 0;                       ///< index into FrameDecoder::slots()
+  bool has_counter = false;           ///< the layout has a counter signal
   std::uint8_t counter = 0;
   std::uint16_t roles = 0;            ///< role_bit() mask of what `values` holds
   std::array<double, kRoleCount> values{};
@@ -57,16 +60,23 @@ struct DecodeResult {
 
 class FrameDecoder {
  public:
+  struct RoleSignal {
+    Role role = Role::kSin;
+    const dbc::Signal* signal = nullptr;
+    double to_role_unit = 1.0;  ///< DBC physical value * this = the role's unit (rad, A)
+    bool wrap = false;          ///< an angle: wrapped to [0, 2pi)
+  };
   struct Slot {
     const dbc::Message* message = nullptr;
-    const dbc::Signal* counter = nullptr;
+    const dbc::Signal* counter = nullptr;  ///< nullptr when the layout has no counter
     const dbc::Signal* crc = nullptr;
-    std::vector<std::pair<Role, const dbc::Signal*>> roles;
+    std::vector<RoleSignal> roles;
   };
 
   /// Builds the decoder. Throws std::invalid_argument listing every problem
   /// (unknown message or signal names, missing counter, a signal it reads
-  /// overlapping another signal of its message) in one message.
+  /// overlapping another signal of its message, an angle or current signal whose
+  /// unit is missing or unknown) in one message.
   FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map);
 
   /// Decodes one frame. Cannot fail beyond returning kRejected with a reason.
@@ -77,6 +87,12 @@ class FrameDecoder {
   /// Non-fatal findings: overlapping signals in a mapped message that the decoder
   /// does not read (a DBC may describe the same bytes twice; decoding is unaffected).
   [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
+  /// False for a layout without a counter ([layout] counter_signal = ""): frames
+  /// then join by message order and time (leading_frame_joiner.h).
+  [[nodiscard]] bool has_counter() const { return !map_.counter_signal.empty(); }
+  /// What messages say about the layout in use, e.g.
+  /// "RESOLVER_FB 0x123 (sin = SinEnv, cos = CosEnv), CURRENTS 0x124 (i_a = Ia, ...)".
+  [[nodiscard]] std::string describe_layout() const;
 
  private:
   /// Overlaps in a slot's message: an error when a signal the decoder reads is

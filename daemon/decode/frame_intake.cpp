@@ -4,13 +4,19 @@
 
 namespace resolver {
 
-std::string describe_frame(const CanFrame& frame) {
-  char buf[96];
-  const auto sec = frame.timestamp_us / 1000000;
-  const auto usec = frame.timestamp_us % 1000000;
-  std::snprintf(buf, sizeof buf, "frame %0*X at (%lld.%06lld)", frame.extended ? 8 : 3, frame.id,
-                static_cast<long long>(sec), static_cast<long long>(usec < 0 ? -usec : usec));
+std::string describe_frame_time(std::int64_t timestamp_us) {
+  char buf[48];
+  const auto sec = timestamp_us / 1000000;
+  const auto usec = timestamp_us % 1000000;
+  std::snprintf(buf, sizeof buf, "(%s%lld.%06lld)", timestamp_us < 0 ? "-" : "", static_cast<long long>(sec < 0 ? -sec : sec),
+                static_cast<long long>(usec < 0 ? -usec : usec));
   return buf;
+}
+
+std::string describe_frame(const CanFrame& frame) {
+  char id[16];
+  std::snprintf(id, sizeof id, "%0*X", frame.extended ? 8 : 3, frame.id);
+  return "frame " + std::string(id) + " at " + describe_frame_time(frame.timestamp_us);
 }
 
 FrameIntake::FrameIntake(std::shared_ptr<const FrameDecoder> decoder, int max_counter_delta, Callbacks callbacks)
@@ -18,11 +24,13 @@ FrameIntake::FrameIntake(std::shared_ptr<const FrameDecoder> decoder, int max_co
       max_counter_delta_(max_counter_delta),
       callbacks_(std::move(callbacks)),
       counters_(decoder_->slots().size(), CounterCheck(max_counter_delta)),
-      joiner_([this](const BenchSample& s) { on_joined(s); }) {}
+      joiner_([this](const BenchSample& s) { on_joined(s); }),
+      order_joiner_([this](const BenchSample& s) { on_joined(s); }) {}
 
 void FrameIntake::restart_sequence() {
-  joiner_.flush();
+  flush();
   joiner_.reset();
+  order_joiner_.reset();
   for (auto& c : counters_) c.reset();
 }
 
@@ -61,6 +69,11 @@ void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
   if (r.status == DecodeStatus::kBenchInfo) {
     ++stats_.frames_decoded;
     if (callbacks_.on_bench_info) callbacks_.on_bench_info(info_);
+    return;
+  }
+  if (!part_.has_counter) {
+    order_joiner_.add(part_);
+    ++stats_.frames_decoded;
     return;
   }
   CounterCheck& check = counters_[static_cast<std::size_t>(part_.slot)];
@@ -114,9 +127,12 @@ void FrameIntake::on_joined(const BenchSample& sample) {
     }
     rejects_.add("sample_incomplete");
     if (callbacks_.on_problem) {
-      callbacks_.on_problem("sample_incomplete", "sample counter " + std::to_string(sample.counter) + " (index " +
-                                                     std::to_string(sample.index) + ") is missing " + missing +
-                                                     "; used with what arrived");
+      callbacks_.on_problem("sample_incomplete",
+                            (decoder_->has_counter() ? "sample counter " + std::to_string(sample.counter) + " (index " +
+                                                           std::to_string(sample.index) + ")"
+                                                     : "sample " + std::to_string(sample.index) + " at " +
+                                                           describe_frame_time(sample.timestamp_us)) +
+                                " is missing " + missing + "; used with what arrived");
     }
   }
   if (callbacks_.on_sample) callbacks_.on_sample(sample);

@@ -1,9 +1,10 @@
 // Front half of the pipeline: CAN frames in, joined bench samples out.
 //
 //   frame ─► error frame? ─► bus_errors
-//         └► FrameDecoder (ID, DLC, CRC) ─► reject counters
+//         └► FrameDecoder (ID, DLC, CRC, units) ─► reject counters
 //              └► CounterCheck per message (repeated / some lost / wrong sequence)
 //                   └► SampleJoiner ─► on_sample(BenchSample)
+//              └► (layout without a counter) LeadingFrameJoiner ─► on_sample
 //   BENCH_INFO ─► on_bench_info(BenchInfo)
 //
 // No I/O: problems are reported through the Diagnostics callback with a
@@ -18,6 +19,7 @@
 
 #include "daemon/decode/counter_check.h"
 #include "daemon/decode/frame_decoder.h"
+#include "daemon/decode/leading_frame_joiner.h"
 #include "daemon/decode/reject_counters.h"
 #include "daemon/decode/sample_joiner.h"
 
@@ -45,12 +47,22 @@ class FrameIntake {
 
   /// Processes one frame; `line` is the log line (0 when live). Cannot fail.
   void feed(const CanFrame& frame, std::uint64_t line = 0);
+  /// A sample that came without frames (a CSV row): counted as one frame seen
+  /// and decoded and as one sample, then passed on. Cannot fail.
+  void feed_sample(const BenchSample& sample) {
+    ++stats_.frames_seen;
+    ++stats_.frames_decoded;
+    on_joined(sample);
+  }
   /// Counts a problem found before decoding (e.g. a malformed log line).
   void count_problem(std::string_view reason, const std::string& message);
   /// Counts a problem the caller has already reported.
-  void count_problem_silently(std::string_view reason) { rejects_.add(reason); }
+  void count_problem_silently(std::string_view reason, std::int64_t n = 1) { rejects_.add(reason, n); }
   /// Emits the sample still open (end of input).
-  void flush() { joiner_.flush(); }
+  void flush() {
+    joiner_.flush();
+    order_joiner_.flush();
+  }
   /// Forgets counters and open samples, keeps statistics (e.g. log loop).
   void restart_sequence();
 
@@ -68,14 +80,17 @@ class FrameIntake {
   int max_counter_delta_;
   Callbacks callbacks_;
   std::vector<CounterCheck> counters_;
-  SampleJoiner joiner_;
+  SampleJoiner joiner_;             ///< layouts with a counter
+  LeadingFrameJoiner order_joiner_;  ///< layouts without one
   RejectCounters rejects_;
   IntakeStats stats_;
   DecodedPart part_;
   BenchInfo info_;
 };
 
-/// "frame 0x100 (RESOLVER_SAMPLE) at 1700000000.123456 s" — how messages name a frame.
+/// "frame 100 at (1700000000.123456)": how messages name a frame (ID in hex, time as candump prints it).
 std::string describe_frame(const CanFrame& frame);
+/// "(1700000000.123456)": a frame or sample time as candump logs print it.
+std::string describe_frame_time(std::int64_t timestamp_us);
 
 }  // namespace resolver

@@ -17,6 +17,7 @@ JoinResult SampleJoiner::add(const DecodedPart& part) {
   if (!open_) {
     open_ = true;
     sample_ = BenchSample{};
+    sample_.has_counter = true;
     sample_.counter = part.counter;
     sample_.timestamp_us = part.timestamp_us;
     if (!have_index_) {

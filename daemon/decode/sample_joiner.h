@@ -23,7 +23,8 @@ namespace resolver {
 
 struct BenchSample {
   std::int64_t timestamp_us = 0;  ///< [us] timestamp of the sample's first part
-  std::int64_t index = 0;         ///< counter unwrapped over 256 (gaps advance it)
+  std::int64_t index = 0;         ///< counter unwrapped over 256 (gaps advance it), else a running count
+  bool has_counter = false;       ///< index comes from a counter (the sample clock may count on it)
   std::uint8_t counter = 0;
   std::uint16_t roles = 0;        ///< role_bit() mask of valid values
   std::array<double, kRoleCount> values{};

@@ -116,7 +116,7 @@ CalibrationTable read_table_csv(const std::string& path) {
     ++n;
     const std::string where = fmt::format("{}:{}", path, n);
     if (n == 1) {
-      if (line != kMagic) throw std::runtime_error(where + ": not a calibration table (the first line must be '" + kMagic + "'; export one with resolver-model export --format csv)");
+      if (line != kMagic) throw std::runtime_error(where + ": not a calibration table (the first line must be '" + kMagic + "'; export one with resolver-model export --table-format csv)");
       magic = true;
       continue;
     }

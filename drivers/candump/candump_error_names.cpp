@@ -16,7 +16,6 @@ std::string_view to_string(LogLineError error) {
     case LogLineError::kOddNibbles: return "odd_nibbles";
     case LogLineError::kTooLong: return "dlc_too_long";
     case LogLineError::kBadFdFlags: return "bad_fd_flags";
-    case LogLineError::kNonMonotonicTimestamp: return "non_monotonic_timestamp";
     case LogLineError::kLineTooLong: return "line_too_long";
   }
   // Only reachable with a value cast from outside the enum's range.

@@ -55,20 +55,19 @@ enum class LogLineError : std::uint8_t {
   kOddNibbles,             ///< a data byte with only one hex digit
   kTooLong,                ///< > 8 classic / > 64 FD bytes, or not a valid FD length
   kBadFdFlags,             ///< '##' without a flags nibble 0..7
-  kNonMonotonicTimestamp,  ///< timestamp before the previous good frame's (reader only)
   kLineTooLong,            ///< more than kMaxCandumpLineLength bytes
 };
-inline constexpr std::size_t kLogLineErrorCount = 12;
+inline constexpr std::size_t kLogLineErrorCount = 11;
 inline constexpr std::array<LogLineError, kLogLineErrorCount> kAllLogLineErrors{
-    LogLineError::kMissingTimestamp, LogLineError::kBadTimestamp,  LogLineError::kMissingInterface,
-    LogLineError::kMissingFrame,     LogLineError::kBadId,         LogLineError::kBadSeparator,
-    LogLineError::kBadHex,           LogLineError::kOddNibbles,    LogLineError::kTooLong,
-    LogLineError::kBadFdFlags,       LogLineError::kNonMonotonicTimestamp, LogLineError::kLineTooLong};
+    LogLineError::kMissingTimestamp, LogLineError::kBadTimestamp, LogLineError::kMissingInterface,
+    LogLineError::kMissingFrame,     LogLineError::kBadId,        LogLineError::kBadSeparator,
+    LogLineError::kBadHex,           LogLineError::kOddNibbles,   LogLineError::kTooLong,
+    LogLineError::kBadFdFlags,       LogLineError::kLineTooLong};
 
 /// Stable snake_case counter name: "missing_timestamp", "bad_timestamp",
 /// "missing_interface", "missing_frame", "bad_id", "bad_separator", "bad_hex",
-/// "odd_nibbles", "dlc_too_long", "bad_fd_flags", "non_monotonic_timestamp",
-/// "line_too_long".
+/// "odd_nibbles", "dlc_too_long", "bad_fd_flags", "line_too_long". (A timestamp
+/// that goes back is no line error: the sample clock counts it as timestamp_step_back.)
 [[nodiscard]] std::string_view to_string(LogLineError error);
 
 struct LogLineProblem {

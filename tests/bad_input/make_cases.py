@@ -104,17 +104,67 @@ def data_of(text):
     return bytes.fromhex(text.rpartition("#")[2])
 
 
+def asc_of(lines):
+    """The candump lines as a Vector ASC file (absolute times from the first frame)."""
+    t0 = None
+    out = ["date Tue Nov 14 10:13:20.000 PM 2023", "base hex  timestamps absolute", "internal events logged",
+           "Begin Triggerblock Tue Nov 14 10:13:20.000 PM 2023"]
+    for l in lines:
+        t, rest = l[1:].split(")", 1)
+        us = round(float(t) * 1e6)
+        t0 = us if t0 is None else t0
+        frame = rest.split()[1]
+        can_id, data = frame.split("#")
+        b = bytes.fromhex(data)
+        out.append("   %d.%06d 1  %-15s Rx   d %d %s" % ((us - t0) // 1_000_000, (us - t0) % 1_000_000, can_id.lstrip("0") or "0",
+                                                      len(b), " ".join("%02X" % x for x in b)))
+    out.append("End TriggerBlock")
+    return out
+
+
+SCOPE_TOML = """[bench]
+p_r = 1
+p = 1
+[input.csv]
+delimiter = ";"
+decimal = ","
+header_lines = 5
+time_column = "Time"
+time_unit = "filetime"
+[input.csv.columns]
+rd_angle = { column = "Resolver", unit = "deg" }
+ref_angle = { column = "Encoder", unit = "deg" }
+"""
+# 2024-01-01 00:00:00 UTC as a Windows FILETIME (100 ns ticks since 1601-01-01).
+FILETIME_2024 = 133_485_408_000_000_000
+
+
+def scope_rows():
+    """A scope export: 5 header lines, a name line, N_SAMPLES rows at 2 kHz (FILETIME, degrees, decimal comma)."""
+    out = ["Scope export", "Model;XY-123", "Channels;2", "Sample rate;2000 Hz", "Unit;deg",
+           "Time;Resolver;Encoder"]
+    for k in range(N_SAMPLES):
+        deg = 360.0 * k / 40.0
+        out.append("%d;%s;%s" % (FILETIME_2024 + 5000 * k, ("%.4f" % deg).replace(".", ","),
+                                 ("%.4f" % (deg + 0.01)).replace(".", ",")))
+    return out
+
+
 cases = []
 
 
-def log_case(name, lines, reason, count, message, also=None, note=""):
-    path = os.path.join(CASES, name + ".log")
-    with open(path, "w", encoding="ascii", newline="\n") as f:
+def log_case(name, lines, reason, count, message, also=None, note="", samples=None, ext=".log", config=None):
+    path = os.path.join(CASES, name + ext)
+    with open(path, "w", encoding="latin-1", newline="\n") as f:
         f.write("\n".join(lines) + "\n")
-    case = {"file": "cases/" + name + ".log", "kind": "log", "expected_reason": reason,
+    case = {"file": "cases/" + name + ext, "kind": "log", "expected_reason": reason,
             "expected_count": count, "expected_message_substring": message}
     if also:
         case["also_expected"] = also
+    if samples is not None:
+        case["expected_samples"] = samples
+    if config:
+        case["config"] = "cases/" + config
     if note:
         case["note"] = note
     cases.append(case)
@@ -136,7 +186,7 @@ def health_case(name, lines, faults, message, note=""):
 
 def text_case(name, ext, kind, text, message, note="", dbc=None):
     path = os.path.join(CASES, name + ext)
-    with open(path, "w", encoding="ascii", newline="\n") as f:
+    with open(path, "w", encoding="latin-1", newline="\n") as f:
         f.write(text)
     case = {"file": "cases/" + name + ext, "kind": kind, "expected_reason": None, "expected_count": 0,
             "expected_message_substring": message}
@@ -173,9 +223,27 @@ def main():
              "classic CAN frame has 9 data bytes, at most 8 are allowed")
     log_case("missing_timestamp", inserted(after, "can0 101#0A3200CEFF4C01E8"), "missing_timestamp", 1,
              "missing_timestamp.log:%d:1: expected '(' opening the timestamp" % (after + 1))
-    earlier = replace_data(base[index_of(2, 0)], "7FF#00")  # period 2's time, after period 5
-    log_case("non_monotonic_timestamp", inserted(after, earlier), "non_monotonic_timestamp", 1,
-             "non_monotonic_timestamp.log:%d:" % (after + 1))
+    # ---- odd time (issue 16.3): counted and re-anchored, every sample still used
+    def shifted(lines, from_period, dt_us):
+        out = list(lines)
+        for i in range(index_of(from_period, 0), len(out)):
+            t, rest = out[i][1:].split(")", 1)
+            us = round(float(t) * 1e6) + dt_us
+            out[i] = "(%d.%06d)%s" % (us // 1_000_000, us % 1_000_000, rest)
+        return out
+    log_case("timestamp_step_back", shifted(base, 12, -1_000_000), "timestamp_step_back", 1,
+             "line %d: sample 12 at (1699999999.006500): the timestamp goes back 0.999500 s from the previous "
+             "sample's; time continues from the counter" % (index_of(12, 2) + 1),
+             samples=N_SAMPLES,
+             note="every frame from period 12 on is 1 s earlier; the counter goes on: all samples used")
+    log_case("timestamp_jump", shifted(base, 12, 86_400_000_000), "timestamp_jump", 1,
+             "the timestamp jumps forward 86400.000500 s while the counter advanced by 1; read as a clock jump, "
+             "time continues from the counter", samples=N_SAMPLES,
+             note="every frame from period 12 on is a day later; the counter goes on: all samples used")
+    log_case("logs_appended", base + base[1:], "timestamp_step_back", 1,
+             "time continues one sample period after the previous sample (logs appended?)",
+             also={"counter_wrong_sequence": 3}, samples=2 * N_SAMPLES,
+             note="the clean log twice: time and counter both restart; the second copy joins one period on")
     log_case("bad_fd_flags", inserted(after, t5 + " can0 101##80A3200CEFF4C01E8"), "bad_fd_flags", 1,
              "expected the CAN FD flags nibble 0-7")
     log_case("bad_fd_length", inserted(after, t5 + " can0 101##10A3200CEFF4C01E8AA"), "dlc_too_long", 1,
@@ -250,6 +318,70 @@ def main():
                 "signal fault overspeed started 0.000 s into the input (sample 0): resolver electrical travel 4.712 "
                 "rad per sample (from the reference angle)",
                 note="30000 r/min: more than pi rad of resolver travel per sample")
+
+    # ---- Vector ASC (drivers/asc): the clean log as CANoe writes it, then one bad line each
+    asc = asc_of(base)
+    log_case("asc_clean", asc, None, 0, "", samples=N_SAMPLES, ext=".asc",
+             note="the clean log as a Vector ASC file (header, trigger block, classic lines)")
+    at = 5 + 3 * 6  # after period 5 (4 header lines, BENCH_INFO, 3 lines per period)
+    asc_t5 = asc[at - 1].split()[0]
+    for name, line, reason, message in [
+        ("asc_unknown_line", "hello", "asc_unknown_line", "asc_unknown_line.asc:%d:1: not a Vector ASC line" % (at + 1)),
+        ("asc_unsupported_event", "   %s 1 Statistic: D 0 R 0 XD 0 XR 0" % asc_t5, "asc_unsupported_event",
+         "asc_unsupported_event.asc:%d:15: event '1 Statistic: D 0 R 0 XD 0 XR 0' carries no CAN frame" % (at + 1)),
+        ("asc_bad_data_byte", "   %s 1  101             Rx   d 2 0A 0G" % asc_t5, "bad_data_byte",
+         "asc_bad_data_byte.asc:%d:44: expected a data byte (hex 00..FF), found '0G'" % (at + 1)),
+        ("asc_missing_data", "   %s 1  101             Rx   d 8 0A" % asc_t5, "missing_data",
+         "the DLC announces 8 data bytes, the line has 1"),
+    ]:
+        bad_asc = list(asc)
+        bad_asc.insert(at, line)
+        log_case(name, bad_asc, reason, 1, message, samples=N_SAMPLES, ext=".asc")
+
+    # ---- CSV / scope exports (drivers/csv, daemon/decode/row_decoder.h) through a column map
+    with open(os.path.join(CASES, "scope.toml"), "w", encoding="ascii") as f:
+        f.write(SCOPE_TOML)
+    rows = scope_rows()
+    log_case("csv_clean", rows, None, 0, "", samples=N_SAMPLES, ext=".csv", config="scope.toml",
+             note="FILETIME, ';', decimal comma, degrees, 5 header lines: every row a sample")
+    row_at = 6 + 15  # header lines, names line, then row 15 (the clock has learned the period by then)
+    bad = list(rows)
+    bad[row_at] = bad[row_at].replace(";", ";x", 1)
+    log_case("csv_bad_number", bad, "bad_number", 1,
+             "csv_bad_number.csv:%d:20: column 'Resolver' (rd_angle): expected a number with ',' as decimal mark" % (row_at + 1),
+             samples=N_SAMPLES - 1, ext=".csv", config="scope.toml", also={"sample_gap": 1, "samples_lost": 1},
+             note="the bad row is lost; the sample clock finds the gap it leaves")
+    short = list(rows)
+    short[row_at] = short[row_at].rsplit(";", 1)[0]
+    log_case("csv_missing_column", short, "missing_column", 1,
+             "csv_missing_column.csv:%d:" % (row_at + 1), samples=N_SAMPLES - 1, ext=".csv", config="scope.toml",
+             also={"sample_gap": 1, "samples_lost": 1})
+    back = list(rows)
+    for i in range(row_at, len(back)):
+        ft, rest = back[i].split(";", 1)
+        back[i] = "%d;%s" % (int(ft) - 10_000_000, rest)  # 1 s earlier from row 15 on
+    log_case("csv_time_step_back", back, "timestamp_step_back", 1,
+             "line %d: sample 15 at (1704067199.007500): the timestamp goes back 0.999500 s" % (row_at + 1),
+             samples=N_SAMPLES, ext=".csv", config="scope.toml",
+             note="rows from 15 on are 1 s earlier: counted, re-anchored, every row used")
+    text_case("csv_unknown_column", ".toml", "config", SCOPE_TOML.replace('"Encoder"', '"Encoder2"'),
+              "no column named 'Encoder2' (the columns are 'Time', 'Resolver', 'Encoder')")
+    cases[-1]["replay"] = "cases/csv_clean.csv"
+    text_case("csv_unknown_unit", ".toml", "config", SCOPE_TOML.replace('unit = "deg" }\nref', 'unit = "grad" }\nref'),
+              "rd_angle: unit \"grad\" is not an angle unit")
+    cases[-1]["replay"] = "cases/csv_clean.csv"
+    text_case("csv_without_columns", ".toml", "config", "[bench]\np_r = 1\n",
+              "is read as a CSV / scope export (by its extension), but ")
+    cases[-1]["replay"] = "cases/csv_clean.csv"
+
+    # ---- a DBC angle in an unknown unit (signal_units.h): refused, naming the signal
+    with open(os.path.join(HERE, "..", "..", "proto", "resolver_bench.dbc"), encoding="ascii") as f:
+        grad = f.read().replace('"rad" RESOLVERD', '"grad" RESOLVERD', 1)
+    text_case("dbc_angle_unit_unknown", ".dbc", "dbc", grad,
+              "role 'rd_angle' (RESOLVER_SAMPLE.rd_angle): unit \"grad\" is unknown")
+    with open(os.path.join(CASES, "dbc_angle_unit_unknown.toml"), "w", encoding="ascii") as f:
+        f.write("[layout]\ndbc = \"cases/dbc_angle_unit_unknown.dbc\"\n")
+    cases[-1]["config"] = "cases/dbc_angle_unit_unknown.toml"
 
     # ---- configuration and DBC: resolverd must refuse to start, exit 2, say where and why
     text_case("bad_toml", ".toml", "config", "[bench]\np_r = = 3\n",

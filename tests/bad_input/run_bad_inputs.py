@@ -1,18 +1,19 @@
 #!/usr/bin/python3
 """Runs resolverd on every bad-input case of cases.json and checks what it says.
 
-For a log case (kind "log"):
-  resolverd --replay FILE --once --fast --quiet --lcm memq:// --report R.json
+For a log case (kind "log"; a candump, Vector ASC or CSV file, with its config if named):
+  resolverd --replay FILE [--config CONFIG] --once --fast --quiet --lcm memq:// --report R.json
   must exit 0 (bad input is counted, never fatal), count expected_count problems
   under expected_reason in R.json "rejects", count nothing else except the
-  reasons listed in also_expected (with exactly those counts), and print a line
-  "resolverd: ... <expected_message_substring> ... [<reason>]" on stderr.
+  reasons listed in also_expected (with exactly those counts), print a line
+  "resolverd: ... <expected_message_substring> ... [<reason>]" on stderr, and,
+  where expected_samples is given, decode exactly that many samples (nothing lost).
 For a signal-fault case (kind "health"): the same run must exit 0 with no reject,
   report every fault of expected_faults in R.json "signal_health" for at least the
   given share of the samples, report no other fault, and print the message.
 For a config or DBC case (kind "config" / "dbc"):
-  resolverd --config CONFIG --replay cases/clean.log ... must refuse to start:
-  exit 2 with "resolverd: ...<expected_message_substring>..." on stderr.
+  resolverd --config CONFIG --replay cases/clean.log (or the case's "replay") ... must
+  refuse to start: exit 2 with "resolverd: ...<expected_message_substring>..." on stderr.
 Any death by a signal, a sanitizer report or a timeout fails the case.
 
 Paths in cases.json are relative to this folder, where resolverd runs.
@@ -53,13 +54,13 @@ def check_case(case, resolverd, work):
     kind = case["kind"]
     want = case["expected_message_substring"]
     if kind in ("log", "health"):
-        args = ["--replay", case["file"]]
+        args = ["--replay", case["file"]] + (["--config", case["config"]] if "config" in case else [])
         want_rc = 0
     elif kind == "config":
-        args = ["--config", case["file"], "--replay", CLEAN_LOG]
+        args = ["--config", case["file"], "--replay", case.get("replay", CLEAN_LOG)]
         want_rc = 2
     elif kind == "dbc":
-        args = ["--config", case["config"], "--replay", CLEAN_LOG]
+        args = ["--config", case["config"], "--replay", case.get("replay", CLEAN_LOG)]
         want_rc = 2
     else:
         return ["unknown kind '%s' in cases.json" % kind]
@@ -116,6 +117,10 @@ def check_case(case, resolverd, work):
             others = {n: f["samples"] for n, f in faults.items() if n not in wanted and f["samples"]}
             if others:
                 failures.append("unexpected signal faults %s" % others)
+            if "expected_samples" in case:
+                got = report.get("samples_complete", 0) + report.get("samples_incomplete", 0)
+                if got != case["expected_samples"]:
+                    failures.append("%d samples decoded, expected %d" % (got, case["expected_samples"]))
     if failures:
         tail = "\n".join("      | " + l for l in stderr.splitlines()[-15:])
         failures.append("stderr (last lines):\n" + tail)
@@ -162,8 +167,10 @@ def main():
                     summary = "no rejects"
                 print("ok   %-34s %s" % (name, summary))
             if opts.verbose:
-                _, stderr, _, _ = run(resolverd, ["--replay", case["file"]] if case["kind"] in ("log", "health") else
-                                      ["--config", case.get("config", case["file"]), "--replay", CLEAN_LOG], work)
+                _, stderr, _, _ = run(resolverd, ["--replay", case["file"]] + (["--config", case["config"]] if "config" in case else [])
+                                      if case["kind"] in ("log", "health") else
+                                      ["--config", case.get("config", case["file"]), "--replay",
+                                       case.get("replay", CLEAN_LOG)], work)
                 print("\n".join("      | " + l for l in stderr.splitlines()))
     print("%d of %d bad-input cases passed" % (len(cases) - failed, len(cases)))
     return 1 if failed else 0

@@ -26,6 +26,7 @@
 #include "daemon/decode/crc8_j1850.h"
 #include "daemon/decode/frame_intake.h"
 #include "drivers/candump/candump_line.h"
+#include "tests/fuzz/fuzz_bench_decoder.h"
 #include "tests/fuzz/fuzz_support.h"
 
 #ifndef RESOLVER_BENCH_DBC
@@ -36,17 +37,7 @@ namespace {
 
 using resolver::CanFrame;
 
-std::shared_ptr<const resolver::FrameDecoder> bench_decoder() {
-  static const std::shared_ptr<const resolver::FrameDecoder> decoder = [] {
-    auto loaded = resolver::dbc::load_dbc_file(RESOLVER_BENCH_DBC);
-    if (const auto* error = std::get_if<resolver::dbc::DbcError>(&loaded)) {
-      throw std::runtime_error("fuzz_frame_intake: cannot load the bench DBC: " + error->what());
-    }
-    auto db = std::make_shared<const resolver::dbc::Database>(std::get<resolver::dbc::Database>(std::move(loaded)));
-    return std::make_shared<const resolver::FrameDecoder>(db, resolver::SignalMap::bench_default());
-  }();
-  return decoder;
-}
+using resolver::fuzz::bench_decoder;
 
 resolver::FrameIntake::Callbacks checking_callbacks(std::uint16_t mapped_roles) {
   resolver::FrameIntake::Callbacks cb;

@@ -10,7 +10,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <string>
 #include <string_view>
+
+#include <sys/mman.h>
+#include <unistd.h>
 
 namespace resolver::fuzz {
 
@@ -42,6 +46,32 @@ void for_each_line(std::string_view text, Fn&& fn) {
     text.remove_prefix(nl + 1);
   }
 }
+
+/// The input as a file (a memfd), so readers that open a path read it the way
+/// they read a log. Closes it at scope end; path() is empty when no memfd
+/// could be made or written (old kernel): the target then has nothing to test.
+class MemFile {
+ public:
+  MemFile(const std::uint8_t* data, std::size_t size) : fd_(::memfd_create("fuzz_input", MFD_CLOEXEC)) {
+    std::size_t written = 0;
+    while (fd_ >= 0 && written < size) {
+      const ssize_t n = ::write(fd_, data + written, size - written);
+      if (n <= 0) break;
+      written += static_cast<std::size_t>(n);
+    }
+    ok_ = fd_ >= 0 && written == size;
+  }
+  ~MemFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  MemFile(const MemFile&) = delete;
+  MemFile& operator=(const MemFile&) = delete;
+  [[nodiscard]] std::string path() const { return ok_ ? "/proc/self/fd/" + std::to_string(fd_) : std::string(); }
+
+ private:
+  int fd_;
+  bool ok_ = false;
+};
 
 /// Reads bytes off the front of the input; past the end everything reads as 0.
 class ByteReader {

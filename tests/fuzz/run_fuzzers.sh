@@ -7,7 +7,7 @@
 #   tests/fuzz/run_fuzzers.sh [SECONDS_PER_TARGET] [TARGET...]
 #       SECONDS_PER_TARGET  default 20 (or $FUZZ_SECONDS)
 #       TARGET              candump_line candump_reader dbc_parser frame_intake
-#                           daemon_config (default: all)
+#                           daemon_config asc_reader csv_reader (default: all)
 #   environment:
 #       FUZZ_BUILD_DIR  build folder (default <repo>/build-fuzz)
 #       FUZZ_JOBS       parallel compile jobs (default: nproc)
@@ -27,7 +27,7 @@ set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 seconds=${1:-${FUZZ_SECONDS:-20}}
 shift $(( $# > 0 ? 1 : 0 ))
-all_targets=(candump_line candump_reader dbc_parser frame_intake daemon_config)
+all_targets=(candump_line candump_reader dbc_parser frame_intake daemon_config asc_reader csv_reader)
 if (( $# > 0 )); then targets=("$@"); else targets=("${all_targets[@]}"); fi
 build=${FUZZ_BUILD_DIR:-$repo/build-fuzz}
 jobs=${FUZZ_JOBS:-$(nproc)}
@@ -65,6 +65,8 @@ dict_for() {
     candump_line|candump_reader|frame_intake) echo "$repo/tests/fuzz/dict/candump.dict" ;;
     dbc_parser) echo "$repo/tests/fuzz/dict/dbc.dict" ;;
     daemon_config) echo "$repo/tests/fuzz/dict/toml.dict" ;;
+    asc_reader) echo "$repo/tests/fuzz/dict/asc.dict" ;;
+    csv_reader) echo "$repo/tests/fuzz/dict/csv.dict" ;;
   esac
 }
 

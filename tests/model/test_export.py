@@ -80,11 +80,11 @@ def main():
         seed_comp = json.load(f)["position_error"]["compensated_moving"]["rms_rad"]
     check(seed_comp > 3 * bound, f"control: the seed model's table leaves {seed_comp:.3g} rad > 3 x the bound")
     # Other formats.
-    js = json.loads(run([f"{b}/resolver-model", "export", log, "--effects", effects, "--format", "json",
+    js = json.loads(run([f"{b}/resolver-model", "export", log, "--effects", effects, "--table-format", "json",
                          "--points", "256"]).stdout)
     check(len(js["correction_rad"]) == 256 and js["p_r"] == 3, "JSON export loads with 256 points and p_r")
     hdr = os.path.join(w, "cal.h")
-    run([f"{b}/resolver-model", "export", log, "--effects", effects, "--format", "c-header", "--points", "64",
+    run([f"{b}/resolver-model", "export", log, "--effects", effects, "--table-format", "c-header", "--points", "64",
          "--out", hdr])
     src = os.path.join(w, "use.c")
     with open(src, "w") as f:

@@ -362,8 +362,10 @@ def check_scenario(c, s, out, msgs, facts, inputs, summary):
                 f"frames_seen {last['frames_seen']} == {sent} data + {err_bus} error frames")
         c.check(s, last["bus_errors"] == err_bus, f"bus_errors {last['bus_errors']} == error frames candump received {err_bus}")
         c.check(s, r.get("network_down", 0) >= 1, f"network_down counted across the split sockets ({r})")
-        # sample_clock_reanchored: the 1.5 s pause of the flap, as in linkflap.
-        c.check(s, set(r) <= {"network_down", "sample_clock_reanchored"},
+        # The 1.5 s pause of the flap, as in linkflap: the sender stops and its counter goes on
+        # where it stopped, so the sample clock reads a timestamp_jump (time continues from the
+        # counter); sample_clock_reanchored if frames were lost across it too.
+        c.check(s, set(r) <= {"network_down", "sample_clock_reanchored", "timestamp_jump"},
                 f"no other rejects: frames in order, none completed a sample from the quiet socket ({r})")
         c.check(s, len(angles) == inputs["samples"], f"angle_t {len(angles)} == samples {inputs['samples']}")
     elif s == "wakechange":

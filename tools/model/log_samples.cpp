@@ -1,75 +1,93 @@
 #include "tools/model/log_samples.h"
 
+#include <cmath>
+#include <map>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
+#include "daemon/app/log_input.h"
 #include "daemon/app/pipeline.h"
-#include "daemon/decode/frame_intake.h"
-#include "daemon/decode/signal_map.h"
-#include "drivers/candump/candump_reader.h"
+#include "daemon/decode/sample_stream.h"
 
 namespace resolver {
 
 LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
-                            const DaemonConfig& config) {
+                            const DaemonConfig& config, const LogReadOptions& options) {
   LogSamples out;
   out.input.p_r = config.bench.p_r;
   out.input.p = config.bench.p;
-  CandumpReader reader(path);  // throws "cannot open <path>: <strerror>"
-  std::int64_t first_us = -1;
-  FrameIntake intake(make_frame_decoder(config), config.max_counter_delta,
-                     FrameIntake::Callbacks{
-                         [&](const BenchSample& s) {
-                           if (first_us < 0) first_us = s.timestamp_us;
-                           Sample d;
-                           d.t = static_cast<double>(s.timestamp_us - first_us) * 1e-6;
-                           d.has_rd = s.has(Role::kRdAngle);
-                           d.theta_rd = s.get(Role::kRdAngle);
-                           d.has_sincos = s.has(Role::kSin) && s.has(Role::kCos);
-                           d.sin = s.get(Role::kSin);
-                           d.cos = s.get(Role::kCos);
-                           d.has_ref = s.has(Role::kRefAngle);
-                           d.theta_m_ref = s.get(Role::kRefAngle);
-                           d.has_currents = s.has(Role::kIA) && s.has(Role::kIB) && s.has(Role::kIC);
-                           d.i_a = s.get(Role::kIA);
-                           d.i_b = s.get(Role::kIB);
-                           d.i_c = s.get(Role::kIC);
-                           out.input.samples.push_back(d);
-                         },
-                         [&](const BenchInfo& i) {
-                           if (config.bench.use_bench_info && i.p_r >= 1 && i.p >= 1) {
-                             out.input.p_r = i.p_r;
-                             out.input.p = i.p;
-                             out.bench_info = true;
-                           }
-                         },
-                         [&](std::string_view, const std::string&) { ++out.problems; }});
-  CanFrame frame;
+  const LogFormat format = resolve_log_format(path, options.format, config);
+  const std::unique_ptr<LogInput> reader = open_log_input(path, format, config);  // throws "cannot open <path>: ..."
+  const auto decoder = make_frame_decoder(config);
+  std::map<std::string, std::int64_t, std::less<>> problem_counts;
+  SampleStream stream(decoder, sample_stream_config(config, options.slice),
+                      SampleStream::Callbacks{
+                          [&](const Sample& s, std::uint8_t) { out.input.samples.push_back(s); },
+                          [&](const BenchInfo& i) {
+                            if (config.bench.use_bench_info && i.p_r >= 1 && i.p >= 1) {
+                              out.input.p_r = i.p_r;
+                              out.input.p = i.p;
+                              out.bench_info = true;
+                            }
+                          },
+                          [&](std::string_view reason, const std::string&) {
+                            ++out.problems;
+                            ++problem_counts[std::string(reason)];
+                          }});
+  LogRecord record;
   std::int64_t since_progress = 0;
-  for (;;) {
-    const auto st = reader.next(frame);
-    if (st == CandumpReader::Status::kEnd) break;
-    if (st == CandumpReader::Status::kBadLine) {
+  while (!stream.past_slice_end()) {
+    const auto st = reader->next(record);
+    if (st == LogInput::Status::kEnd) break;
+    if (st == LogInput::Status::kBadLine) {
       ++out.bad_lines;
       continue;
     }
     ++out.frames;
-    intake.feed(frame, reader.line_number());
-    if (progress && ++since_progress >= 20000 && reader.total_bytes() > 0) {
+    if (record.is_row) {
+      stream.feed_row(record.row, reader->line_number());
+    } else {
+      stream.feed(record.frame, reader->line_number());
+    }
+    if (progress && ++since_progress >= 20000 && reader->total_bytes() > 0) {
       since_progress = 0;
-      progress(static_cast<double>(reader.bytes_read()) / static_cast<double>(reader.total_bytes()));
+      progress(static_cast<double>(reader->bytes_read()) / static_cast<double>(reader->total_bytes()));
     }
   }
-  intake.flush();
+  stream.flush();
+  out.outside_slice = stream.samples_outside_slice();
   if (progress) progress(1.0);
   if (out.input.samples.empty()) {
-    throw std::runtime_error(path + ": no samples: " + std::to_string(out.frames) + " frames, " +
-                             std::to_string(out.bad_lines) +
-                             " bad lines, none decoded as the default bench layout (RESOLVER_SAMPLE 0x100 ...)");
+    if (options.slice.limited() && out.outside_slice > 0) {
+      const std::string to = std::isfinite(options.slice.to_s) ? fmt::format(" to --to {} s", options.slice.to_s) : "";
+      throw std::runtime_error(fmt::format("{}: no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
+                                           path, options.slice.from_s, to, out.outside_slice,
+                                           stream.clock().last_t()));
+    }
+    const std::string layout = format == LogFormat::kCsv ? "the [input.csv] column map of " + config.source
+                                                         : describe_layout(config, *decoder);
+    throw std::runtime_error(fmt::format("{}: no samples: {} {} read as {}, {} bad lines, none decoded with {}", path,
+                                         out.frames, format == LogFormat::kCsv ? "rows" : "frames",
+                                         log_format_name(format), out.bad_lines, layout));
   }
   if (!out.bench_info) {
     out.notes.push_back("p_r = " + std::to_string(out.input.p_r) + ", p = " + std::to_string(out.input.p) + " from " +
                         (config.source.empty() ? std::string("the defaults") : config.source) +
                         (config.bench.use_bench_info ? " (no BENCH_INFO frame in the log)" : " (use_bench_info = false)"));
+  }
+  for (const char* odd : {"timestamp_step_back", "timestamp_jump", "sample_clock_reanchored"}) {
+    const auto it = problem_counts.find(odd);
+    if (it != problem_counts.end()) {
+      out.notes.push_back(fmt::format("{}: {} (the sample clock re-anchored; every sample after it used)", odd, it->second));
+    }
+  }
+  if (const auto it = problem_counts.find("sample_gap"); it != problem_counts.end()) {
+    out.notes.push_back(fmt::format("sample_gap: {} (samples missing from the recording, found from time)", it->second));
+  }
+  if (options.slice.limited()) {
+    out.notes.push_back(fmt::format("slice {} s .. {} s: {} samples used, {} outside", options.slice.from_s,
+                                    options.slice.to_s, out.input.samples.size(), out.outside_slice));
   }
   return out;
 }

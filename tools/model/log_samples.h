@@ -1,34 +1,47 @@
-// A candump log as model-discovery samples: CandumpReader -> FrameIntake (the
-// resolverd config's DBC and signal map: by default the built-in DBC and the
-// default bench layout) -> DiscoverySample per joined sample. p_r, p come from
-// BENCH_INFO when the log has it (unless the config says use_bench_info = false),
-// else the config's [bench] values, and a note says so.
+// A log as model-discovery samples, through the same input path as resolverd:
+// LogInput (candump, Vector ASC or CSV; daemon/app/log_input.h) -> SampleStream
+// (the config's DBC and signal map or CSV column map, units, joining, the
+// sample clock and the slice; daemon/decode/sample_stream.h) -> Sample. So
+// resolver-model fits exactly the samples, at exactly the times, that
+// resolverd's processor gets. p_r, p come from BENCH_INFO when the log has it
+// (unless the config says use_bench_info = false), else the config's [bench]
+// values, and a note says so.
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "daemon/app/daemon_config.h"
 #include "daemon/core/discovery/model_discovery.h"
+#include "daemon/decode/sample_slice.h"
 
 namespace resolver {
 
 struct LogSamples {
   DiscoveryInput input;
-  std::int64_t frames = 0;
+  std::int64_t frames = 0;         ///< frames (or CSV rows) read
   std::int64_t bad_lines = 0;
-  std::int64_t problems = 0;       ///< decode problems (CRC, counters, ...)
+  std::int64_t problems = 0;       ///< decode problems (CRC, counters, odd time, ...)
+  std::int64_t outside_slice = 0;  ///< samples before --from or after --to
   bool bench_info = false;
-  std::vector<std::string> notes;  ///< what the log lacks
+  std::vector<std::string> notes;  ///< what the log lacks, what was odd
+};
+
+struct LogReadOptions {
+  std::optional<LogFormat> format;  ///< --format; nullopt: [input] format, else the extension
+  SampleSlice slice;                ///< --from/--to [s]
 };
 
 /// Reads `path`. progress(fraction of the file's bytes) is called now and then
 /// (may be empty). Throws std::runtime_error "cannot open <path>: ..." when the
-/// file cannot be read, "<path>: no samples ..." when nothing decodes, and
-/// ConfigError when the config's DBC or signal map is bad.
+/// file cannot be read, "<path>: no samples ..." (naming the layout in use) when
+/// nothing decodes, and ConfigError when the config's DBC, signal map or CSV
+/// column map is bad.
 [[nodiscard]] LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
-                                          const DaemonConfig& config = DaemonConfig{});
+                                          const DaemonConfig& config = DaemonConfig{},
+                                          const LogReadOptions& options = {});
 
 }  // namespace resolver

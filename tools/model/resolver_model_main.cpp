@@ -4,8 +4,9 @@
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
 //   resolver-model export-data LOG [--effects a,b] --csv OUT.csv | --mat OUT.mat
 // All take --config FILE: a resolverd config whose [layout] (DBC, signal map),
-// [bench] pole pairs and [model] effects apply (logs of a user's own layout).
-// Reads the log (default bench layout), fits the named catalog effects
+// [input.csv] column map, [bench] pole pairs and [model] effects apply (logs of
+// a user's own layout, scope exports), --format candump|asc|csv and --from/--to [s].
+// Reads the log through resolverd's input path (tools/model/log_samples.h), fits the named catalog effects
 // (default amplitude_imbalance), prints residuals against the noise floor and,
 // for explain, the ranked missing effects and a verdict; report runs the
 // discovery loop to its verdict and writes one self-contained HTML page of it.
@@ -152,11 +153,13 @@ int run(int argc, char** argv) {
   std::string log;
   std::vector<std::string> effects_args;
   std::string config_path;
+  std::string format_name;
+  resolver::SampleSlice slice;
   bool json = false;
   std::string fittable;
   for (auto e : resolver::fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(e);
   auto add_common = [&](CLI::App* sub) {
-    sub->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+    sub->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
     sub->add_option("--effects", effects_args,
                     "the model: comma-separated effect references, an effect by name (its default parameters) or "
                     "with a parameter list, e.g. amplitude_imbalance,harmonics(k5,k3_opp),delay; catalog effects or "
@@ -176,8 +179,16 @@ int run(int argc, char** argv) {
   };
   auto add_config = [&](CLI::App* sub) {
     sub->add_option("--config", config_path,
-                    "resolverd config (TOML): its [layout] DBC and signals decode the log, [bench] p_r/p apply "
-                    "without BENCH_INFO, [model] effects is the model when --effects is not given");
+                    "resolverd config (TOML): its [layout] DBC and signals decode the log ([input.csv] a CSV), "
+                    "[bench] p_r/p apply without BENCH_INFO, [model] effects is the model when --effects is not given");
+    sub->add_option("--format", format_name,
+                    "log format: candump, asc (Vector ASC) or csv (scope export, needs [input.csv] in --config); "
+                    "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
+        ->check(CLI::IsMember({"candump", "asc", "csv"}));
+    sub->add_option("--from", slice.from_s, "use samples from this time on [s, 0 = the log's first sample]")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--to", slice.to_s, "use samples up to this time [s, from the log's first sample]")
+        ->check(CLI::NonNegativeNumber);
   };
   CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
@@ -187,7 +198,7 @@ int run(int argc, char** argv) {
       "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
   std::string html_out;
   int max_steps = 6;
-  report->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+  report->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
   report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)");
   report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
   report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
@@ -195,7 +206,7 @@ int run(int argc, char** argv) {
       "export-data", "write the log's samples, the fitted model's prediction and residual per sample, and the "
                      "parameters with units: CSV (MATLAB readtable, pandas) and/or MATLAB .mat");
   std::string csv_out, mat_out;
-  export_data->add_option("LOG", log, "candump -l log of the default bench layout")->required();
+  export_data->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
   export_data->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
   export_data->add_option("--csv", csv_out, "CSV of the samples [one header line, units in the column names]; the "
                                             "parameters go to OUT's stem + .params.csv");
@@ -214,7 +225,7 @@ int run(int argc, char** argv) {
   int export_points = 1024;
   exporter->add_option("LOG", log, "the log to fit (as for fit)")->required();
   exporter->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
-  exporter->add_option("--format", export_format, "csv (default), json or c-header")
+  exporter->add_option("--table-format", export_format, "the table's format: csv (default), json or c-header")
       ->check(CLI::IsMember({"csv", "json", "c-header"}));
   exporter->add_option("--points", export_points, "table points over one mechanical revolution (default 1024)")
       ->check(CLI::Range(8, 1 << 20));
@@ -223,6 +234,10 @@ int run(int argc, char** argv) {
   add_slicing(exporter);
   add_slicing(export_data);
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
+  if (slice.to_s < slice.from_s) {
+    std::cerr << "resolver-model: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
+    return resolver::exit_code::kUsage;
+  }
   for (const auto& [option, path] : {std::pair{"LOG", log}, std::pair{"--config", config_path}}) {
     if (path.empty()) continue;
     if (auto problem = resolver::exit_code::unreadable(option, path)) {
@@ -244,7 +259,10 @@ int run(int argc, char** argv) {
     resolver::LogSamples samples;
     {
       ProgressBar bar("reading " + log);
-      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config);
+      resolver::LogReadOptions read_options;
+      read_options.format = resolver::log_format_from_name(format_name);
+      read_options.slice = slice;
+      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config, read_options);
     }
     resolver::DiscoveryOptions options;
     options.customs = config.model.customs.get();  // the config's [[model.custom]] effects

@@ -91,8 +91,12 @@ namespace {
 double radius(const Sample& s) { return std::sqrt(s.sin * s.sin + s.cos * s.cos); }
 }  // namespace
 
+double SignalHealthMonitor::level_reference() const {
+  return config_.full_scale > 0.0 ? config_.full_scale : peak_block_amplitude_;
+}
+
 bool SignalHealthMonitor::sincos_lost(const Sample& s) const {
-  return s.has_sincos && radius(s) < config_.loss_of_signal_fraction * config_.full_scale;
+  return s.has_sincos && radius(s) < config_.loss_of_signal_fraction * level_reference();
 }
 
 AmplitudeStats SignalHealthMonitor::take_amplitude_window() {
@@ -224,13 +228,13 @@ void SignalHealthMonitor::add(const Sample& s) {
     amplitude_total_.add(r);
     block_.r_all.add(r);
     const double clip_at = config_.full_scale - config_.clip_margin;
-    if (std::abs(s.sin) >= clip_at || std::abs(s.cos) >= clip_at) {
+    if (config_.full_scale > 0.0 && (std::abs(s.sin) >= clip_at || std::abs(s.cos) >= clip_at)) {
       if (block_.clipped++ == 0) {
         block_.clipped_t = s.t;
         block_.clipped_index = s.index;
       }
     }
-    sincos_usable = r >= config_.loss_of_signal_fraction * config_.full_scale;  // as sincos_lost()
+    sincos_usable = r >= config_.loss_of_signal_fraction * level_reference();  // as sincos_lost()
     if (sincos_usable) {
       sincos_angle = std::atan2(s.sin, s.cos);
       if (is_outlier(s, r, sincos_angle)) {
@@ -277,28 +281,36 @@ void SignalHealthMonitor::set_fault(SignalFault f, bool present, std::int64_t sa
 
 void SignalHealthMonitor::evaluate_block() {
   Block& b = block_;
-  const double fs = config_.full_scale;
+  // Full scale unknown (a CSV export in volts): the levels are judged against the
+  // largest block amplitude seen so far, and the absolute ones (too low, no
+  // headroom, clipping) cannot be judged at all.
+  const bool fs_known = config_.full_scale > 0.0;
+  const double fs = level_reference();
   const double t0 = b.t_first;
   const std::int64_t i0 = b.index_first;
 
   // LOS, DOS and LOT are known only from blocks with sin/cos; without them they keep their state.
   bool lost = fault(SignalFault::kLossOfSignal).active;
-  if (b.r_all.n > 0) {
+  if (b.r_all.n > 0 && fs > 0.0) {
     const double level = config_.loss_of_signal_fraction * fs;
     lost = b.r_all.mean() < level;
     set_fault(SignalFault::kLossOfSignal, lost, b.n, t0, i0,
-              fmt::format("sin/cos amplitude {:.1f} (mean over the block), below {:.0f} = {:g} % of full scale {:.0f}: "
-                          "no excitation, or both channels open",
-                          b.r_all.mean(), level, 100.0 * config_.loss_of_signal_fraction, fs));
+              fs_known ? fmt::format("sin/cos amplitude {:.1f} (mean over the block), below {:.0f} = {:g} % of full "
+                                     "scale {:.0f}: no excitation, or both channels open",
+                                     b.r_all.mean(), level, 100.0 * config_.loss_of_signal_fraction, fs)
+                       : fmt::format("sin/cos amplitude {:.4g} (mean over the block), below {:.4g} = {:g} % of the "
+                                     "largest block amplitude so far ({:.4g}; full scale unknown): no excitation, "
+                                     "or both channels open",
+                                     b.r_all.mean(), level, 100.0 * config_.loss_of_signal_fraction, fs));
   }
   if (b.r_clean.n > 0 && !lost) {
     const double mean = b.r_clean.mean();
     const double swing = (b.r_clean.max - b.r_clean.min) / mean;
     std::string why;
-    if (mean < config_.degradation_low_fraction * fs) {
+    if (fs_known && mean < config_.degradation_low_fraction * fs) {
       why = fmt::format("sin/cos amplitude {:.0f}, below {:g} % of full scale {:.0f}", mean,
                         100.0 * config_.degradation_low_fraction, fs);
-    } else if (mean > config_.degradation_high_fraction * fs) {
+    } else if (fs_known && mean > config_.degradation_high_fraction * fs) {
       why = fmt::format("sin/cos amplitude {:.0f}, above {:g} % of full scale {:.0f} (no headroom)", mean,
                         100.0 * config_.degradation_high_fraction, fs);
     } else if (swing > config_.degradation_mismatch) {
@@ -307,6 +319,7 @@ void SignalHealthMonitor::evaluate_block() {
                         b.r_clean.min, b.r_clean.max, 100.0 * swing, 100.0 * config_.degradation_mismatch);
     }
     set_fault(SignalFault::kDegradationOfSignal, !why.empty(), b.n, t0, i0, why);
+    peak_block_amplitude_ = std::max(peak_block_amplitude_, mean);
   } else if (lost) {
     set_fault(SignalFault::kDegradationOfSignal, false, 0, t0, i0, {});  // LOS says more
   }

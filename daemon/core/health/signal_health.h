@@ -53,7 +53,9 @@ inline constexpr std::size_t kSignalFaultCount = 7;
 /// Thresholds. Defaults come from the physics of a 16-bit ADC bench; each says where from.
 struct SignalHealthConfig {
   /// [signal units, counts on the default layout] the largest |sin| or |cos| the ADC can
-  /// report; the caller takes it from the DBC signal's range (daemon/app).
+  /// report; the caller takes it from the DBC signal's range (daemon/app). 0 = unknown
+  /// (a CSV export in volts): loss of signal is then judged against the largest block
+  /// amplitude seen so far, and low level, headroom and clipping are not judged.
   double full_scale = 32767.0;
   /// [signal units] a sample within this of +-full_scale is clipped: half an ADC count.
   double clip_margin = 0.5;
@@ -163,6 +165,11 @@ class SignalHealthMonitor {
   SignalHealthMonitor(const SignalHealthConfig& config, int p_r, double sample_rate_hz);
 
   void set_pole_pairs(int p_r) { p_r_ = p_r; }
+  /// The input's full scale (0 = unknown) and clip margin, once the input is known.
+  void set_full_scale(double full_scale, double clip_margin) {
+    config_.full_scale = full_scale;
+    config_.clip_margin = clip_margin;
+  }
   void set_sample_rate(double hz) { sample_rate_hz_ = hz; }
 
   /// One sample. Cannot fail; samples without sin/cos or angles only move what they can.
@@ -175,6 +182,9 @@ class SignalHealthMonitor {
   /// True when this sample's sin/cos amplitude is too small for an angle (below the LOS
   /// level): atan2 of it is noise and must be published as NaN, not as an angle.
   [[nodiscard]] bool sincos_lost(const Sample& s) const;
+  /// The amplitude loss of signal is measured against: full scale, or without one the
+  /// largest clean block amplitude so far (0 before the first block: nothing is lost).
+  [[nodiscard]] double level_reference() const;
 
   [[nodiscard]] const std::array<SignalFaultState, kSignalFaultCount>& faults() const { return faults_; }
   [[nodiscard]] const SignalFaultState& fault(SignalFault f) const { return faults_[static_cast<std::size_t>(f)]; }
@@ -218,6 +228,7 @@ class SignalHealthMonitor {
   std::vector<SignalFaultEvent> events_;
   AmplitudeStats amplitude_window_;
   AmplitudeStats amplitude_total_;
+  double peak_block_amplitude_ = 0.0;  ///< largest clean block mean so far (the reference without a full scale)
   std::int64_t samples_ = 0;
   Block block_;
   bool have_grid_ = false;

@@ -152,5 +152,75 @@ TEST(DaemonConfig, MissingFileSaysSo) {
   }
 }
 
+TEST(DaemonConfig, CsvScopeExportColumnMap) {
+  const DaemonConfig c = parse_daemon_config(R"(
+[input]
+format = "csv"
+[input.csv]
+delimiter = ";"
+decimal = ","
+header_lines = 5
+time_column = "Time"
+time_unit = "filetime"
+[input.csv.columns]
+rd_angle = { column = "Resolver", unit = "deg" }
+ref_angle = { column = 3, unit = "counts", full_scale = 65536, divide = 21 }
+i_a = { column = "Ia", unit = "mA", scale = 2.0, offset = -1.0 }
+)", "scope.toml");
+  EXPECT_EQ(c.input_format, LogFormat::kCsv);
+  EXPECT_EQ(c.csv.format.delimiter, CsvFormat::Delimiter::kSemicolon);
+  EXPECT_EQ(c.csv.format.decimal, ',');
+  EXPECT_EQ(c.csv.format.header_lines, 5);
+  ASSERT_TRUE(c.csv.map.time);
+  EXPECT_EQ(c.csv.map.time->name, "Time");
+  EXPECT_EQ(c.csv.map.time_unit, TimeUnit::kFiletime);
+  const auto& rd = c.csv.map.roles[static_cast<std::size_t>(Role::kRdAngle)];
+  ASSERT_TRUE(rd);
+  EXPECT_DOUBLE_EQ(rd->to_role_unit, 3.14159265358979323846 / 180.0);
+  const auto& ref = c.csv.map.roles[static_cast<std::size_t>(Role::kRefAngle)];
+  ASSERT_TRUE(ref);
+  EXPECT_EQ(ref->column.index, 3);
+  EXPECT_DOUBLE_EQ(ref->to_role_unit, 2.0 * 3.14159265358979323846 / 65536.0);
+  EXPECT_DOUBLE_EQ(ref->divide, 21.0);
+  const auto& ia = c.csv.map.roles[static_cast<std::size_t>(Role::kIA)];
+  ASSERT_TRUE(ia);
+  EXPECT_DOUBLE_EQ(ia->to_role_unit, 1e-3);
+  EXPECT_DOUBLE_EQ(ia->scale, 2.0);
+  EXPECT_DOUBLE_EQ(ia->offset, -1.0);
+}
+
+TEST(DaemonConfig, CsvMistakesAreNamed) {
+  const std::string base = "[input.csv]\ntime_column = \"t\"\n[input.csv.columns]\n";
+  EXPECT_NE(error_of(base + "rd_angle = { column = \"R\" }\n").find("rd_angle: unit \"\" is not an angle unit; one of: rad, deg"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "rd_angle = { column = \"R\", unit = \"counts\" }\n").find("needs full_scale"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "i_a = { column = \"I\", unit = \"kA\" }\nrd_angle = { column = \"R\", unit = \"rad\" }\n")
+                .find("i_a: unit \"kA\" is not a current unit; one of: A, mA"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "sin = { column = \"S\", divide = 2 }\n").find("for rd_angle and ref_angle only"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "sin = { column = \"S\" }\n").find("needs rd_angle, or both sin and cos"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "speed = { column = \"S\" }\n").find("unknown role 'speed'"), std::string::npos);
+  EXPECT_NE(error_of("[input.csv]\n[input.csv.columns]\nrd_angle = { column = 2, unit = \"rad\" }\n")
+                .find("no time_column: set row_rate_hz"),
+            std::string::npos);
+  EXPECT_NE(error_of("[input.csv]\ncolumn_names = false\ntime_column = \"t\"\n").find("give its 1-based index"),
+            std::string::npos);
+  EXPECT_NE(error_of("[input.csv]\ndecimal = \",\"\ndelimiter = \",\"\n").find("cannot be told apart"),
+            std::string::npos);
+  EXPECT_NE(error_of("[input.csv]\ntime_unit = \"min\"\n").find("\"filetime\""), std::string::npos);
+  EXPECT_NE(error_of("[input]\nformat = \"blf\"\n").find("\"asc\""), std::string::npos);
+}
+
+TEST(DaemonConfig, LogFormatFromTheExtension) {
+  EXPECT_EQ(log_format_for_path("a/b.log"), LogFormat::kCandump);
+  EXPECT_EQ(log_format_for_path("b.ASC"), LogFormat::kAsc);
+  EXPECT_EQ(log_format_for_path("scope.csv"), LogFormat::kCsv);
+  EXPECT_EQ(log_format_for_path("optical_encoder_ab.txt"), LogFormat::kCsv);
+  EXPECT_EQ(log_format_for_path("dir.csv/noext"), LogFormat::kCandump);
+}
+
 }  // namespace
 }  // namespace resolver

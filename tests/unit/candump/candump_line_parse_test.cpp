@@ -207,7 +207,7 @@ TEST(CandumpLineParse, CounterNamesAreStableAndDistinct) {
   EXPECT_EQ(to_string(LogLineError::kBadHex), "bad_hex");
   EXPECT_EQ(to_string(LogLineError::kOddNibbles), "odd_nibbles");
   EXPECT_EQ(to_string(LogLineError::kTooLong), "dlc_too_long");
-  EXPECT_EQ(to_string(LogLineError::kNonMonotonicTimestamp), "non_monotonic_timestamp");
+  EXPECT_EQ(to_string(LogLineError::kLineTooLong), "line_too_long");
   EXPECT_EQ(to_string(LogLineError::kMissingTimestamp), "missing_timestamp");
 }
 

@@ -131,6 +131,44 @@ TEST(SignalHealth, LossOfSignalInTheMiddleStartsAndEndsOnce) {
   EXPECT_FALSE(los.active_at_end);
 }
 
+// A CSV export in volts has no DBC range (full_scale = 0): a signal that dies
+// mid-run is still a loss of signal, judged against the amplitude it had, and
+// the absolute levels (weak, no headroom, clipping) are not judged at all.
+TEST(SignalHealth, UnknownFullScaleJudgesLossAgainstTheAmplitudeSeen) {
+  SignalHealthConfig unknown;
+  unknown.full_scale = 0.0;
+  Bench volts;
+  volts.amplitude = 1.2;  // [V] a scope channel; with a 16-bit full scale this would be "no signal"
+  volts.noise = 0.0005;   // [V] 0.5 mV scope noise
+  volts.seconds = 3.0;
+  auto damaged = volts;
+  damaged.damage = [](std::int64_t k, double, Sample& s) {
+    if (k >= 4000) s.sin = s.cos = 0.0;  // dead from t = 2 s
+  };
+  // make_samples rounds to ADC counts: undo it for volts.
+  auto in_volts = [](Bench b) {
+    std::mt19937 rng(3);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    auto damage = b.damage;
+    b.damage = [&, damage, b](std::int64_t k, double theta, Sample& s) {
+      s.sin = b.amplitude * std::sin(theta) + b.noise * noise(rng);
+      s.cos = b.amplitude * std::cos(theta) + b.noise * noise(rng);
+      if (damage) damage(k, theta, s);
+    };
+    return make_samples(b);
+  };
+  const SignalHealthSummary clean = summarize_signal_health(in_volts(volts), unknown, kPr, kRate);
+  EXPECT_TRUE(seen(clean).empty()) << clean.describe();
+  // Control: the same volts against the 16-bit default full scale read as a dead signal.
+  const SignalHealthSummary wrong = summarize_signal_health(in_volts(volts), {}, kPr, kRate);
+  EXPECT_EQ(wrong.fault(SignalFault::kLossOfSignal).share, 1.0) << wrong.describe();
+  const SignalHealthSummary dead = summarize_signal_health(in_volts(damaged), unknown, kPr, kRate);
+  const auto& los = dead.fault(SignalFault::kLossOfSignal);
+  EXPECT_EQ(los.samples, 2000) << dead.describe();  // blocks of 200 line up with sample 4000
+  EXPECT_EQ(los.episodes, 1);
+  EXPECT_EQ(dead.fault(SignalFault::kClipping).samples, 0);
+}
+
 TEST(SignalHealth, OneOpenChannelIsDegradationNotLoss) {
   Bench b;
   b.damage = [](std::int64_t, double, Sample& s) { s.sin = 0.0; };

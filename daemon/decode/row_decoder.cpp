@@ -1,0 +1,124 @@
+#include "daemon/decode/row_decoder.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "drivers/csv/csv_number.h"
+
+namespace resolver {
+
+namespace {
+
+// Windows FILETIME epoch (1601-01-01) to Unix epoch (1970-01-01) [us]: 369 years
+// with 89 leap days = 134774 days = 11644473600 s (Microsoft's documented constant).
+constexpr std::int64_t kFiletimeToUnixUs = 11'644'473'600'000'000;
+
+int time_scale_exp10(TimeUnit unit) {
+  switch (unit) {
+    case TimeUnit::kSeconds: return 6;
+    case TimeUnit::kMilliseconds: return 3;
+    case TimeUnit::kMicroseconds: return 0;
+    case TimeUnit::kFiletime: return -1;  // 100 ns ticks
+  }
+  return 6;
+}
+
+bool is_angle(Role r) { return r == Role::kRdAngle || r == Role::kRefAngle; }
+
+}  // namespace
+
+std::string ColumnRef::describe() const {
+  return name.empty() ? "column " + std::to_string(index) : "column '" + name + "'";
+}
+
+bool RowMap::empty() const {
+  for (const auto& r : roles) {
+    if (r) return false;
+  }
+  return true;
+}
+
+double csv_sincos_full_scale(const RowMap& map) {
+  const auto& s = map.roles[static_cast<std::size_t>(Role::kSin)];
+  const auto& c = map.roles[static_cast<std::size_t>(Role::kCos)];
+  if (!s || !c || !(s->full_scale > 0.0) || !(c->full_scale > 0.0)) return 0.0;
+  return std::min(s->full_scale, c->full_scale);
+}
+
+std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& names) {
+  std::string missing;
+  auto resolve = [&](const ColumnRef& ref, const std::string& what) -> std::optional<Bound> {
+    if (ref.name.empty()) return Bound{static_cast<std::size_t>(ref.index - 1)};
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i] == ref.name) return Bound{i};
+    }
+    missing += (missing.empty() ? "" : "; ") + what + ": no column named '" + ref.name + "'";
+    return std::nullopt;
+  };
+  if (map_.time) time_ = resolve(*map_.time, "time_column");
+  for (std::size_t r = 0; r < kRoleCount; ++r) {
+    if (map_.roles[r]) roles_[r] = resolve(map_.roles[r]->column, std::string(role_name(static_cast<Role>(r))));
+  }
+  if (missing.empty()) return std::nullopt;
+  std::string have;
+  for (const std::string& n : names) have += (have.empty() ? "'" : ", '") + n + "'";
+  return missing + (names.empty() ? std::string(" (the export has no column-name line: set column_names = true, or name "
+                                                "columns by their 1-based index)")
+                                  : " (the columns are " + have + ")");
+}
+
+std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, RowSample& out) {
+  out = RowSample{};
+  out.sequence = sequence_++;
+  auto field = [&](const Bound& b, const ColumnRef& ref, std::string_view& text) -> std::optional<TextProblem> {
+    if (b.field >= row.fields.size()) {
+      return TextProblem{"missing_column", row.end_column,
+                         fmt::format("the row has {} fields, {} is field {}", row.fields.size(), ref.describe(),
+                                     b.field + 1)};
+    }
+    text = row.fields[b.field];
+    return std::nullopt;
+  };
+  if (time_) {
+    std::string_view text;
+    if (auto p = field(*time_, *map_.time, text)) return p;
+    const auto t = parse_csv_scaled_integer(text, decimal, time_scale_exp10(map_.time_unit));
+    if (!t || (map_.time_unit == TimeUnit::kFiletime && *t < 0)) {
+      return TextProblem{"bad_number", row.columns[time_->field],
+                         fmt::format("{} (time): expected a number with '{}' as decimal mark, found '{}'",
+                                     map_.time->describe(), decimal, text.substr(0, 40))};
+    }
+    out.has_time = true;
+    out.time_us = map_.time_unit == TimeUnit::kFiletime ? *t - kFiletimeToUnixUs : *t;
+  }
+  std::array<double, kRoleCount> raw{};
+  for (std::size_t r = 0; r < kRoleCount; ++r) {
+    if (!roles_[r]) continue;
+    const RowRole& role = *map_.roles[r];
+    std::string_view text;
+    if (auto p = field(*roles_[r], role.column, text)) return p;
+    const auto v = parse_csv_number(text, decimal);
+    if (!v) {
+      return TextProblem{"bad_number", row.columns[roles_[r]->field],
+                         fmt::format("{} ({}): expected a number with '{}' as decimal mark, found '{}'",
+                                     role.column.describe(), role_name(static_cast<Role>(r)), decimal,
+                                     text.substr(0, 40))};
+    }
+    raw[r] = (*v * role.scale + role.offset) * role.to_role_unit;
+  }
+  // Only a whole row moves the unwrapping state.
+  for (std::size_t r = 0; r < kRoleCount; ++r) {
+    if (!roles_[r]) continue;
+    double value = raw[r];
+    if (is_angle(static_cast<Role>(r))) {
+      const double divide = map_.roles[r]->divide;
+      value = divide != 1.0 ? wrap_2pi(unwrap_[r].update(wrap_2pi(value)) / divide) : wrap_2pi(value);
+    }
+    out.values[r] = value;
+    out.roles = static_cast<std::uint16_t>(out.roles | role_bit(static_cast<Role>(r)));
+  }
+  return std::nullopt;
+}
+
+}  // namespace resolver

@@ -1,0 +1,91 @@
+// A CSV / scope export row -> RowSample, through a column map ([input.csv] in
+// resolverd's config): which column holds the time and in which unit, which
+// column holds each role and in which unit.
+//
+//   time      "s", "ms", "us", or "filetime" (Windows: 100 ns ticks since
+//             1601-01-01, converted exactly to us since the Unix epoch); no time
+//             column: rows are evenly spaced at row_rate_hz
+//   angles    "rad", "deg", "rev" (signal_units.h) or "counts" with full_scale
+//             counts per revolution; value = (raw * scale + offset) in that unit,
+//             then radians in [0, 2pi). `divide = N` unwraps the column first and
+//             divides it by N: an electrical angle of an N-pole-pair motor
+//             becomes the mechanical one.
+//   currents  "A" or "mA", after scale and offset
+//   sin, cos  raw * scale + offset, any consistent unit
+//
+// Every row yields a sample or a problem (bad_number, missing_column) naming
+// the column; rows with odd times are the sample clock's business (it counts
+// and re-anchors them, sample_clock.h). Pure: no I/O.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "daemon/core/angles.h"
+#include "daemon/decode/row_sample.h"
+#include "drivers/csv/csv_reader.h"
+#include "drivers/text/text_problem.h"
+
+namespace resolver {
+
+/// A column by name (as the column-name line writes it) or 1-based index.
+struct ColumnRef {
+  std::string name;  ///< "" = by index
+  int index = 0;     ///< 1-based; 0 = by name
+  [[nodiscard]] std::string describe() const;
+};
+
+enum class TimeUnit : std::uint8_t { kSeconds, kMilliseconds, kMicroseconds, kFiletime };
+
+struct RowRole {
+  ColumnRef column;
+  std::string unit;            ///< as the config wrote it (messages)
+  double scale = 1.0;          ///< raw * scale + offset, in `unit`
+  double offset = 0.0;
+  double to_role_unit = 1.0;   ///< from `unit` to the role's (rad, A)
+  double divide = 1.0;         ///< angles: unwrap, divide by this, wrap
+  double full_scale = 0.0;     ///< sin/cos: the largest |value| the ADC reaches (after scale), 0 = unknown
+};
+
+struct RowMap {
+  std::optional<ColumnRef> time;  ///< nullopt: no time column (rows at row_rate_hz)
+  TimeUnit time_unit = TimeUnit::kSeconds;
+  double row_rate_hz = 0.0;       ///< [Hz] only without a time column
+  std::array<std::optional<RowRole>, kRoleCount> roles;
+  [[nodiscard]] bool empty() const;
+};
+
+/// The smaller of the sin and cos columns' full_scale, 0 when either is unknown.
+[[nodiscard]] double csv_sincos_full_scale(const RowMap& map);
+
+class RowDecoder {
+ public:
+  explicit RowDecoder(RowMap map) : map_(std::move(map)) {}
+
+  /// Resolves column names against the export's column-name line (`names`,
+  /// empty when it has none). Returns a message naming every column that is
+  /// not there and the columns that are, or nullopt when all resolve.
+  [[nodiscard]] std::optional<std::string> bind(const std::vector<std::string>& names);
+
+  /// Decodes one data row (after bind()). A problem names the column (reason
+  /// bad_number or missing_column); the row still counts as one in the
+  /// sequence. Never throws except std::bad_alloc.
+  std::optional<TextProblem> decode(const CsvRow& row, char decimal, RowSample& out);
+
+  [[nodiscard]] const RowMap& map() const { return map_; }
+
+ private:
+  struct Bound {
+    std::size_t field = 0;  ///< 0-based field index
+  };
+  RowMap map_;
+  std::optional<Bound> time_;
+  std::array<std::optional<Bound>, kRoleCount> roles_;
+  std::array<AngleUnwrapper, kRoleCount> unwrap_{};
+  std::int64_t sequence_ = 0;
+};
+
+}  // namespace resolver

@@ -1,0 +1,122 @@
+#include "daemon/decode/sample_stream.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace resolver {
+
+Sample to_sample(const BenchSample& s, const ClockReading& clock) {
+  Sample out;
+  out.t = clock.t;
+  out.index = clock.index;
+  out.utime = s.timestamp_us;
+  out.has_rd = s.has(Role::kRdAngle);
+  out.theta_rd = s.get(Role::kRdAngle);
+  out.has_sincos = s.has(Role::kSin) && s.has(Role::kCos);
+  out.sin = s.get(Role::kSin);
+  out.cos = s.get(Role::kCos);
+  out.has_ref = s.has(Role::kRefAngle);
+  out.theta_m_ref = s.get(Role::kRefAngle);
+  out.has_currents = s.has(Role::kIA) && s.has(Role::kIB) && s.has(Role::kIC);
+  out.i_a = s.get(Role::kIA);
+  out.i_b = s.get(Role::kIB);
+  out.i_c = s.get(Role::kIC);
+  return out;
+}
+
+SampleStream::SampleStream(std::shared_ptr<const FrameDecoder> decoder, const SampleStreamConfig& config,
+                           Callbacks callbacks)
+    : config_(config),
+      callbacks_(std::move(callbacks)),
+      intake_(std::move(decoder), config.clock.max_counter_delta,
+              FrameIntake::Callbacks{[this](const BenchSample& s) { on_joined(s); },
+                                     [this](const BenchInfo& info) {
+                                       if (config_.use_bench_info) clock_.set_sample_rate(info.sample_rate_hz);
+                                       if (callbacks_.on_bench_info) callbacks_.on_bench_info(info);
+                                     },
+                                     [this](std::string_view reason, const std::string& message) {
+                                       if (callbacks_.on_problem) callbacks_.on_problem(reason, message);
+                                     }}),
+      clock_(config.clock) {}
+
+void SampleStream::restart_sequence() {
+  intake_.restart_sequence();
+  clock_.restart();
+}
+
+void SampleStream::feed_row(const RowSample& row, std::uint64_t line) {
+  line_ = line;
+  BenchSample s;
+  s.roles = row.roles;
+  s.values = row.values;
+  s.index = row.sequence;
+  // Without a time column the row number is the sample number and the row
+  // rate its clock, exactly as a counter and a sample rate are for frames.
+  s.has_counter = !row.has_time;
+  if (row.has_time) {
+    s.timestamp_us = row.time_us;
+  } else {
+    clock_.set_sample_rate(config_.row_rate_hz);
+    s.timestamp_us = config_.row_rate_hz > 0.0
+                         ? std::llround(static_cast<double>(row.sequence) * 1e6 / config_.row_rate_hz)
+                         : row.sequence;
+  }
+  s.counter = static_cast<std::uint8_t>(row.sequence & 0xFF);
+  intake_.feed_sample(s);
+}
+
+void SampleStream::on_joined(const BenchSample& joined) {
+  const ClockReading r =
+      clock_.read(joined.timestamp_us, joined.has_counter ? std::optional<std::int64_t>(joined.index) : std::nullopt);
+  if (r.event != ClockEvent::kNone) report_clock_event(joined, r);
+  if (!config_.slice.contains(r.t)) {
+    ++outside_slice_;
+    if (r.t > config_.slice.to_s) past_slice_end_ = true;
+    return;
+  }
+  if (callbacks_.on_sample) callbacks_.on_sample(to_sample(joined, r), joined.counter);
+}
+
+void SampleStream::report_clock_event(const BenchSample& joined, const ClockReading& r) {
+  const std::string where = fmt::format("{}sample {} at {}", line_ > 0 ? fmt::format("line {}: ", line_) : std::string(),
+                                        r.index, describe_frame_time(joined.timestamp_us));
+  const bool counter_time = clock_.uses_counter_time();
+  switch (r.event) {
+    case ClockEvent::kNone: break;
+    case ClockEvent::kStepBack:
+      intake_.count_problem(
+          "timestamp_step_back",
+          fmt::format("{}: the timestamp goes back {:.6f} s from the previous sample's; {}", where, -r.step_s,
+                      counter_time && r.index_step <= config_.clock.max_counter_delta
+                          ? "time continues from the counter"
+                          : "time continues one sample period after the previous sample (logs appended?)"));
+      break;
+    case ClockEvent::kJump:
+      intake_.count_problem(
+          "timestamp_jump",
+          fmt::format("{}: the timestamp jumps forward {:.6f} s{}; read as a clock jump, {}", where, r.step_s,
+                      joined.has_counter ? fmt::format(" while the counter advanced by {}", r.index_step)
+                                         : std::string(" (more than an hour, with no counter to count it)"),
+                      counter_time ? "time continues from the counter"
+                                   : "time continues one sample period after the previous sample"));
+      break;
+    case ClockEvent::kOutage:
+      intake_.count_problem(
+          "sample_clock_reanchored",
+          fmt::format("{}: arrived {:.6f} s after the previous sample, more than its counter step ({}) explains and "
+                      "more than a u8 counter can count: time base re-anchored on the frame clock",
+                      where, r.step_s, r.index_step));
+      break;
+    case ClockEvent::kGap:
+      intake_.count_problem("sample_gap",
+                            fmt::format("{}: {:.6f} s after the previous sample, {:.1f} sample periods of {:.6f} s: "
+                                        "{} sample(s) lost",
+                                        where, r.step_s, r.step_s / clock_.period_s(), clock_.period_s(),
+                                        r.samples_lost));
+      intake_.count_problem_silently("samples_lost", r.samples_lost);
+      break;
+  }
+}
+
+}  // namespace resolver

@@ -1,0 +1,196 @@
+// CSV / scope exports: numbers as exports write them, the reader's header
+// handling and field splitting, and the column map's units.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "daemon/core/angles.h"
+#include "daemon/decode/row_decoder.h"
+#include "drivers/csv/csv_number.h"
+#include "drivers/csv/csv_reader.h"
+
+namespace resolver {
+namespace {
+
+class TempFile {
+ public:
+  explicit TempFile(const std::string& text) {
+    path_ = std::string(RESOLVER_BINARY_DIR) + "/row_decoder_test_" + std::to_string(::getpid()) + "_" +
+            std::to_string(counter_++) + ".csv";
+    std::ofstream(path_, std::ios::binary) << text;
+  }
+  ~TempFile() { std::remove(path_.c_str()); }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  static inline int counter_ = 0;
+  std::string path_;
+};
+
+TEST(CsvNumber, DecimalMarksAndExponents) {
+  EXPECT_DOUBLE_EQ(*parse_csv_number("1.25", '.'), 1.25);
+  EXPECT_DOUBLE_EQ(*parse_csv_number(" -1,25 ", ','), -1.25);
+  EXPECT_DOUBLE_EQ(*parse_csv_number("1.260000000000000182e-02", '.'), 1.260000000000000182e-02);
+  EXPECT_DOUBLE_EQ(*parse_csv_number("+3", '.'), 3.0);
+  EXPECT_DOUBLE_EQ(*parse_csv_number("5.", '.'), 5.0);
+  EXPECT_FALSE(parse_csv_number("1,25", '.'));  // a comma is not the mark here
+  EXPECT_FALSE(parse_csv_number("1.2.3", '.'));
+  EXPECT_FALSE(parse_csv_number("", '.'));
+  EXPECT_FALSE(parse_csv_number("abc", '.'));
+  EXPECT_FALSE(parse_csv_number("nan", '.'));
+  EXPECT_FALSE(parse_csv_number("1e999", '.'));
+}
+
+TEST(CsvNumber, ScaledIntegersAreExact) {
+  // A FILETIME needs 18 digits: a double would round it to 16 ticks (1.6 us).
+  EXPECT_EQ(parse_csv_scaled_integer("133485408001234567", '.', -1), 13348540800123456);
+  EXPECT_EQ(parse_csv_scaled_integer("0,000501", ',', 6), 501);
+  EXPECT_EQ(parse_csv_scaled_integer("1700000000.1234567", '.', 6), 1700000000123456);  // truncated, never rounded up
+  EXPECT_EQ(parse_csv_scaled_integer("-0.0000015", '.', 6), -2);                        // toward minus infinity
+  EXPECT_EQ(parse_csv_scaled_integer("1.5e3", '.', 3), 1'500'000);
+  EXPECT_FALSE(parse_csv_scaled_integer("1e30", '.', 6));  // past int64
+  EXPECT_FALSE(parse_csv_scaled_integer("x", '.', 6));
+}
+
+TEST(CsvReader, ScopeExportWithHeaderLinesNamesAndSemicolons) {
+  TempFile f("\xEF\xBB\xBF" "Scope XY-123\nDate;24.11.2025\n\nSamples;3\nUnit;deg\n"
+             "Time;Resolver;\"Encoder\"\n"
+             "133485408000000000;1,5;2,25\n"
+             "133485408000100000; 3,0 ;4\n"
+             "\n"
+             "133485408000200000;x;5\n");
+  CsvFormat fmt;
+  fmt.decimal = ',';
+  fmt.header_lines = 4;  // blank lines are not counted
+  CsvReader reader(f.path(), fmt);
+  CsvRow row;
+  ASSERT_EQ(reader.next(row), CsvReader::Status::kRow);
+  EXPECT_EQ(reader.column_names(), (std::vector<std::string>{"Time", "Resolver", "Encoder"}));
+  EXPECT_EQ(reader.names_line(), 6U);
+  EXPECT_EQ(reader.delimiter(), CsvFormat::Delimiter::kSemicolon);
+  EXPECT_EQ(reader.line_number(), 7U);
+  ASSERT_EQ(row.fields.size(), 3U);
+  EXPECT_EQ(row.fields[1], "1,5");
+  ASSERT_EQ(reader.next(row), CsvReader::Status::kRow);
+  EXPECT_EQ(row.fields[1], "3,0");
+  EXPECT_EQ(row.columns[1], 21U);  // after the space: where "3,0" starts
+  ASSERT_EQ(reader.next(row), CsvReader::Status::kRow);
+  EXPECT_EQ(reader.line_number(), 10U);
+  EXPECT_EQ(reader.next(row), CsvReader::Status::kEnd);
+}
+
+TEST(CsvReader, SkipUntilNumbersFindsTheNamesAndSpaceRuns) {
+  TempFile f("# exported by a tool\n  t   A    B\n  0.0  1.0  2.0\n  0.1  3.0  4.0\n");
+  CsvFormat fmt;
+  fmt.skip_until_numbers = true;
+  CsvReader reader(f.path(), fmt);
+  CsvRow row;
+  ASSERT_EQ(reader.next(row), CsvReader::Status::kRow);
+  EXPECT_EQ(reader.column_names(), (std::vector<std::string>{"t", "A", "B"}));
+  EXPECT_EQ(reader.delimiter(), CsvFormat::Delimiter::kSpace);
+  ASSERT_EQ(row.fields.size(), 3U);
+  EXPECT_EQ(row.fields[2], "2.0");
+  EXPECT_EQ(row.columns[0], 3U);
+}
+
+RowMap degree_map() {
+  RowMap m;
+  m.time = ColumnRef{"Time", 0};
+  m.time_unit = TimeUnit::kFiletime;
+  RowRole rd;
+  rd.column = ColumnRef{"Resolver", 0};
+  rd.unit = "deg";
+  rd.to_role_unit = kPi / 180.0;
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  RowRole ref = rd;
+  ref.column = ColumnRef{"", 3};
+  m.roles[static_cast<std::size_t>(Role::kRefAngle)] = ref;
+  return m;
+}
+
+CsvRow row_of(const std::string& line) {
+  static std::vector<std::string> keep;  // the views must outlive the row
+  keep.push_back(line);
+  CsvRow row;
+  split_csv_line(keep.back(), CsvFormat::Delimiter::kSemicolon, row);
+  return row;
+}
+
+TEST(RowDecoder, FiletimeAndDegrees) {
+  RowDecoder d(degree_map());
+  ASSERT_FALSE(d.bind({"Time", "Resolver", "Encoder"}));
+  RowSample s;
+  ASSERT_FALSE(d.decode(row_of("133485408000000000;450,0;-90"), ',', s));
+  EXPECT_TRUE(s.has_time);
+  // 133485408000000000 ticks of 100 ns since 1601 = 1704067200 s since 1970 (2024-01-01 00:00:00 UTC).
+  EXPECT_EQ(s.time_us, 1'704'067'200'000'000);
+  EXPECT_EQ(s.sequence, 0);
+  EXPECT_NEAR(s.values[static_cast<std::size_t>(Role::kRdAngle)], kPi / 2.0, 1e-12);       // 450 deg wraps to 90
+  EXPECT_NEAR(s.values[static_cast<std::size_t>(Role::kRefAngle)], 1.5 * kPi, 1e-12);      // -90 deg wraps to 270
+  EXPECT_EQ(s.roles, role_bit(Role::kRdAngle) | role_bit(Role::kRefAngle));
+}
+
+TEST(RowDecoder, BadRowsNameTheColumnAndKeepTheSequence) {
+  RowDecoder d(degree_map());
+  ASSERT_FALSE(d.bind({"Time", "Resolver", "Encoder"}));
+  RowSample s;
+  const auto bad = d.decode(row_of("133485408000000000;4x5;1"), ',', s);
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->reason, "bad_number");
+  EXPECT_EQ(bad->column, 20U);
+  EXPECT_NE(bad->message.find("column 'Resolver' (rd_angle)"), std::string::npos) << bad->message;
+  const auto missing = d.decode(row_of("133485408000000000;45"), ',', s);
+  ASSERT_TRUE(missing);
+  EXPECT_EQ(missing->reason, "missing_column");
+  EXPECT_NE(missing->message.find("column 3"), std::string::npos) << missing->message;
+  ASSERT_FALSE(d.decode(row_of("133485408000100000;1;2"), ',', s));
+  EXPECT_EQ(s.sequence, 2);  // the two bad rows still count
+}
+
+TEST(RowDecoder, AColumnTheExportLacksIsNamed) {
+  RowDecoder d(degree_map());
+  const auto msg = d.bind({"time", "resolver"});
+  ASSERT_TRUE(msg);
+  EXPECT_NE(msg->find("time_column: no column named 'Time'"), std::string::npos) << *msg;
+  EXPECT_NE(msg->find("rd_angle: no column named 'Resolver'"), std::string::npos) << *msg;
+  EXPECT_NE(msg->find("the columns are 'time', 'resolver'"), std::string::npos) << *msg;
+}
+
+TEST(RowDecoder, CountsUnwrappedAndDividedGiveTheMechanicalAngle) {
+  // moteus-style: phase_cmd is the electrical angle of a 21-pole-pair motor in
+  // u16 counts (65536 = 2 pi electrical), stepping 1300 counts per row.
+  RowMap m;
+  RowRole ref;
+  ref.column = ColumnRef{"", 1};
+  ref.unit = "counts";
+  ref.to_role_unit = kTwoPi / 65536.0;
+  ref.divide = 21.0;
+  m.roles[static_cast<std::size_t>(Role::kRefAngle)] = ref;
+  m.row_rate_hz = 100.0;
+  RowDecoder d(m);
+  ASSERT_FALSE(d.bind({}));
+  RowSample s;
+  double first = 0.0;
+  const int rows = 21 * 65536 / 1300 + 1;  // one mechanical revolution
+  for (int k = 0; k <= rows; ++k) {
+    const std::string text = std::to_string((1300 * k) % 65536);
+    CsvRow row;
+    split_csv_line(text, CsvFormat::Delimiter::kComma, row);
+    ASSERT_FALSE(d.decode(row, '.', s));
+    const double want = wrap_2pi(kTwoPi * 1300.0 * k / 65536.0 / 21.0);
+    if (k == 0) first = s.values[static_cast<std::size_t>(Role::kRefAngle)];
+    EXPECT_NEAR(wrap_pi(s.values[static_cast<std::size_t>(Role::kRefAngle)] - want), 0.0, 1e-9) << k;
+  }
+  EXPECT_EQ(first, 0.0);
+  EXPECT_FALSE(s.has_time);
+}
+
+}  // namespace
+}  // namespace resolver
