@@ -470,7 +470,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     require_positive(c.dq_decimation, "[output] dq_decimation", s);
   }
   if (const auto* t = section("bench")) {
-    check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source"}, s);
+    check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source", "reference_aligned"}, s);
     read(*t, "sample_rate_hz", c.bench.sample_rate_hz, s, "bench");
     // Written so NaN fails too (found by fuzzing: NaN < 0 is false).
     if (!(c.bench.sample_rate_hz >= 0.0) || !std::isfinite(c.bench.sample_rate_hz)) {
@@ -486,6 +486,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     read(*t, "p", c.bench.p, s, "bench");
     read(*t, "rd_bits", c.bench.rd_bits, s, "bench");
     read(*t, "use_bench_info", c.bench.use_bench_info, s, "bench");
+    read(*t, "reference_aligned", c.bench.reference_aligned, s, "bench");
     require_positive(c.bench.p_r, "[bench] p_r", s);
     require_positive(c.bench.p, "[bench] p", s);
     if (c.bench.rd_bits < 1 || c.bench.rd_bits > 16) {
@@ -594,6 +595,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     throw ConfigError(s + ": [compensation] domain = \"signal\" needs [estimator] method = \"sincos_least_squares\" "
                           "(only it estimates the sin/cos signal parameters)");
   }
+  c.model.reference_aligned = c.bench.reference_aligned;
   return c;
 }
 

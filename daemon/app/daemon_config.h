@@ -23,6 +23,8 @@
 //   use_bench_info = true
 //   sample_rate_hz = 2000      # used until BENCH_INFO gives it; 0 = unknown
 //   time_source = "counter"    # sample time = counter / sample rate; "frame" = frame timestamps
+//   reference_aligned = false  # true: the reference encoder's zero is on the rotor d axis (resolver-sim's is),
+//                              # so a constant position error is the mounting offset, not the reference's zero
 //   [layout]
 //   dbc = "/path/to/inverter.dbc"
 //   counter_signal = "counter"
@@ -123,6 +125,11 @@ struct BenchDefaults {
   int p = 3;                   ///< motor pole pairs
   int rd_bits = 16;            ///< R/D resolution [bits]
   bool use_bench_info = true;  ///< let BENCH_INFO frames override p_r, p, rd_bits, sample rate
+  /// The reference encoder's zero is on the rotor d axis (set at commissioning, or
+  /// resolver-sim's): a constant position error against it is then the mounting
+  /// offset. Otherwise (a real bench's encoder, an open-loop command) the reference's
+  /// zero is a free constant of the fit and the mounting offset is not identifiable.
+  bool reference_aligned = false;
   /// Control/sample rate [Hz]; 0 = unknown until BENCH_INFO.
   double sample_rate_hz = 0.0;
   /// Where the estimators' time axis comes from. The DSP samples on a fixed
@@ -144,6 +151,7 @@ struct ModelFitOptions {
   std::shared_ptr<const CustomEffects> customs;
   double window_revolutions = 16.0;  ///< resolver electrical revolutions per model_fit_t
   bool candidates = true;            ///< rank the missing catalog effects (explain) or only fit
+  bool reference_aligned = false;    ///< [bench] reference_aligned, copied here for the fit
 };
 
 /// A CSV / scope export's layout and column map ([input.csv]).

@@ -112,6 +112,7 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
     try {
       DiscoveryOptions dopt;
       dopt.customs = opt.customs.get();
+      dopt.prepare.reference_aligned = opt.reference_aligned;
       dopt.rank_when_explained = false;  // see DiscoveryOptions: the costly part, moot while explained
       Explanation ex;
       if (opt.candidates) ex = explain_model(w, opt.effects, dopt);

@@ -124,8 +124,12 @@ ref_angle = "REFERENCE_ANGLE.ref_angle"
     return path
 
 
-def explain(bin_dir, log, effects=None, config=None, allow_fail=False):
+def explain(bin_dir, log, effects=None, config=None, allow_fail=False, aligned=True):
     cmd = [os.path.join(bin_dir, "resolver-model"), "explain", log, "--json"]
+    if aligned:
+        # Both generators write the true rotor angle as the reference: its zero is on the
+        # d axis, so a constant error is the mounting offset, not the reference's zero.
+        cmd.append("--reference-aligned")
     if effects:
         cmd += ["--effects", ",".join(effects)]
     if config:
@@ -215,6 +219,15 @@ def hidden_case(check, bin_dir, log, hidden, profile, config):
         return
     check("refit_verdict", after["verdict"] == "explained", f"{ref} added: verdict explained (got {after['verdict']})")
     check_floor(check, after, "refit", f"{ref} added")
+    if hidden.key == "mounting_offset" and profile.name == "const":
+        # Control: told that the reference's zero is unknown (a real bench's encoder), the
+        # tool must not name a mounting offset: a constant is then the reference's zero.
+        free, err = explain(bin_dir, log, config=config, allow_fail=True, aligned=False)
+        if check("unaligned_runs", free is not None, f"explain without --reference-aligned runs ({err})"):
+            named = [c["effect"] for c in free["candidates"] if c["proposed"]]
+            reason = [n for n in free["not_evaluated"] if n.startswith("mounting_offset:")]
+            check("unaligned_not_named", "mounting_offset" not in named and bool(reason),
+                  f"unaligned reference: mounting_offset not evaluated ({reason}), proposed {named}")
     if ref != hidden.refs[0] and profile.name == "const":
         # The explicit reference (README: "harmonics(k3,k5_opp)", "mechanical_harmonics(a2,b2)")
         # names the same model: once per effect, on the default bench.

@@ -68,7 +68,8 @@ def make_pages():
     part = os.path.join(ARGS.work, "half_turn.log")
     run([sim, "-o", part, "--rpm", "5", "--duration", "2", "-e", "amplitude_imbalance:alpha=0.003"])
     PAGES["half_turn"] = os.path.join(ARGS.work, "half_turn.html")
-    run([model, "report", part, "--effects", "mounting_offset", "--html", PAGES["half_turn"]])
+    # (resolver-sim's reference zero is on the d axis: --reference-aligned makes mounting_offset fittable)
+    run([model, "report", part, "--effects", "mounting_offset", "--reference-aligned", "--html", PAGES["half_turn"]])
     # Without the reference encoder: no dq plots, the self-calibrated angle.
     noref = os.path.join(ARGS.work, "no_reference.log")
     run([sim, "-o", noref, "--no-reference", "-e", "amplitude_imbalance:alpha=0.003", "--duration", "3"])

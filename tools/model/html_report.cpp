@@ -409,7 +409,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
 
   std::vector<std::string> notes = log.notes;
   if (log.bad_lines > 0) notes.push_back(fmt::format("{} malformed log lines skipped", log.bad_lines));
-  if (log.problems > 0) notes.push_back(fmt::format("{} decode problems (CRC, counters) skipped", log.problems));
+  if (log.problems > 0) notes.push_back(fmt::format("{} input problems counted (by reason above: a gap is counted, not skipped)", log.problems));
   for (const auto& ex : run.steps) {
     for (const auto& n : ex.fit.notes) {
       if (std::find(notes.begin(), notes.end(), n) == notes.end()) notes.push_back(n);

@@ -52,11 +52,15 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
   for (const auto& s : f.signals) {
     const bool rad = s.signal == "position_error";
     const std::string unit = s.signal == "i_dq" ? " A" : " of the amplitude";
-    o += fmt::format("  {:<15} {:.3g}{} (before: {:.3g}), floor {:.3g}{} -> {:.2f}x floor; held back {:.2f}x\n",
-                     s.signal, s.rms, rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.rms)) : unit,
-                     s.raw_rms, s.floor,
+    // NaN: not computed for this signal (no folds, or a position error derived from sin/cos).
+    const auto or_na = [](double v, const char* spec) {
+      return std::isfinite(v) ? fmt::format(fmt::runtime(spec), v) : std::string("n/a");
+    };
+    o += fmt::format("  {:<15} {:.3g}{} (before: {}), floor {:.3g}{} -> {:.2f}x floor; held back {}\n", s.signal,
+                     s.rms, rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.rms)) : unit,
+                     or_na(s.raw_rms, "{:.3g}"), s.floor,
                      rad ? fmt::format(" rad = {:.3g} arcmin", rad_to_arcmin(s.floor)) : std::string(""),
-                     s.rms / s.floor, s.held_back_rms / s.floor);
+                     s.rms / s.floor, or_na(s.held_back_rms / s.floor, "{:.2f}x"));
   }
   auto floor_line = [&](const char* name, const FloorEstimate& e) {
     if (e.source.empty() || e.source == "none") return;

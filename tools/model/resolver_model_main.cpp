@@ -168,11 +168,15 @@ int run(int argc, char** argv) {
   };
   std::string direction = "both";
   bool moving_only = false;
+  bool reference_aligned = false;
   auto add_slicing = [&](CLI::App* sub) {
     sub->add_option("--direction", direction,
                     "fit only the samples moving this way: forward, backward or both (default both); the others are "
                     "counted as excluded")
         ->check(CLI::IsMember({"forward", "backward", "both"}));
+    sub->add_flag("--reference-aligned", reference_aligned,
+                  "the reference encoder's zero is on the rotor d axis (as resolver-sim's is; [bench] "
+                  "reference_aligned): a constant position error is then the mounting offset, not a free constant");
     sub->add_flag("--moving-only", moving_only,
                   "leave standstill samples out of everything, the noise floor too (default: they give the floor "
                   "and never enter a fit)");
@@ -270,6 +274,7 @@ int run(int argc, char** argv) {
                                 : direction == "backward" ? resolver::DirectionFilter::kBackward
                                                           : resolver::DirectionFilter::kBoth;
     options.prepare.moving_only = moving_only;
+    options.prepare.reference_aligned = reference_aligned || config.bench.reference_aligned;
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
     if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
     if (export_data->parsed()) {
@@ -285,7 +290,7 @@ int run(int argc, char** argv) {
     }
     std::vector<std::string> notes = samples.notes;
     if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
-    if (samples.problems > 0) notes.push_back(std::to_string(samples.problems) + " decode problems (CRC, counters) skipped");
+    if (samples.problems > 0) notes.push_back(std::to_string(samples.problems) + " input problems counted (by reason above: a gap is counted, not skipped)");
     std::cout << (json ? resolver::format_model_json(ex, do_explain, notes)
                        : resolver::format_model_text(ex, do_explain, notes));
     return 0;

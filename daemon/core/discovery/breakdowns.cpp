@@ -139,25 +139,36 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
       out.rss_position_with_outliers += res_pos * res_pos;
       ++out.n_position_with_outliers;
     }
+    // Per group, as the fit counts rows (sin/cos and dq: two per sample), with the
+    // prediction evaluated: what the fit reports, not its linearised estimate.
+    double group_rss[3] = {0.0, 0.0, 0.0};
+    std::int64_t group_n[3] = {0, 0, 0};
     if (r.has(FitRow::kHasRd)) {
-      out.rss_with_outliers[0] += (r.y_rd - pred.rd) * (r.y_rd - pred.rd);
-      ++out.n_with_outliers[0];
+      const double er = r.y_rd - pred.rd - nuisance.rd;
+      group_rss[0] = er * er;
+      group_n[0] = 1;
     }
     if (r.has(FitRow::kHasSc)) {
-      // The sin/cos angle and radius about the fit's amplitude (nuisance gain left in:
-      // it is small against a spike); two rows, as the fit counts them.
       const double ea = r.y_sa - pred.sa - sa_offset, er = r.y_sr - pred.sr - sr_offset;
-      out.rss_with_outliers[1] += ea * ea + er * er;
-      out.n_with_outliers[1] += 2;
+      group_rss[1] = ea * ea + er * er;
+      group_n[1] = 2;
     }
     if (r.has(FitRow::kHasCur) && log.currents) {
       const double ed = r.y_d - pred.d - d_offset, eq = r.y_q - pred.q - q_offset;
-      out.rss_with_outliers[2] += ed * ed + eq * eq;
-      out.n_with_outliers[2] += 2;
+      group_rss[2] = ed * ed + eq * eq;
+      group_n[2] = 2;
+    }
+    for (int grp = 0; grp < 3; ++grp) {
+      out.rss_with_outliers[grp] += group_rss[grp];
+      out.n_with_outliers[grp] += group_n[grp];
     }
     if (r.has(FitRow::kOutlier)) {
       recent.clear();
       continue;
+    }
+    for (int grp = 0; grp < 3; ++grp) {
+      out.rss[grp] += group_rss[grp];
+      out.n[grp] += group_n[grp];
     }
     if (has_pos) {
       out.rss_position += res_pos * res_pos;

@@ -27,6 +27,10 @@ struct ResidualPass {
   std::int64_t n_position = 0;
   double rss_position_with_outliers = 0.0;
   std::int64_t n_position_with_outliers = 0;
+  /// Per signal group (rd, sin/cos, dq), the residual of the fitted rows with the
+  /// prediction evaluated (the fit's own figure is linearised).
+  double rss[3] = {0.0, 0.0, 0.0};
+  std::int64_t n[3] = {0, 0, 0};
   /// Per signal group (rd, sin/cos, dq), the residual including the outlier samples.
   double rss_with_outliers[3] = {0.0, 0.0, 0.0};
   std::int64_t n_with_outliers[3] = {0, 0, 0};

@@ -10,8 +10,10 @@ namespace resolver {
 
 std::vector<Nuisance> nuisances_for(const PreparedLog& log) {
   std::vector<Nuisance> out;
-  if (!log.reference && log.rd) out.push_back(Nuisance::kRdConstant);
-  if (!log.reference && log.sincos) out.push_back(Nuisance::kSaConstant);
+  // The position error's constant: without a reference the self-calibration's
+  // zero, with an unaligned one the reference's own zero (PrepareOptions).
+  if (!log.reference_aligned && log.rd) out.push_back(Nuisance::kRdConstant);
+  if (!log.reference_aligned && log.sincos) out.push_back(Nuisance::kSaConstant);
   if (log.sincos) out.push_back(Nuisance::kScGain);
   if (log.currents) {
     out.push_back(Nuisance::kIdConstant);
@@ -61,6 +63,10 @@ void check_model_against_log(const ModelSpec& spec, const PreparedLog& log) {
     const std::string name(t.effect->name());
     if (t.effect->needs_reference() && !log.reference) {
       throw std::invalid_argument("effect '" + name + "' needs the reference angle, which this log does not have");
+    }
+    if (t.effect->needs_aligned_reference() && !log.reference_aligned) {
+      throw std::invalid_argument("effect '" + name + "' is not identifiable here: " +
+                                  std::string(kNeedsAlignedReference));
     }
     if (t.effect->current_side() && !log.currents) {
       throw std::invalid_argument("effect '" + name + "' acts on the phase currents, which this log does not have "

@@ -10,6 +10,11 @@
 
 namespace resolver {
 
+/// Why a mounting offset cannot be fitted against an unaligned reference.
+inline constexpr std::string_view kNeedsAlignedReference =
+    "a constant position error against the reference is the reference's own zero unless that zero is set on the "
+    "rotor d axis: [bench] reference_aligned = true (resolver-model --reference-aligned)";
+
 /// The nuisance columns of a log: constants the true angle cannot give (no
 /// reference), the envelopes' amplitude, the dq operating point.
 [[nodiscard]] std::vector<Nuisance> nuisances_for(const PreparedLog& log);

@@ -180,12 +180,24 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   fill_params(f, d, cov);
   // Signals.
   const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
+  std::vector<std::string> convergence_notes;
   const double gf[kGroups] = {floors.rd, floors.sc, floors.cur};
   for (int g = 0; g < kGroups; ++g) {
     if (!(gf[g] > 0.0) || s.n[g] == 0) continue;
     SignalResidual r;
     r.signal = names[g];
-    r.rms = rms(s.rss[g], s.n[g]);
+    // The residual with the prediction evaluated at the fitted values. The step's
+    // own figure is linearised; where they differ the fit has not converged (a
+    // nonlinear parameter at its bound, or out of passes) and the evaluated one is
+    // what the data says.
+    r.rms = rms(pass.rss[g], pass.n[g]);
+    const double linearised = rms(s.rss[g], s.n[g]);
+    if (std::abs(r.rms - linearised) > 0.01 * std::max(r.rms, gf[g])) {
+      f.converged = false;
+      convergence_notes.push_back(fmt::format("{}: the fit did not converge: evaluated residual {:.4g} against its linearised "
+                                    "{:.4g} (a nonlinear parameter at its bound, or the passes ran out)",
+                                    names[g], r.rms, linearised));
+    }
     r.floor = gf[g];
     r.raw_rms = rms(raw_sol.rss[g], raw_sol.n[g]);
     r.held_back_rms = held_back_rms(fr.stats, floors, cols, static_cast<Group>(g));
@@ -226,9 +238,10 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   f.sincos_used = log.sincos;
   f.currents_used = log.currents;
   f.notes = log.notes;
+  f.notes.insert(f.notes.end(), convergence_notes.begin(), convergence_notes.end());
   // Explained: every signal at its floor, in-sample and held back, and no outliers
   // that matter (the residual with them included also at the floor).
-  bool ok = !f.signals.empty();
+  bool ok = !f.signals.empty() && f.converged;
   for (const SignalResidual& r : f.signals) {
     if (r.rms > options.explained_ratio * r.floor) ok = false;
     if (std::isfinite(r.held_back_rms) && r.held_back_rms > options.explained_ratio * r.floor) ok = false;

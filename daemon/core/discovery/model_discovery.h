@@ -176,6 +176,7 @@ struct ModelFit {
   bool reference = false;
   bool sincos_used = false;
   bool currents_used = false;
+  bool converged = true;                     ///< evaluated residual = the fit's linearised one (notes say)
   bool explained = false;                    ///< every signal <= ratio x floor, held back too, outliers not mattering
   bool robust_errors = false;                ///< standard errors from the revolution-to-revolution spread
   int passes = 0;                            ///< passes over the rows

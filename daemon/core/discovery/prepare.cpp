@@ -63,6 +63,50 @@ std::string assign_folds(std::vector<FitRow>& rows, const PreparedLog& p) {
   return "first half against second half of the moving samples";
 }
 
+/// sin/cos pairs that do not circle zero (unipolar ADC counts with their mid-scale
+/// bias still in) give an angle that never turns: every later figure would be
+/// about an artefact. The offsets effect models small DC offsets (a fraction of the
+/// amplitude), not a bias larger than the swing, so this is an input error.
+void check_sincos_centred(const std::vector<Sample>& samples) {
+  double ms = 0.0, mc = 0.0;
+  std::size_t n = 0;
+  for (const Sample& x : samples) {
+    if (!x.has_sincos) continue;
+    ms += x.sin;
+    mc += x.cos;
+    ++n;
+  }
+  if (n == 0) return;
+  ms /= static_cast<double>(n);
+  mc /= static_cast<double>(n);
+  // Mean and spread of the radius about the centre and about zero: a centred pair
+  // that turns only part of the way (an arc) has its mean off zero too, but its
+  // radius about zero stays constant; a biased pair's radius does not.
+  double swing = 0.0, swing2 = 0.0, r0 = 0.0, r02 = 0.0;
+  for (const Sample& x : samples) {
+    if (!x.has_sincos) continue;
+    const double rc = std::hypot(x.sin - ms, x.cos - mc), rz = std::hypot(x.sin, x.cos);
+    swing += rc;
+    swing2 += rc * rc;
+    r0 += rz;
+    r02 += rz * rz;
+  }
+  const auto nd = static_cast<double>(n);
+  swing /= nd;
+  r0 /= nd;
+  const double spread_centre = std::sqrt(std::max(0.0, swing2 / nd - swing * swing)) / std::max(swing, 1e-300);
+  const double spread_zero = std::sqrt(std::max(0.0, r02 / nd - r0 * r0)) / std::max(r0, 1e-300);
+  // Half the swing: the offsets effect's regressors are linearised about zero and
+  // lose meaning long before the centre leaves the circle.
+  if (std::hypot(ms, mc) > 0.5 * swing && spread_zero > spread_centre) {
+    throw std::invalid_argument(fmt::format(
+        "the sin/cos pair does not circle zero: its centre is sin {:.6g}, cos {:.6g} against a swing of {:.6g} "
+        "(unipolar ADC counts with their bias still in?); subtract the bias in the input, e.g. [input.csv.columns] "
+        "sin = {{ ..., offset = {:.6g} }}, cos = {{ ..., offset = {:.6g} }}, or the DBC signal's offset",
+        ms, mc, swing, -ms, -mc));
+  }
+}
+
 }  // namespace
 
 std::int64_t PreparedLog::fitted_rows() const {
@@ -94,6 +138,7 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   p.rd = static_cast<double>(with_rd) >= kSignalPresentShare * total;
   p.sincos = static_cast<double>(with_sc) >= kSignalPresentShare * total;
   p.reference = static_cast<double>(with_ref) >= kSignalPresentShare * total;
+  p.reference_aligned = p.reference && opt.reference_aligned;
   const bool currents = static_cast<double>(with_cur) >= kSignalPresentShare * total;
   if (!p.rd && !p.sincos) {
     throw std::invalid_argument(fmt::format(
@@ -101,10 +146,17 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
         "least 90 % of the samples carry it); check the layout's signal map",
         in.samples.size(), with_rd, with_sc));
   }
+  if (p.sincos) check_sincos_centred(in.samples);
   if (!p.reference) {
     p.notes.emplace_back(
         "no reference angle: fitting against the self-calibrated ideal angle (constant errors, delay, backlash, "
         "mounting offset and mechanical orders are not identifiable)");
+  }
+  if (p.reference && !p.reference_aligned) {
+    p.notes.emplace_back(
+        "the reference's zero against the resolver's is a free constant of the fit (nuisance.rd_constant); "
+        "mounting_offset needs [bench] reference_aligned = true (the reference encoder's zero set on the rotor "
+        "d axis, as resolver-sim's is)");
   }
   if (!p.sincos) p.notes.emplace_back("no sin/cos envelopes: only the R/D angle is fitted (k3 and alpha, k2 and "
                                       "offsets, land on the same orders and are told apart only by sin/cos)");
@@ -269,6 +321,24 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
       r.sig.i_q0 = i_q0;
     }
   }
+  // A position error is known modulo 2 pi. Near +-pi (a reference whose zero is
+  // half a turn from the resolver's: any real bench's encoder) wrapping to
+  // (-pi, pi] would cut the error in two; put the cut opposite its circular mean.
+  auto recenter = [&](FitRow::Flag has, double FitRow::*field) {
+    double sx = 0.0, sy = 0.0;
+    for (const FitRow& r : p.rows) {
+      if (!r.has(has)) continue;
+      sx += std::cos(r.*field);
+      sy += std::sin(r.*field);
+    }
+    if (sx == 0.0 && sy == 0.0) return;
+    const double centre = std::atan2(sy, sx);
+    for (FitRow& r : p.rows) {
+      if (r.has(has)) r.*field = centre + wrap_pi(r.*field - centre);
+    }
+  };
+  if (p.rd) recenter(FitRow::kHasRd, &FitRow::y_rd);
+  if (p.sincos) recenter(FitRow::kHasSc, &FitRow::y_sa);
   // Outliers, per signal over consecutive samples.
   std::vector<bool> flags(n, false), ok(n);
   std::vector<double> y(n);

@@ -38,11 +38,16 @@ struct PrepareOptions {
   DirectionFilter direction = DirectionFilter::kBoth;
   /// Standstill samples are not used at all (no standstill floor either).
   bool moving_only = false;
+  /// The reference's zero is on the rotor d axis ([bench] reference_aligned): a
+  /// constant position error is then the mounting offset. Otherwise it is the
+  /// reference's own zero, a free constant (a nuisance) of every fit.
+  bool reference_aligned = false;
 };
 
 struct PreparedLog {
   int p_r = 3, p = 3;
   bool reference = false;  ///< true angle from the reference encoder
+  bool reference_aligned = false;  ///< its zero is the rotor d axis (PrepareOptions)
   bool rd = false;         ///< R/D angle rows
   bool sincos = false;     ///< sin/cos rows
   bool currents = false;   ///< dq rows (needs the reference)

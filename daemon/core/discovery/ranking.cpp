@@ -58,6 +58,10 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
       not_evaluated.push_back(name + ": needs the reference angle");
       return false;
     }
+    if (t.effect->needs_aligned_reference() && !log.reference_aligned) {
+      not_evaluated.push_back(name + ": " + std::string(kNeedsAlignedReference));
+      return false;
+    }
     if (t.effect->current_side() && !log.currents) {
       not_evaluated.push_back(name + ": needs the phase currents (and the reference angle)");
       return false;
@@ -124,26 +128,31 @@ std::string reason_of(const ModelTerm& t, const std::vector<ParamValue>& params)
   return std::string(t.effect->physics()) + " (fit: " + vals + ").";
 }
 
-/// The candidate's parameters in value coordinates from a solution (internal step dz
-/// from the candidate's neutral point; standard errors from the inverse).
-std::vector<ParamValue> candidate_params(const Design& union_design, std::size_t term, const StepSolution& s) {
-  Design moved = union_design;
+/// Standard error of one parameter in value coordinates from a solution's inverse
+/// (column `col`, internal coordinate `z` for the inverse-square scale).
+double value_std_error(const ParamInfo& info, const StepSolution& s, int col, double z) {
+  const double s2 = s.rss_w / std::max(1.0, static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k));
+  double se = std::sqrt(std::max(0.0, s2 * s.inverse(col, col)));
+  if (info.nonlinear && info.scale == FitScale::kInverseSquare) se *= 0.5 * std::pow(std::max(z, 1e-300), -1.5);
+  return se;
+}
+
+/// The parameters of `design`'s term in value coordinates with standard errors from `s`.
+/// `step` moves the term by the solution first (a linearised candidate taken from its
+/// neutral point); without it the design is already at the solution (a converged refit).
+std::vector<ParamValue> term_params(const Design& design, std::size_t term, const StepSolution& s, bool step) {
+  Design moved = design;
   DesignTerm& dt = moved.terms()[term];
   dt.candidate = false;  // let step() move it
-  moved.step(s.dz);
+  if (step) moved.step(s.dz);
   std::vector<ParamValue> out;
-  const double s2 = s.rss_w / std::max(1.0, static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k));
   for (std::size_t k = 0; k < dt.params.size(); ++k) {
     const auto p = static_cast<std::size_t>(dt.params[k]);
     const ParamInfo& info = dt.effect->params()[p];
-    const int col = union_design.term_column(term) + static_cast<int>(k);
-    double se = std::sqrt(std::max(0.0, s2 * s.inverse(col, col)));
-    if (info.nonlinear && info.scale == FitScale::kInverseSquare) {
-      const double z = std::max(s.dz[col], 1e-300);
-      se *= 0.5 * std::pow(z, -1.5);
-    }
-    out.push_back({std::string(dt.effect->name()) + "." + std::string(info.name),
-                   moved.terms()[term].values[p], se, std::string(info.unit)});
+    const int col = design.term_column(term) + static_cast<int>(k);
+    const double z = step ? s.dz[col] : to_internal(info, dt.values[p]);
+    out.push_back({std::string(dt.effect->name()) + "." + std::string(info.name), dt.values[p],
+                   value_std_error(info, s, col, z), std::string(info.unit)});
   }
   return out;
 }
@@ -213,7 +222,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     c.err = excess_base > 0.0 ? (excess_base - s.rss_w) / excess_base : 0.0;
     c.proposed = c.bic_drop > options.proposal_bic_drop;
     c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
-    c.params = candidate_params(d, term, s);
+    c.params = term_params(d, term, s, true);
     std::erase_if(c.params, [&](const ParamValue& pv) {
       for (int p : terms[i].params) {
         if (pv.name == terms[i].param_name(static_cast<std::size_t>(&p - terms[i].params.data()))) return false;
@@ -254,14 +263,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     c.err = excess_base > 0.0 ? (excess_base - s.rss_w) / excess_base : 0.0;
     c.proposed = c.bic_drop > options.proposal_bic_drop;
     c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
-    const std::size_t last = dm.terms().size() - 1;
-    c.params.clear();
-    const auto& t = dm.terms()[last];
-    for (int p : t.params) {
-      const ParamInfo& info = t.effect->params()[static_cast<std::size_t>(p)];
-      c.params.push_back({std::string(t.effect->name()) + "." + std::string(info.name),
-                          t.values[static_cast<std::size_t>(p)], std::nan(""), std::string(info.unit)});
-    }
+    c.params = term_params(dm, dm.terms().size() - 1, s, false);
     c.reason = reason_of(one.terms.front(), c.params);
   }
   std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });

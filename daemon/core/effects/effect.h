@@ -164,6 +164,9 @@ class Effect {
   [[nodiscard]] virtual bool fittable() const { return true; }
   /// The signature needs the reference angle (an absolute or mechanical quantity).
   [[nodiscard]] virtual bool needs_reference() const { return false; }
+  /// Identifiable only when the reference's zero is the rotor d axis (a constant
+  /// position error is otherwise the reference's own zero: PrepareOptions).
+  [[nodiscard]] virtual bool needs_aligned_reference() const { return false; }
   /// Acts on the phase currents only.
   [[nodiscard]] virtual bool current_side() const { return stage() == EffectStage::kCurrents; }
   /// Only a log with changing speed or reversals separates it from the others

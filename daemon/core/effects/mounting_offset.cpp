@@ -56,6 +56,7 @@ class MountingOffsetEffect final : public BasicEffect {
                      "at every speed and in both directions"},
                     kParams, EffectStage::kMotion) {}
   [[nodiscard]] bool needs_reference() const override { return true; }
+  [[nodiscard]] bool needs_aligned_reference() const override { return true; }
   [[nodiscard]] double resolver_angle_shift(Values v, int p_r, int p) const override {
     return mounting_offset_resolver_shift(MountingOffset{v[0]}, p_r, p);
   }

@@ -134,7 +134,15 @@ StepSolution solve_step(const std::vector<NormalEquations>& groups, const GroupF
 
 namespace {
 
-double cost_at_start(const PassStatistics& s, const GroupFloors& floors) {
+/// The cost at the statistics' point: the weighted RSS with the nuisance constants
+/// solved there (they are not stored between passes). Without them the cost would
+/// carry the operating point (i_q of 10 A against a floor of 0.02 A), and a step
+/// that moves a parameter's constant part would read as worse while it is better.
+double cost_at(const PassStatistics& s, const GroupFloors& floors, std::span<const int> nuisance_cols) {
+  if (!nuisance_cols.empty()) {
+    const StepSolution n = solve_step(s.all, floors, std::vector<int>(nuisance_cols.begin(), nuisance_cols.end()));
+    if (n.ok) return n.rss_w;
+  }
   double c = 0.0;
   for (int g = 0; g < kGroups; ++g) {
     const double f = floors.of(static_cast<Group>(g));
@@ -160,6 +168,7 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
   // Model columns only: candidates are evaluated at the model's solution later.
   std::vector<int> model_cols;
   for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) model_cols.push_back(j);
+  const std::vector<int> nuisance_cols = model_cols;
   for (std::size_t i = 0; i < design.terms().size(); ++i) {
     if (design.terms()[i].candidate) continue;
     for (std::size_t k = 0; k < design.terms()[i].params.size(); ++k) {
@@ -175,8 +184,11 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     accumulate(design, rows, floors, stats);
     ++out.passes;
     if (progress) progress();
-    const double here = cost_at_start(stats, floors);
-    if (here > cost * (1.0 + 1e-12) && lambda < 1e6) {
+    const double here = cost_at(stats, floors, nuisance_cols);
+    // Rounding in sums over many rows moves the cost by ~1e-12 relative: a rise
+    // smaller than the convergence tolerance is not a worse step.
+    const double tolerance = 1e-9 * here + 1e-6;
+    if (here > cost + tolerance && lambda < 1e6) {
       // The last step made it worse (nonlinear): go back, damp harder.
       design = last_good;
       lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
@@ -186,16 +198,27 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     cost = here;
     last_good = design;
     StepSolution sol = solve_step(stats.all, floors, model_cols, lambda);
-    out.stats = std::move(stats);
-    out.last = sol;
-    if (!sol.ok) return out;
-    // Converged when the step lowers the cost by a negligible amount (1e-9 relative
-    // or less than 1e-6 of one row's noise): the statistics are at the solution.
-    const double gain = here - sol.rss_w;
-    if (gain <= 1e-9 * here + 1e-6 && pass > 0) {
-      out.ok = true;
+    if (!sol.ok) {
+      out.last = sol;
+      out.stats = std::move(stats);
       return out;
     }
+    // Converged when the step lowers the cost by a negligible amount (1e-9 relative
+    // or less than 1e-6 of one row's noise): the statistics are at the solution.
+    // Judged on the undamped step: a damped one is small because of the damping
+    // (and damps the nuisance constants the report takes from it), not because the
+    // point is the solution.
+    if (pass > 0 && here - sol.rss_w <= tolerance) {
+      const StepSolution free = lambda > 0.0 ? solve_step(stats.all, floors, model_cols, 0.0) : sol;
+      if (free.ok && here - free.rss_w <= tolerance) {
+        out.last = free;
+        out.stats = std::move(stats);
+        out.ok = true;
+        return out;
+      }
+    }
+    out.last = sol;
+    out.stats = std::move(stats);
     design.step(sol.dz);
     if (linear) {
       // One linearised step is exact; the statistics move with it (RSS(dz) above).

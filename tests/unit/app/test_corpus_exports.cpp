@@ -67,7 +67,9 @@ TEST(CorpusExports, ServoProjectOpticalEncoderChannels) {
   // pauses about 1.1 s every 5 s and once 7.8 s (33 pauses, found from time:
   // 8132 rows' worth of samples missing). Channels A and B, mapped to sin and
   // cos, are raw ADC counts: A spans 4935..14641, B 9814..15677 (unequal
-  // amplitudes and offsets). No R/D angle, no reference.
+  // amplitudes and offsets); the example config subtracts their mean (offset =
+  // -9774 and -13148, what prepare's "does not circle zero" error suggests), so
+  // the pair circles zero. No R/D angle, no reference.
   const DaemonConfig config = load_daemon_config(kRepo + "/tools/examples/servoproject_ab.toml");
   const LogSamples got = read_log_samples(kRepo + "/tests/data/corpus/servoproject/optical_encoder_ab.txt", nullptr, config);
   const auto& s = got.input.samples;
@@ -82,10 +84,10 @@ TEST(CorpusExports, ServoProjectOpticalEncoderChannels) {
     b_lo = std::min(b_lo, x.cos);
     b_hi = std::max(b_hi, x.cos);
   }
-  EXPECT_EQ(a_lo, 4935.0);
-  EXPECT_EQ(a_hi, 14641.0);
-  EXPECT_EQ(b_lo, 9814.0);
-  EXPECT_EQ(b_hi, 15677.0);
+  EXPECT_EQ(a_lo, 4935.0 - 9774.0);
+  EXPECT_EQ(a_hi, 14641.0 - 9774.0);
+  EXPECT_EQ(b_lo, 9814.0 - 13148.0);
+  EXPECT_EQ(b_hi, 15677.0 - 13148.0);
   // The pauses are gaps, not clock jumps: time keeps them (142.89 s end to end above), and the notes say so.
   EXPECT_EQ(got.problems, 33);
   EXPECT_EQ(s.back().index, 26167 + 8132);

@@ -53,6 +53,13 @@ DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<Speed
 }
 
 const std::vector<std::string> kDefault{"amplitude_imbalance"};
+// The simulator's reference is the true rotor angle: its zero is on the d axis, so a
+// constant error is the mounting offset (resolver-model --reference-aligned).
+const DiscoveryOptions kAligned = [] {
+  DiscoveryOptions o;
+  o.prepare.reference_aligned = true;
+  return o;
+}();
 
 void expect_within_floor(const ModelFit& f) {
   for (const auto& s : f.signals) {
@@ -63,7 +70,7 @@ void expect_within_floor(const ModelFit& f) {
 
 TEST(ModelDiscovery, AlphaOnlyIsExplainedAndNothingProposed) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003"});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kExplained) << ex.summary;
   for (const auto& c : ex.candidates) EXPECT_FALSE(c.proposed) << c.effect;
   ASSERT_FALSE(ex.fit.params.empty());
@@ -75,13 +82,13 @@ TEST(ModelDiscovery, AlphaOnlyIsExplainedAndNothingProposed) {
 
 TEST(ModelDiscovery, HiddenQuadratureIsNamedFirstAndExplainedWhenAdded) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "quadrature:beta=0.002"});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_FALSE(ex.candidates.empty());
   EXPECT_EQ(ex.candidates.front().effect, "quadrature");
   EXPECT_GT(ex.fit.residual_rms_rad, 1.5 * ex.fit.noise_floor_rad);
   const std::vector<std::string> with{"amplitude_imbalance", "quadrature"};
-  const Explanation after = explain_model(in, with);
+  const Explanation after = explain_model(in, with, kAligned);
   EXPECT_EQ(after.verdict, Verdict::kExplained) << after.summary;
   expect_within_floor(after.fit);
   for (const auto& p : after.fit.params) {
@@ -93,46 +100,46 @@ TEST(ModelDiscovery, HiddenQuadratureIsNamedFirstAndExplainedWhenAdded) {
 
 TEST(ModelDiscovery, HiddenOffsetsAreNamedFirst) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "offsets:o_s=0.001,o_c=-0.0015"});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_FALSE(ex.candidates.empty());
   EXPECT_EQ(ex.candidates.front().effect, "offsets");
   const std::vector<std::string> with{"amplitude_imbalance", "offsets"};
-  expect_within_floor(fit_model(in, with));
+  expect_within_floor(fit_model(in, with, kAligned));
 }
 
 TEST(ModelDiscovery, HiddenThirdHarmonicIsToldFromAlphaBySinCos) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "harmonics:k3=0.001"});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_FALSE(ex.candidates.empty());
   EXPECT_EQ(ex.candidates.front().effect, "harmonics");
   const std::vector<std::string> with{"amplitude_imbalance", "harmonics"};
-  expect_within_floor(fit_model(in, with));
+  expect_within_floor(fit_model(in, with, kAligned));
 }
 
 TEST(ModelDiscovery, HiddenSamplingSkewOverTwoSpeeds) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "sampling_skew:tau=2e-5"},
                            {{2.5, 200.0, 200.0}, {1.0, 200.0, 600.0}, {2.5, 600.0, 600.0}});  // a ramp, not a step: a
   // speed step kicks the R/D loop into a transient no catalog effect models
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_FALSE(ex.candidates.empty());
   EXPECT_EQ(ex.candidates.front().effect, "sampling_skew");
   const std::vector<std::string> with{"amplitude_imbalance", "sampling_skew"};
-  expect_within_floor(fit_model(in, with));
+  expect_within_floor(fit_model(in, with, kAligned));
 }
 
 TEST(ModelDiscovery, TrackingLoopOverTwoSpeeds) {
   // The default chain's R/D loop (omega_n = 3000 rad/s) is the hidden effect: at
   // 2000 r/min the 2 theta ripple is filtered visibly.
   const auto in = simulate({"amplitude_imbalance:alpha=0.003"}, {{1.0, 500.0, 500.0}, {2.0, 500.0, 2000.0}, {1.0, 2000.0, 2000.0}});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_FALSE(ex.candidates.empty());
   EXPECT_EQ(ex.candidates.front().effect, "tracking_loop");
   const std::vector<std::string> with{"amplitude_imbalance", "tracking_loop"};
-  expect_within_floor(fit_model(in, with));
+  expect_within_floor(fit_model(in, with, kAligned));
 }
 
 // Current-side effects: the resolver signals are clean of them, the dq currents
@@ -143,7 +150,7 @@ TEST(ModelDiscovery, TrackingLoopOverTwoSpeeds) {
 void expect_current_effect_found(const std::string& spec, const std::string& effect, const std::string& param,
                                  double truth) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", spec});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_FALSE(ex.candidates.empty());
   EXPECT_EQ(ex.candidates.front().effect, effect) << ex.summary;
@@ -151,7 +158,7 @@ void expect_current_effect_found(const std::string& spec, const std::string& eff
   // The resolver side is already explained: the failure is on i_dq only.
   EXPECT_LE(ex.fit.residual_rms_rad, 1.5 * ex.fit.noise_floor_rad);
   const std::vector<std::string> with{"amplitude_imbalance", effect};
-  const ModelFit after = fit_model(in, with);
+  const ModelFit after = fit_model(in, with, kAligned);
   expect_within_floor(after);
   bool seen = false;
   for (const auto& p : after.params) {
@@ -180,7 +187,7 @@ TEST(ModelDiscovery, TwoHiddenEffectsAreNamedAsAPair) {
   // Neither quadrature nor offsets alone removes most of the excess; together they
   // reach the floor. The verdict names both, best single first, and adding both explains.
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "quadrature:beta=0.002", "offsets:o_s=0.001,o_c=-0.0015"});
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
   ASSERT_EQ(ex.missing_pair.size(), 2U) << ex.summary;
   EXPECT_EQ(ex.missing_pair[0], ex.candidates.front().effect);
@@ -188,7 +195,7 @@ TEST(ModelDiscovery, TwoHiddenEffectsAreNamedAsAPair) {
   std::sort(pair.begin(), pair.end());
   EXPECT_EQ(pair, (std::vector<std::string>{"offsets", "quadrature"}));
   const std::vector<std::string> with{"amplitude_imbalance", "quadrature", "offsets"};
-  expect_within_floor(fit_model(in, with));
+  expect_within_floor(fit_model(in, with, kAligned));
 }
 
 TEST(ModelDiscovery, AlphaDriftingInTimeIsNotExplainedByACatalogEffect) {
@@ -196,7 +203,7 @@ TEST(ModelDiscovery, AlphaDriftingInTimeIsNotExplainedByACatalogEffect) {
   // warming up). No catalog effect is a function of time, so none may be named:
   // the verdict must be "unexplained", with the residual described instead.
   const auto in = simulate({"amplitude_imbalance:alpha=0.003"}, {{5.0, 200.0, 200.0}}, 0.0006);
-  const Explanation ex = explain_model(in, kDefault);
+  const Explanation ex = explain_model(in, kDefault, kAligned);
   EXPECT_EQ(ex.verdict, Verdict::kUnexplained) << ex.summary;
   EXPECT_GT(ex.fit.residual_rms_rad, 1.5 * ex.fit.noise_floor_rad);
   for (const auto& c : ex.candidates) EXPECT_FALSE(c.reaches_floor) << c.effect;
@@ -208,7 +215,7 @@ TEST(ModelDiscovery, AlphaDriftingInTimeIsNotExplainedByACatalogEffect) {
 TEST(ModelDiscovery, NoReferenceFitsAgainstSmoothedAngle) {
   auto in = simulate({"amplitude_imbalance:alpha=0.003"});
   for (auto& s : in.samples) s.has_ref = false;
-  const ModelFit f = fit_model(in, kDefault);
+  const ModelFit f = fit_model(in, kDefault, kAligned);
   EXPECT_FALSE(f.reference);
   ASSERT_FALSE(f.params.empty());
   EXPECT_NEAR(f.params.back().value, 0.003, 5.0 * f.params.back().std_error + 2e-5);
@@ -218,9 +225,9 @@ TEST(ModelDiscovery, NoReferenceFitsAgainstSmoothedAngle) {
 TEST(ModelDiscovery, UnknownEffectAndTooFewSamplesThrow) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003"}, {{0.2, 200.0, 200.0}});
   const std::vector<std::string> bad{"flux_capacitor"};
-  EXPECT_THROW((void)fit_model(in, bad), std::invalid_argument);
+  EXPECT_THROW((void)fit_model(in, bad, kAligned), std::invalid_argument);
   DiscoveryInput empty;
-  EXPECT_THROW((void)fit_model(empty, kDefault), std::invalid_argument);
+  EXPECT_THROW((void)fit_model(empty, kDefault, kAligned), std::invalid_argument);
 }
 
 }  // namespace
