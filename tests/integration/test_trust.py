@@ -156,6 +156,32 @@ class DeadExcitation(unittest.TestCase):
         self.assertIn("fault      none", proc.stdout)
 
 
+class ExplainOnFaultySignals(unittest.TestCase):
+    """resolver-model judges signal health as resolverd does: a fault over a tenth of the
+    log forbids "explained" and any proposed effect (issue 16, part 2)."""
+
+    def explain(self, log):
+        p = run([os.path.join(ARGS.bin, "resolver-model"), "explain", log, "--json"])
+        return json.loads(p.stdout)
+
+    def test_dead_excitation_is_unexplained_with_the_fault(self):
+        ex = self.explain(case("dead_excitation.log"))
+        self.assertEqual(ex["verdict"], "unexplained")
+        self.assertFalse([c for c in ex["candidates"] if c["proposed"]])
+        self.assertIn("signal health: loss_of_signal for 1000 of 1000 samples", ex["where_it_fails"][0])
+
+    def test_overspeed_at_the_floor_is_still_not_explained(self):
+        # 30000 r/min aliases: the residual can sit at the floor while the angle is wrong.
+        ex = self.explain(case("overspeed_30000rpm.log"))
+        self.assertEqual(ex["verdict"], "unexplained")
+        self.assertIn("overspeed", ex["summary"])
+
+    def test_control_clean_log_is_explained(self):
+        ex = self.explain(sim_log("clean_200rpm.log", "--rpm", "200", "--duration", "2"))
+        self.assertEqual(ex["verdict"], "explained")
+        self.assertFalse([w for w in ex["where_it_fails"] if "signal health" in w])
+
+
 class OverlappingDbc(unittest.TestCase):
     def test_refused_naming_both_signals_message_and_bits(self):
         cfg = os.path.join(work("overlap.toml"))

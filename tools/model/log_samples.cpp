@@ -8,6 +8,7 @@
 
 #include "daemon/app/log_input.h"
 #include "daemon/app/pipeline.h"
+#include "daemon/app/signal_health_log.h"
 #include "daemon/decode/sample_stream.h"
 
 namespace resolver {
@@ -21,15 +22,24 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
   const std::unique_ptr<LogInput> reader = open_log_input(path, format, config);  // throws "cannot open <path>: ..."
   const auto decoder = make_frame_decoder(config);
   std::map<std::string, std::int64_t, std::less<>> problem_counts;
+  SignalHealthMonitor health(health_config_for(config, *decoder), config.bench.p_r, config.bench.sample_rate_hz);
+  if (format == LogFormat::kCsv && !config.health_full_scale_set) {
+    health.set_full_scale(csv_sincos_full_scale(config.csv.map), 0.0);  // as resolverd's Pipeline::feed_row
+  }
   SampleStream stream(decoder, sample_stream_config(config, options.slice),
                       SampleStream::Callbacks{
-                          [&](const Sample& s, std::uint8_t) { out.input.samples.push_back(s); },
+                          [&](const Sample& s, std::uint8_t) {
+                            out.input.samples.push_back(s);
+                            health.add(s);
+                          },
                           [&](const BenchInfo& i) {
                             if (config.bench.use_bench_info && i.p_r >= 1 && i.p >= 1) {
                               out.input.p_r = i.p_r;
                               out.input.p = i.p;
                               out.bench_info = true;
+                              health.set_pole_pairs(i.p_r);
                             }
+                            if (i.sample_rate_hz > 0.0) health.set_sample_rate(i.sample_rate_hz);
                           },
                           [&](std::string_view reason, const std::string&) {
                             ++out.problems;
@@ -56,6 +66,9 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
     }
   }
   stream.flush();
+  health.finish();
+  out.faults = health.faults();
+  out.health_samples = health.samples();
   out.outside_slice = stream.samples_outside_slice();
   if (progress) progress(1.0);
   if (out.input.samples.empty()) {
@@ -88,6 +101,21 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
   if (options.slice.limited()) {
     out.notes.push_back(fmt::format("slice {} s .. {} s: {} samples used, {} outside", options.slice.from_s,
                                     options.slice.to_s, out.input.samples.size(), out.outside_slice));
+  }
+  return out;
+}
+
+std::vector<std::string> lasting_faults(const LogSamples& log, double share) {
+  std::vector<std::string> out;
+  if (log.health_samples <= 0) return out;
+  for (std::size_t i = 0; i < kSignalFaultCount; ++i) {
+    const auto f = static_cast<SignalFault>(i);
+    if (f == SignalFault::kStopped || f == SignalFault::kOutliers) continue;
+    const SignalFaultState& st = log.faults[i];
+    const double part = static_cast<double>(st.samples) / static_cast<double>(log.health_samples);
+    if (st.samples == 0 || part < share) continue;
+    out.push_back(fmt::format("{} for {} of {} samples ({:.0f} %) from {:.3g} s", fault_name(f), st.samples,
+                              log.health_samples, 100.0 * part, st.first_t));
   }
   return out;
 }

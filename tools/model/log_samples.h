@@ -8,6 +8,7 @@
 // values, and a note says so.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -16,6 +17,7 @@
 
 #include "daemon/app/daemon_config.h"
 #include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/health/signal_health.h"
 #include "daemon/decode/sample_slice.h"
 
 namespace resolver {
@@ -28,7 +30,17 @@ struct LogSamples {
   std::int64_t outside_slice = 0;  ///< samples before --from or after --to
   bool bench_info = false;
   std::vector<std::string> notes;  ///< what the log lacks, what was odd
+  /// Signal health over every sample read, judged as resolverd judges it ([health],
+  /// the DBC's or the CSV column's full scale): what each fault held for.
+  std::array<SignalFaultState, kSignalFaultCount> faults{};
+  std::int64_t health_samples = 0;
 };
+
+/// The faults that held for at least `share` of the samples, worded for a note and
+/// for the verdict ("loss_of_signal for 9000 of 10000 samples (90 %) from 0.5 s").
+/// stopped and outliers are not among them: a standstill is motion, and outliers
+/// are discovery's own (kept out of the fit and reported there).
+[[nodiscard]] std::vector<std::string> lasting_faults(const LogSamples& log, double share);
 
 struct LogReadOptions {
   std::optional<LogFormat> format;  ///< --format; nullopt: [input] format, else the extension

@@ -117,7 +117,11 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
     o += "\nwhere it fails:\n";
     for (const auto& w : ex.where_it_fails) o += "  - " + w + "\n";
   }
-  o += "\ncandidates (lowest BIC first; * = proposed; ERR = share of the residual it removes):\n";
+  if (ex.candidates.empty() && ex.not_evaluated.empty()) {
+    o += "\ncandidates: none ranked\n";
+  } else {
+    o += "\ncandidates (lowest BIC first; * = proposed; ERR = share of the residual it removes):\n";
+  }
   for (const auto& c : ex.candidates) {
     const std::string dq = f.currents_used ? fmt::format(", i_dq {:.3g} A", c.dq_residual_after) : std::string();
     o += fmt::format("  {} {:<26} residual {:.3g} rad ({:.2f}x floor){}  BIC {:.1f} (drop {:.1f}) ERR {:.3f}{}\n      {}\n",

@@ -247,7 +247,10 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
     if (std::isfinite(r.held_back_rms) && r.held_back_rms > options.explained_ratio * r.floor) ok = false;
     if (!f.outliers.empty() && r.rms_with_outliers > options.explained_ratio * r.floor) ok = false;
   }
-  f.explained = ok;
+  // Faulty signals for a large part of the log (a dead excitation, a lost channel,
+  // clipping, a lost track): a fit at the floor on them is no evidence.
+  f.untrusted = !options.untrusted_input.empty();
+  f.explained = ok && options.untrusted_input.empty();
   if (!f.robust_errors) {
     f.notes.push_back(fmt::format("standard errors are formal (only {} revolutions: the revolution-to-revolution "
                                   "spread needs {})",
@@ -268,6 +271,25 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
   Explanation ex;
   ex.fit = fit_prepared(log, effects, options);
   if (options.progress) options.progress(0.4);
+  if (ex.fit.untrusted) {
+    // Neither "explained" nor a proposed effect: candidates fitted to faulty signals
+    // would name the fault's shape, not the resolver's physics.
+    ex.verdict = Verdict::kUnexplained;
+    for (const std::string& u : options.untrusted_input) ex.where_it_fails.push_back("signal health: " + u);
+    bool at_floor = true;
+    for (const SignalResidual& r : ex.fit.signals) at_floor = at_floor && r.rms <= options.explained_ratio * r.floor;
+    if (!at_floor) {
+      for (std::string& w : describe_failure(log, ex.fit, options.explained_ratio)) ex.where_it_fails.push_back(std::move(w));
+    }
+    ex.summary = fmt::format("unexplained: the signals are faulty for a large part of the log ({}){}: a fit on them "
+                             "says nothing about the resolver, and no effect is proposed; fix the input (see the "
+                             "faults' start times) and record again.",
+                             fmt::join(options.untrusted_input, "; "),
+                             at_floor ? fmt::format(", although every residual is within {}x its noise floor",
+                                                    num(options.explained_ratio))
+                                      : std::string());
+    return ex;
+  }
   if (ex.fit.explained && !options.rank_when_explained) {
     ex.verdict = Verdict::kExplained;
     ex.summary = "explained: every signal's residual is within " + num(options.explained_ratio) +

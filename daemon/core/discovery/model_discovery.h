@@ -56,6 +56,9 @@ struct DiscoveryOptions {
   PrepareOptions prepare;
   /// The config's [[model.custom]] effects (may be null): usable in models and ranked as candidates.
   const CustomEffects* customs = nullptr;
+  /// Signal faults that held for a large part of the log (resolver-model: from the same
+  /// health monitor as resolverd's): never "explained" while any is listed.
+  std::vector<std::string> untrusted_input;
 };
 
 /// A value with its standard error (NaN: not identifiable / not computed).
@@ -178,6 +181,7 @@ struct ModelFit {
   bool currents_used = false;
   bool converged = true;                     ///< evaluated residual = the fit's linearised one (notes say)
   bool explained = false;                    ///< every signal <= ratio x floor, held back too, outliers not mattering
+  bool untrusted = false;                    ///< DiscoveryOptions::untrusted_input listed faulty signals: never explained
   bool robust_errors = false;                ///< standard errors from the revolution-to-revolution spread
   int passes = 0;                            ///< passes over the rows
   std::vector<std::string> notes;
