@@ -62,10 +62,20 @@ LiveModelFit::~LiveModelFit() {
   if (running_.valid()) running_.wait();
 }
 
-void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp) {
+std::vector<std::string> LiveModelFit::take_window_faults() {
+  std::vector<std::string> out = lasting_faults(window_faults_, window_samples_, kUntrustedFaultShare);
+  window_faults_ = {};
+  window_samples_ = 0;
+  return out;
+}
+
+void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp, std::uint8_t active_faults) {
   last_stamp_ = stamp;
+  ++window_samples_;
+  for (std::size_t i = 0; i < kSignalFaultCount; ++i) window_faults_[i] += (active_faults >> i) & 1U;
   if (window_.add(sample, p_r, p)) {
     DiscoveryInput w = window_.take();
+    std::vector<std::string> untrusted = take_window_faults();
     if (running_.valid()) {
       if (realtime_ && running_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
         ++counters_.windows_skipped;
@@ -73,7 +83,7 @@ void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp)
       }
       publish_ready(true);
     }
-    start(std::move(w), stamp);
+    start(std::move(w), stamp, std::move(untrusted));
     return;
   }
   if (++since_poll_ >= kPollEvery) {
@@ -85,7 +95,7 @@ void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp)
 void LiveModelFit::finish() {
   publish_ready(true);
   if (window_.revolutions() >= kMinTailRevolutions) {
-    start(window_.take(), last_stamp_);
+    start(window_.take(), last_stamp_, take_window_faults());
     publish_ready(true);
   } else if (window_.size() > 0 && counters_.windows_fitted + counters_.windows_insufficient == 0) {
     // Nothing was published in the whole run (a stopped motor): say so, with the reason.
@@ -104,9 +114,9 @@ void LiveModelFit::finish() {
   }
 }
 
-void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
+void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp, std::vector<std::string> untrusted) {
   const ModelFitOptions opt = options_;
-  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window)]() {
+  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window), untrusted = std::move(untrusted)]() {
     Result r;
     model_fit_t& m = r.message;
     try {
@@ -114,6 +124,7 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp) {
       dopt.customs = opt.customs.get();
       dopt.prepare.reference_aligned = opt.reference_aligned;
       dopt.rank_when_explained = false;  // see DiscoveryOptions: the costly part, moot while explained
+      dopt.untrusted_input = untrusted;
       Explanation ex;
       if (opt.candidates) ex = explain_model(w, opt.effects, dopt);
       else ex.fit = fit_model(w, opt.effects, dopt);

@@ -18,11 +18,13 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/output_sink.h"
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/discovery/model_window.h"
+#include "daemon/core/health/signal_health.h"
 
 namespace resolver {
 
@@ -50,9 +52,10 @@ class LiveModelFit {
   LiveModelFit(const LiveModelFit&) = delete;
   LiveModelFit& operator=(const LiveModelFit&) = delete;
 
-  /// One joined sample (pole pairs as currently known). May publish the previous
+  /// One joined sample (pole pairs as currently known) and the signal faults active
+  /// at it (bit i: SignalFault i, signal_health.h). May publish the previous
   /// window's model_fit_t.
-  void add(const Sample& sample, int p_r, int p, const Stamp& stamp);
+  void add(const Sample& sample, int p_r, int p, const Stamp& stamp, std::uint8_t active_faults = 0);
   /// End of input: waits for the running fit and publishes it. The open, partial
   /// window is fitted too when it covers at least two revolutions.
   void finish();
@@ -75,7 +78,7 @@ class LiveModelFit {
     std::string error;  ///< why the window could not be fitted ("" = fitted)
     std::optional<FittedModel> fitted;
   };
-  void start(DiscoveryInput window, const Stamp& stamp);
+  void start(DiscoveryInput window, const Stamp& stamp, std::vector<std::string> untrusted);
   void publish_ready(bool wait);
 
   ModelFitOptions options_;
@@ -83,6 +86,10 @@ class LiveModelFit {
   std::ostream& diagnostics_;
   bool realtime_;
   ModelWindow window_;
+  FaultCounts window_faults_{};     ///< samples of the open window under each fault
+  std::int64_t window_samples_ = 0;
+  /// The open window's lasting faults (DiscoveryOptions::untrusted_input); resets the counts.
+  std::vector<std::string> take_window_faults();
   Stamp last_stamp_;
   std::future<Result> running_;
   std::string last_error_;

@@ -451,6 +451,17 @@ class Overspeed(unittest.TestCase):
         self.assertIn("signal fault overspeed started", proc.stderr)
         self.assertIn("30000 r/min at 2000 Hz, p_r = 3", proc.stderr)
 
+    def test_live_model_fit_is_not_explained_once_the_fault_is_known(self):
+        # The aliased angle fits at the floor; the live fit must not call it explained.
+        # Health judges blocks of 0.1 s (200 samples here): windows that end before the
+        # first block is judged cannot know yet (a stated limit); every later one does.
+        _, _, lcmlog = replay_fast(case("overspeed_30000rpm.log"), "overspeed_fit")
+        fits = echo_messages(lcmlog, "--channel", "RESOLVER_MODEL_FIT")
+        judged = [m for m in fits if m["sample_index"] >= 200 and m["verdict"] != "insufficient_data"]
+        self.assertTrue(judged)
+        self.assertEqual({m["verdict"] for m in judged}, {"unexplained"})
+        self.assertIn("overspeed", judged[0]["reason"])
+
 
 class ExitCodes(unittest.TestCase):
     PROGRAMS = ["resolverd", "resolver-sim", "resolver-model", "resolver-echo", "resolver-accuracy"]

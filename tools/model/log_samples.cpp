@@ -105,19 +105,10 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
   return out;
 }
 
-std::vector<std::string> lasting_faults(const LogSamples& log, double share) {
-  std::vector<std::string> out;
-  if (log.health_samples <= 0) return out;
-  for (std::size_t i = 0; i < kSignalFaultCount; ++i) {
-    const auto f = static_cast<SignalFault>(i);
-    if (f == SignalFault::kStopped || f == SignalFault::kOutliers) continue;
-    const SignalFaultState& st = log.faults[i];
-    const double part = static_cast<double>(st.samples) / static_cast<double>(log.health_samples);
-    if (st.samples == 0 || part < share) continue;
-    out.push_back(fmt::format("{} for {} of {} samples ({:.0f} %) from {:.3g} s", fault_name(f), st.samples,
-                              log.health_samples, 100.0 * part, st.first_t));
-  }
-  return out;
+FaultCounts fault_counts(const LogSamples& log) {
+  FaultCounts c{};
+  for (std::size_t i = 0; i < kSignalFaultCount; ++i) c[i] = log.faults[i].samples;
+  return c;
 }
 
 }  // namespace resolver

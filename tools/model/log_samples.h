@@ -36,11 +36,8 @@ struct LogSamples {
   std::int64_t health_samples = 0;
 };
 
-/// The faults that held for at least `share` of the samples, worded for a note and
-/// for the verdict ("loss_of_signal for 9000 of 10000 samples (90 %) from 0.5 s").
-/// stopped and outliers are not among them: a standstill is motion, and outliers
-/// are discovery's own (kept out of the fit and reported there).
-[[nodiscard]] std::vector<std::string> lasting_faults(const LogSamples& log, double share);
+/// Samples each fault held for (lasting_faults(), signal_health.h, words them).
+[[nodiscard]] FaultCounts fault_counts(const LogSamples& log);
 
 struct LogReadOptions {
   std::optional<LogFormat> format;  ///< --format; nullopt: [input] format, else the extension

@@ -43,11 +43,6 @@
 
 namespace {
 
-/// Share of the samples a signal fault must hold for before the log cannot be
-/// "explained": a tenth, so one fault block of 0.1 s in a few seconds of bench
-/// (resolverd's [health] block_s) is a note, and a dead or clipped tenth is not.
-constexpr double kUntrustedFaultShare = 0.1;
-
 /// A one-line progress bar on stderr, shown only once a run has taken longer
 /// than 1.5 s (short logs stay quiet) and only when stderr is a terminal.
 /// RESOLVER_PROGRESS=1 shows it on a pipe or file too, =0 never;
@@ -280,10 +275,10 @@ int run(int argc, char** argv) {
                                                           : resolver::DirectionFilter::kBoth;
     options.prepare.moving_only = moving_only;
     options.prepare.reference_aligned = reference_aligned || config.bench.reference_aligned;
-    // Faults over a tenth of the log forbid "explained" (a transient fault of a block
-    // or two is noted, not fatal: its samples are a few percent of a bench run).
-    options.untrusted_input = resolver::lasting_faults(samples, kUntrustedFaultShare);
-    for (const std::string& f : resolver::lasting_faults(samples, 0.0)) {
+    // Faults over a tenth of the log forbid "explained"; shorter ones are notes.
+    const resolver::FaultCounts faults = resolver::fault_counts(samples);
+    options.untrusted_input = resolver::lasting_faults(faults, samples.health_samples, resolver::kUntrustedFaultShare);
+    for (const std::string& f : resolver::lasting_faults(faults, samples.health_samples, 0.0)) {
       samples.notes.push_back("signal health: " + f);
     }
     if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);

@@ -50,6 +50,21 @@ inline constexpr std::size_t kSignalFaultCount = 7;
 /// Stable names (health_t fault_name, run report, JSON): "loss_of_signal", ...
 [[nodiscard]] std::string_view fault_name(SignalFault fault);
 
+/// Share of a fit's samples a signal fault must hold for before the fit cannot be
+/// "explained" (resolver-model explain, resolverd's live model fit): a tenth, so one
+/// fault block of 0.1 s (block_s) in a few seconds of bench is a note, and a dead,
+/// clipped or aliased tenth is not.
+inline constexpr double kUntrustedFaultShare = 0.1;
+
+/// Samples each fault held for, over some span of samples.
+using FaultCounts = std::array<std::int64_t, kSignalFaultCount>;
+
+/// The faults that held for at least `share` of `total` samples, worded for a note and
+/// a verdict ("loss_of_signal for 9000 of 10000 samples (90 %)"). stopped and outliers
+/// are never among them: a standstill is motion, and outliers are discovery's own
+/// (kept out of the fit and reported there).
+[[nodiscard]] std::vector<std::string> lasting_faults(const FaultCounts& counts, std::int64_t total, double share);
+
 /// Thresholds. Defaults come from the physics of a 16-bit ADC bench; each says where from.
 struct SignalHealthConfig {
   /// [signal units, counts on the default layout] the largest |sin| or |cos| the ADC can

@@ -167,6 +167,7 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
   FitResult out;
   // Model columns only: candidates are evaluated at the model's solution later.
   std::vector<int> model_cols;
+  model_cols.reserve(static_cast<std::size_t>(design.columns()));
   for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) model_cols.push_back(j);
   const std::vector<int> nuisance_cols = model_cols;
   for (std::size_t i = 0; i < design.terms().size(); ++i) {

@@ -1,0 +1,113 @@
+#!/usr/bin/python3
+"""Scale (issue 15): resolver-model explain against log length, the default replay
+(live model fit on) against can-utils' log2asc, side by side in one run.
+
+Prints two tables (medians of --repeats runs, each under /usr/bin/time -v):
+
+  1. explain: peak RSS, wall time and bytes per sample for logs of a 10 kHz bench
+     (resolver-sim --sample-rate 10000, 200 r/min, alpha = 0.003) of each --minutes
+     length; a length whose projected RSS (from the shortest log's bytes per sample)
+     exceeds --max-rss-gb is not run and is printed as projected.
+  2. replay: resolverd --replay LOG --once --fast with the default config (the live
+     model fit on, every window fitted), the same with --baseline-bin (an older build,
+     to measure a change side by side), and log2asc on the same log; ratios are the
+     median of the per-repetition ratios, so a noisy neighbour slows both sides alike.
+
+Examples:
+  /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin
+  /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin --minutes 1 10 --baseline-bin ../old/build/bin
+"""
+import argparse
+import pathlib
+import statistics
+import subprocess
+import sys
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import replay_benchmark as rb  # noqa: E402  (its timed(), resolverd and log2asc runners)
+
+SAMPLE_RATE = 10000.0  # [Hz] the issue's bench
+FRAMES_PER_SECOND = 3 * SAMPLE_RATE + 10  # RESOLVER_SAMPLE, PHASE_CURRENTS, REFERENCE_ANGLE + BENCH_INFO at 10 Hz
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--bin", type=pathlib.Path, required=True)
+    p.add_argument("--baseline-bin", type=pathlib.Path, help="an older build's bin folder for the replay table")
+    p.add_argument("--minutes", type=float, nargs="+", default=[1.0, 10.0, 60.0], help="log lengths [min]")
+    p.add_argument("--replay-minutes", type=float, default=1.0, help="log length for the replay table [min]")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--max-rss-gb", type=float, default=16.0, help="do not run explain beyond this projected RSS")
+    p.add_argument("--work", type=pathlib.Path, default=pathlib.Path("/tmp/resolver-scale-bench"))
+    return p.parse_args()
+
+
+def make_log(args, minutes):
+    log = args.work / f"bench10k_{minutes:g}min.log"
+    if not log.exists():
+        cmd = [str(args.bin / "resolver-sim"), "--out", str(log), "--rpm", "200", "--duration", f"{minutes * 60:g}",
+               "--sample-rate", f"{SAMPLE_RATE:g}", "--effect", "amplitude_imbalance:alpha=0.003"]
+        print("generating: " + " ".join(cmd), flush=True)
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    return log
+
+
+def explain_table(args):
+    rows, per_sample = [], None
+    for minutes in sorted(args.minutes):
+        samples = SAMPLE_RATE * minutes * 60
+        if per_sample is not None and per_sample * samples > args.max_rss_gb * 1e9:
+            rows.append((minutes, samples, None, None, per_sample * samples / 1e6))
+            continue
+        log = make_log(args, minutes)
+        rb.warm_cache(log)
+        runs = [rb.timed([str(args.bin / "resolver-model"), "explain", str(log)]) for _ in range(args.repeats)]
+        wall = statistics.median(r[0] for r in runs)
+        rss_mb = statistics.median(r[1] for r in runs) / 1024
+        per_sample = per_sample or rss_mb * 1e6 / samples
+        rows.append((minutes, samples, wall, rss_mb, None))
+    print("\nresolver-model explain, 10 kHz bench (median of %d)" % args.repeats)
+    print("| log | samples | wall [s] | peak RSS [MB] | bytes/sample |")
+    print("|---|---|---|---|---|")
+    for minutes, samples, wall, rss, projected in rows:
+        if wall is None:
+            print(f"| {minutes:g} min | {samples:.3g} | not run | {projected:.0f} projected | - |")
+        else:
+            print(f"| {minutes:g} min | {samples:.3g} | {wall:.1f} | {rss:.0f} | {rss * 1e6 / samples:.0f} |")
+
+
+def replay_table(args):
+    log = make_log(args, args.replay_minutes)
+    frames = rb.count_lines(log)
+    rb.warm_cache(log)
+    tools = {"resolverd (live fit on)": args.bin}
+    if args.baseline_bin:
+        tools["baseline resolverd (live fit on)"] = args.baseline_bin
+    res = {name: [] for name in list(tools) + ["log2asc"]}
+    for _ in range(args.repeats):
+        for name, b in tools.items():
+            res[name].append(rb.run_resolverd(argparse.Namespace(bin=b, work=args.work), log, frames))
+        res["log2asc"].append(rb.run_log2asc(args, log, frames))
+    print(f"\nreplay of a {args.replay_minutes:g} min 10 kHz log ({frames} frames), median of {args.repeats}")
+    print("| program | frames/s | wall [s] | CPU [s] | peak RSS [MB] | x log2asc |")
+    print("|---|---|---|---|---|---|")
+    for name, runs in res.items():
+        ratio = statistics.median(l2["wall"] / r["wall"] for r, l2 in zip(runs, res["log2asc"]))
+        wall = statistics.median(r["wall"] for r in runs)
+        print(f"| {name} | {frames / wall / 1e6:.2f} M | {wall:.2f} | {statistics.median(r['cpu'] for r in runs):.2f} "
+              f"| {statistics.median(r['rss_kb'] for r in runs) / 1024:.0f} | {ratio:.2f} |")
+    if args.baseline_bin:
+        name = "baseline resolverd (live fit on)"
+        r = statistics.median(b["wall"] / a["wall"] for a, b in zip(res["resolverd (live fit on)"], res[name]))
+        print(f"\nresolverd vs baseline: {r:.2f}x faster (median of the per-repetition ratios)")
+
+
+def main():
+    args = parse_args()
+    args.work.mkdir(parents=True, exist_ok=True)
+    replay_table(args)
+    explain_table(args)
+
+
+if __name__ == "__main__":
+    main()
