@@ -108,6 +108,43 @@ class ServoProject(unittest.TestCase):
         self.assertGreater(ex["covers"]["fitted"], 20000)
 
 
+class BundledScopeSweep(unittest.TestCase):
+    """tools/examples/scope_sweep.csv (README): a 1X resolver out and back with standstills,
+    R/D angle and encoder in degrees as a scope prints them. Hidden: backlash h = 0.002 rad
+    and k3 = 0.0006 beside alpha = 0.004 (make_scope_sweep.py)."""
+    CSV = ("tools", "examples", "scope_sweep.csv")
+    CONFIG = ("tools", "examples", "scope_sweep.toml")
+
+    def test_bundled_file_is_what_the_script_makes(self):
+        out = os.path.join(ARGS.work, "scope_sweep.csv")
+        subprocess.run([sys.executable, repo("tools", "examples", "make_scope_sweep.py"),
+                        os.path.join(ARGS.bin, "resolver-sim"), out], check=True, capture_output=True)
+        with open(out, "rb") as a, open(repo(*self.CSV), "rb") as b:
+            self.assertEqual(a.read(), b.read())
+
+    def test_backlash_is_named_and_adding_it_reaches_the_floor(self):
+        ex = json.loads(model("explain", repo(*self.CSV), "--config", repo(*self.CONFIG), "--json").stdout)
+        self.assertEqual(ex["covers"]["reversals"], 1)
+        self.assertEqual(ex["covers"]["standstills"], 3)
+        self.assertEqual(ex["verdict"], "missing_effect")
+        self.assertEqual(ex["candidates"][0]["effect"], "backlash")
+        self.assertTrue(ex["candidates"][0]["reaches_floor"])
+        # The floor: the printed degrees (1e-4 deg) hide the converter's LSB and the angle
+        # holds exactly still at rest, so the moving samples give it: a 16-bit LSB at
+        # p_r = 1 is 9.6e-5 rad, LSB/sqrt(12) = 2.8e-5 rad; second differences see 3.4e-5.
+        pe = next(s for s in ex["signals"] if s["signal"] == "position_error")
+        self.assertGreater(pe["floor"], 2.0e-5)
+        self.assertLess(pe["floor"], 5.0e-5)
+        fit = json.loads(model("fit", repo(*self.CSV), "--config", repo(*self.CONFIG), "--json",
+                               "--effects", "amplitude_imbalance,backlash").stdout)
+        h = fit["params"]["backlash.h"]
+        self.assertLess(abs(h["value"] - 0.002), 5 * h["stderr"] + 1e-5)
+        self.assertEqual(fit["verdict"], "explained")
+        # Without sin/cos, k3 lands on 2 theta with alpha (Hanselman eq. 9): alpha - 2 k3.
+        alpha = fit["params"]["amplitude_imbalance.alpha"]
+        self.assertLess(abs(alpha["value"] - (0.004 - 2 * 0.0006)), 5 * alpha["stderr"] + 2e-5)
+
+
 def main():
     global ARGS
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -164,7 +164,13 @@ FloorEstimate choose(double second, double standstill, double quantization, std:
   f.quantization = quantization;
   f.standstill_samples = ss_samples;
   f.standstill = std::isnan(standstill) ? kNaN : std::sqrt(standstill * standstill + quantization * quantization);
-  if (use_standstill && f.standstill > 0.0) {
+  // A signal that holds exactly still at rest (a quantizer on one code, no visible
+  // noise) says nothing about the moving floor unless the quantum is known; when the
+  // quantum found is far below the moving samples' own noise (a scope export's print
+  // rounding hides the converter's LSB), the moving samples are the only evidence.
+  // (Exactly still: below a thousandth of the moving noise, the rounding of the sums.)
+  const bool silent_at_rest = standstill < 1e-3 * second && quantization < 0.25 * second;
+  if (use_standstill && f.standstill > 0.0 && !silent_at_rest) {
     f.chosen = f.standstill;
     f.source = "standstill";
   } else if (second > 0.0) {
@@ -203,10 +209,21 @@ double channel_quantum(std::span<const double> values) {
   std::sort(d.begin(), d.end());
   const double tiny = 1e-12 * range;
   double q = std::numeric_limits<double>::infinity();
+  // Distinct non-zero step sizes: with only one (a commanded angle, or a fine reference
+  // at a speed commensurate with the sample rate steps by exactly the same amount every
+  // sample) the step is the motion, not the quantizer, and the quantum is unknown.
+  double first_size = 0.0;
+  bool two_sizes = false;
   for (std::size_t i = 0; i < d.size(); ++i) {
-    if (std::abs(d[i]) > tiny) q = std::min(q, std::abs(d[i]));
+    const double a = std::abs(d[i]);
+    if (a > tiny) {
+      q = std::min(q, a);
+      if (first_size == 0.0) first_size = a;
+      else if (std::abs(a - first_size) > tiny) two_sizes = true;
+    }
     if (i > 0 && d[i] - d[i - 1] > tiny) q = std::min(q, d[i] - d[i - 1]);
   }
+  if (!two_sizes) return 0.0;
   return std::isfinite(q) && q > 1e-9 * range ? q : 0.0;
 }
 
