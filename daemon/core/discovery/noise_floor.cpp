@@ -1,8 +1,10 @@
 #include "daemon/core/discovery/noise_floor.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "daemon/core/angles.h"
 #include "daemon/core/model/normal_equations.h"
@@ -22,25 +24,27 @@ int nyquist_order(double omega_abs_max, double dt) {
   return std::clamp(n, 2, kSaturatedOrder);
 }
 
-/// [1, sin n a, cos n a (n <= order)] (+ sin/cos of theta_m, 2 theta_m).
-void saturated_basis(double a, double theta_m, int order, bool mech, Eigen::VectorXd& x) {
+/// [1, sin n a, cos n a (n <= kSaturatedOrder)], then sin/cos of theta_m and 2 theta_m.
+/// A bin's basis of order N is the first 1 + 2N entries and (mechanical) the last four.
+constexpr int kFullBasis = 1 + 2 * kSaturatedOrder + 4;
+using FullBasis = Eigen::Matrix<double, kFullBasis, 1>;
+
+void full_basis(double a, double theta_m, FullBasis& x) {
   const double s1 = std::sin(a), c1 = std::cos(a);
   double sn = s1, cn = c1;
   int j = 0;
   x[j++] = 1.0;
-  for (int n = 1; n <= order; ++n) {
+  for (int n = 1; n <= kSaturatedOrder; ++n) {
     x[j++] = sn;
     x[j++] = cn;
     const double next = sn * c1 + cn * s1;
     cn = cn * c1 - sn * s1;
     sn = next;
   }
-  if (mech) {
-    x[j++] = std::sin(theta_m);
-    x[j++] = std::cos(theta_m);
-    x[j++] = std::sin(2.0 * theta_m);
-    x[j++] = std::cos(2.0 * theta_m);
-  }
+  x[j++] = std::sin(theta_m);
+  x[j++] = std::cos(theta_m);
+  x[j++] = std::sin(2.0 * theta_m);
+  x[j++] = std::cos(2.0 * theta_m);
 }
 
 enum Sig { kRd, kSa, kSr, kD, kQ, kSigCount };
@@ -60,7 +64,12 @@ double value(const FitRow& r, int s) {
   }
 }
 
-/// Second-difference floor of each signal (NaN where not estimable).
+/// Second-difference floor of each signal (NaN where not estimable): per speed bin,
+/// the second differences of each signal regressed on the second differences of its
+/// angle harmonics up to what the bin's speed leaves below Nyquist (smooth structure
+/// out), pooled over the bins. One pass over the rows; each row's basis (of theta for
+/// the resolver's signals, theta_e for the currents) is computed once and shared by
+/// every signal and the row's three triplets.
 std::vector<double> second_difference_floors(std::span<const FitRow> rows, double dt, bool reference) {
   double wmax = 0.0;
   for (const FitRow& r : rows) {
@@ -72,34 +81,72 @@ std::vector<double> second_difference_floors(std::span<const FitRow> rows, doubl
     return std::clamp(static_cast<int>(std::abs(r.sig.omega) / wmax * kSpeedBins), 0, kSpeedBins - 1);
   };
   const double e_per_r = rows.empty() ? 1.0 : static_cast<double>(rows.front().sig.p) / rows.front().sig.p_r;
+  // Per bin and signal: the basis order, its width and the normal equations.
+  struct Cell {
+    int order = 0;
+    int k = 0;
+    bool mech = false;
+    std::optional<NormalEquations> ne;
+  };
+  std::vector<Cell> cells(static_cast<std::size_t>(kSpeedBins * kSigCount));
+  auto cell = [&](int b, int s) -> Cell& { return cells[static_cast<std::size_t>(b * kSigCount + s)]; };
   for (int b = 0; b < kSpeedBins; ++b) {
     const double bin_wmax = wmax * (b + 1) / kSpeedBins;
     for (int s = 0; s < kSigCount; ++s) {
       const bool electrical = s == kD || s == kQ;
-      const int order = nyquist_order(bin_wmax * (electrical ? e_per_r : 1.0), dt);
-      const bool mech = reference && !electrical;
-      const int k = 1 + 2 * order + (mech ? 4 : 0);
-      NormalEquations ne(k);
-      Eigen::VectorXd x0(k), x1(k), x2(k);
-      for (std::size_t i = 1; i + 1 < rows.size(); ++i) {
-        const FitRow& a = rows[i - 1];
-        const FitRow& m = rows[i];
-        const FitRow& c = rows[i + 1];
-        if (!a.fitted() || !m.fitted() || !c.fitted()) continue;
-        if (!has_sig(a, s) || !has_sig(m, s) || !has_sig(c, s)) continue;
-        if (bin_of(a) != b || bin_of(m) != b || bin_of(c) != b) continue;
-        if (c.sig.t - a.sig.t > 3.0 * dt) continue;  // consecutive samples only
-        auto angle = [&](const FitRow& r) { return electrical ? r.sig.theta_e : r.sig.theta; };
-        saturated_basis(angle(a), a.sig.theta_m, order, mech, x0);
-        saturated_basis(angle(m), m.sig.theta_m, order, mech, x1);
-        saturated_basis(angle(c), c.sig.theta_m, order, mech, x2);
-        ne.add(x2 - 2.0 * x1 + x0, value(c, s) - 2.0 * value(m, s) + value(a, s));
-      }
-      if (ne.n() < 4 * k) continue;
+      Cell& c = cell(b, s);
+      c.order = nyquist_order(bin_wmax * (electrical ? e_per_r : 1.0), dt);
+      c.mech = reference && !electrical;
+      c.k = 1 + 2 * c.order + (c.mech ? 4 : 0);
+      c.ne.emplace(c.k);
+    }
+  }
+  // Rolling bases of rows i-1, i, i+1 (index 0: theta, 1: theta_e).
+  std::array<std::array<FullBasis, 3>, 2> basis;
+  std::array<std::size_t, 3> basis_row{~std::size_t{0}, ~std::size_t{0}, ~std::size_t{0}};
+  auto basis_of = [&](std::size_t row, int slot) {
+    if (basis_row[static_cast<std::size_t>(slot)] != row) {
+      const FitRow& r = rows[row];
+      full_basis(r.sig.theta, r.sig.theta_m, basis[0][static_cast<std::size_t>(slot)]);
+      full_basis(r.sig.theta_e, r.sig.theta_m, basis[1][static_cast<std::size_t>(slot)]);
+      basis_row[static_cast<std::size_t>(slot)] = row;
+    }
+  };
+  Eigen::VectorXd x;
+  for (std::size_t i = 1; i + 1 < rows.size(); ++i) {
+    const FitRow& a = rows[i - 1];
+    const FitRow& m = rows[i];
+    const FitRow& c = rows[i + 1];
+    if (!a.fitted() || !m.fitted() || !c.fitted()) continue;
+    const int b = bin_of(m);
+    if (bin_of(a) != b || bin_of(c) != b) continue;
+    if (c.sig.t - a.sig.t > 3.0 * dt) continue;  // consecutive samples only
+    // Slots by row index mod 3: each row's basis is computed once while it is in the triplet.
+    const int sa = static_cast<int>((i - 1) % 3), sm = static_cast<int>(i % 3), sc = static_cast<int>((i + 1) % 3);
+    basis_of(i - 1, sa);
+    basis_of(i, sm);
+    basis_of(i + 1, sc);
+    for (int s = 0; s < kSigCount; ++s) {
+      if (!has_sig(a, s) || !has_sig(m, s) || !has_sig(c, s)) continue;
+      Cell& cl = cell(b, s);
+      const auto& bs = basis[(s == kD || s == kQ) ? 1 : 0];
+      const FullBasis d = bs[static_cast<std::size_t>(sc)] - 2.0 * bs[static_cast<std::size_t>(sm)] +
+                          bs[static_cast<std::size_t>(sa)];
+      x.resize(cl.k);
+      x.head(1 + 2 * cl.order) = d.head(1 + 2 * cl.order);
+      if (cl.mech) x.tail(4) = d.tail(4);
+      cl.ne->add(x, value(c, s) - 2.0 * value(m, s) + value(a, s));
+    }
+  }
+  for (int b = 0; b < kSpeedBins; ++b) {
+    for (int s = 0; s < kSigCount; ++s) {
+      Cell& cl = cell(b, s);
+      NormalEquations& ne = *cl.ne;
+      if (ne.n() < 4 * cl.k) continue;
       const Eigen::VectorXd coef = ne.m().completeOrthogonalDecomposition().solve(ne.b());
       // The differenced constant column is zero: k - 1 effective columns.
       sum[static_cast<std::size_t>(s)] += ne.rss(coef);
-      dof[static_cast<std::size_t>(s)] += 6.0 * static_cast<double>(ne.n() - (k - 1));
+      dof[static_cast<std::size_t>(s)] += 6.0 * static_cast<double>(ne.n() - (cl.k - 1));
     }
   }
   std::vector<double> out(kSigCount, kNaN);
