@@ -39,6 +39,7 @@ def parse_args():
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--max-rss-gb", type=float, default=16.0, help="do not run explain beyond this projected RSS")
     p.add_argument("--work", type=pathlib.Path, default=pathlib.Path("/tmp/resolver-scale-bench"))
+    p.add_argument("--skip-replay", action="store_true", help="only the explain table")
     return p.parse_args()
 
 
@@ -53,27 +54,24 @@ def make_log(args, minutes):
 
 
 def explain_table(args):
-    rows, per_sample = [], None
+    per_sample = None
+    print("\nresolver-model explain, 10 kHz bench (median of %d)" % args.repeats)
+    print("| log | samples | wall [s] | peak RSS [MB] | bytes/sample |")
+    print("|---|---|---|---|---|", flush=True)
     for minutes in sorted(args.minutes):
         samples = SAMPLE_RATE * minutes * 60
-        if per_sample is not None and per_sample * samples > args.max_rss_gb * 1e9:
-            rows.append((minutes, samples, None, None, per_sample * samples / 1e6))
+        # Projected from the largest log run so far, with 20 % margin (bytes per sample fall with length).
+        if per_sample is not None and 1.2 * per_sample * samples > args.max_rss_gb * 1e9:
+            print(f"| {minutes:g} min | {samples:.3g} | not run | {per_sample * samples / 1e6:.0f} projected | "
+                  f"{per_sample:.0f} |", flush=True)
             continue
         log = make_log(args, minutes)
         rb.warm_cache(log)
         runs = [rb.timed([str(args.bin / "resolver-model"), "explain", str(log)]) for _ in range(args.repeats)]
         wall = statistics.median(r[0] for r in runs)
         rss_mb = statistics.median(r[1] for r in runs) / 1024
-        per_sample = per_sample or rss_mb * 1e6 / samples
-        rows.append((minutes, samples, wall, rss_mb, None))
-    print("\nresolver-model explain, 10 kHz bench (median of %d)" % args.repeats)
-    print("| log | samples | wall [s] | peak RSS [MB] | bytes/sample |")
-    print("|---|---|---|---|---|")
-    for minutes, samples, wall, rss, projected in rows:
-        if wall is None:
-            print(f"| {minutes:g} min | {samples:.3g} | not run | {projected:.0f} projected | - |")
-        else:
-            print(f"| {minutes:g} min | {samples:.3g} | {wall:.1f} | {rss:.0f} | {rss * 1e6 / samples:.0f} |")
+        per_sample = rss_mb * 1e6 / samples
+        print(f"| {minutes:g} min | {samples:.3g} | {wall:.1f} | {rss_mb:.0f} | {per_sample:.0f} |", flush=True)
 
 
 def replay_table(args):
@@ -105,7 +103,8 @@ def replay_table(args):
 def main():
     args = parse_args()
     args.work.mkdir(parents=True, exist_ok=True)
-    replay_table(args)
+    if not args.skip_replay:
+        replay_table(args)
     explain_table(args)
 
 
