@@ -24,6 +24,7 @@ std::vector<Nuisance> nuisances_for(const PreparedLog& log) {
 
 std::vector<int> model_columns(const Design& design) {
   std::vector<int> out;
+  out.reserve(static_cast<std::size_t>(design.columns()));
   for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) out.push_back(j);
   for (std::size_t i = 0; i < design.terms().size(); ++i) {
     if (design.terms()[i].candidate) continue;

@@ -88,8 +88,10 @@ std::vector<double> second_difference_floors(std::span<const FitRow> rows, doubl
     bool mech = false;
     std::optional<NormalEquations> ne;
   };
-  std::vector<Cell> cells(static_cast<std::size_t>(kSpeedBins * kSigCount));
-  auto cell = [&](int b, int s) -> Cell& { return cells[static_cast<std::size_t>(b * kSigCount + s)]; };
+  std::vector<Cell> cells(static_cast<std::size_t>(kSpeedBins) * kSigCount);
+  auto cell = [&](int b, int s) -> Cell& {
+    return cells[static_cast<std::size_t>(b) * kSigCount + static_cast<std::size_t>(s)];
+  };
   for (int b = 0; b < kSpeedBins; ++b) {
     const double bin_wmax = wmax * (b + 1) / kSpeedBins;
     for (int s = 0; s < kSigCount; ++s) {
@@ -142,7 +144,7 @@ std::vector<double> second_difference_floors(std::span<const FitRow> rows, doubl
     for (int s = 0; s < kSigCount; ++s) {
       Cell& cl = cell(b, s);
       NormalEquations& ne = *cl.ne;
-      if (ne.n() < 4 * cl.k) continue;
+      if (ne.n() < 4 * static_cast<std::int64_t>(cl.k)) continue;
       const Eigen::VectorXd coef = ne.m().completeOrthogonalDecomposition().solve(ne.b());
       // The differenced constant column is zero: k - 1 effective columns.
       sum[static_cast<std::size_t>(s)] += ne.rss(coef);
