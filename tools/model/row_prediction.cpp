@@ -12,16 +12,18 @@ RowPredictor::RowPredictor(const PreparedLog& log, const Model& model) : model_(
   SignalValues sum, n;
   for (const FitRow& r : log.rows) {
     if (!r.fitted()) continue;
-    const SignalValues p = model_.predict(r.sig);
+    const SignalValues p = model_.predict_in_log_frame(r.sig);
     if (r.has(FitRow::kHasRd)) {
       sum.rd += r.y_rd - p.rd;
       n.rd += 1.0;
     }
     if (r.has(FitRow::kHasSc)) {
       sum.sa += r.y_sa - p.sa;
-      sum.sr += r.y_sr - p.sr;
+      // The amplitude scales the modelled radius (design.cpp, kScGain): least squares
+      // of y - r on the column 1 + r.
+      sum.sr += (r.y_sr - p.sr) * (1.0 + p.sr);
       n.sa += 1.0;
-      n.sr += 1.0;
+      n.sr += (1.0 + p.sr) * (1.0 + p.sr);
     }
     if (r.has(FitRow::kHasCur)) {
       sum.d += r.y_d - p.d;
@@ -39,8 +41,10 @@ RowPredictor::RowPredictor(const PreparedLog& log, const Model& model) : model_(
 }
 
 SignalValues RowPredictor::operator()(const FitRow& row) const {
-  SignalValues p = model_.predict(row.sig);
+  SignalValues p = model_.predict_in_log_frame(row.sig);
+  const double sr = p.sr + constants_.sr * (1.0 + p.sr);
   p += constants_;
+  p.sr = sr;
   return p;
 }
 

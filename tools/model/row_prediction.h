@@ -23,7 +23,7 @@ class RowPredictor {
   /// Effects + constants at `row`.
   [[nodiscard]] SignalValues operator()(const FitRow& row) const;
   /// The effects alone (what compensation subtracts).
-  [[nodiscard]] SignalValues effects(const FitRow& row) const { return model_.predict(row.sig); }
+  [[nodiscard]] SignalValues effects(const FitRow& row) const { return model_.predict_in_log_frame(row.sig); }
   /// The constants per signal (0 where the fit has none).
   [[nodiscard]] const SignalValues& constants() const { return constants_; }
 

@@ -149,7 +149,8 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
       group_n[0] = 1;
     }
     if (r.has(FitRow::kHasSc)) {
-      const double ea = r.y_sa - pred.sa - sa_offset, er = r.y_sr - pred.sr - sr_offset;
+      // The amplitude scales the modelled radius (design.cpp, kScGain).
+      const double ea = r.y_sa - pred.sa - sa_offset, er = r.y_sr - pred.sr - sr_offset * (1.0 + pred.sr);
       group_rss[1] = ea * ea + er * er;
       group_n[1] = 2;
     }

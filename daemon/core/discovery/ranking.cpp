@@ -79,6 +79,9 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
     const std::string_view name = e->name();
     if (name == "harmonics") {
       // Residual at order m of theta: K_{m+1} (same sign) or K_{m-1} opposite (m >= 3), K_0 / K_2 at m = 1.
+      // Each order alone (in phase with the fundamental, as Hanselman's K_n) and with
+      // its quadrature part (a harmonic with its own phase, as measured): the BIC
+      // and the simpler-first rule name the pair only where the phase is in the data.
       for (int m : significant_orders(fit.harmonics, fit.noise_floor_rad, n, 1)) {
         std::vector<std::string> params;
         if (m == 1) params = {"k2", "k0"};
@@ -88,6 +91,10 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
           if (i < 0 || in_model(spec, *e, i)) continue;
           const ModelTerm t{e, {i}};
           if (usable(t)) out.push_back(t);
+          const int q = p == "k0" ? -1 : find_param(*e, p + "_q");
+          if (q < 0 || in_model(spec, *e, q)) continue;
+          const ModelTerm with_phase{e, {i, q}};
+          if (usable(with_phase)) out.push_back(with_phase);
         }
       }
       continue;

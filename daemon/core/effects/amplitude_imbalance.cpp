@@ -62,6 +62,7 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
     }
     out.col(0) = envelope_column(b, dr * rd, 0.0, b.env_cos(1));
   }
+  [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double a = v[0];

@@ -230,6 +230,12 @@ class Effect {
   /// linear in this effect's parameters even if its own columns are (Gauss-Newton
   /// iterates).
   [[nodiscard]] virtual bool shapes_basis() const { return false; }
+  /// True when the effect's whole action is its windings() hook on the envelopes of
+  /// the seen angle (gain, quadrature, winding harmonics, offsets): the fit then
+  /// evaluates all such effects together, exactly through atan2 and hypot
+  /// (daemon/core/model/envelope_spectrum.h), and signature() serves only as their
+  /// first-order description (the registry's signature test, ranking at zero).
+  [[nodiscard]] virtual bool envelope_only() const { return false; }
 };
 
 /// The self-description every effect has, as data.

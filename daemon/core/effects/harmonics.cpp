@@ -12,7 +12,7 @@ namespace resolver {
 bool Harmonics::active() const {
   if (k0 != 0.0) return true;
   for (std::size_t n = 0; n < k.size(); ++n) {
-    if (k[n] != 0.0 || k_opp[n] != 0.0) return true;
+    if (k[n] != 0.0 || k_opp[n] != 0.0 || k_q[n] != 0.0 || k_opp_q[n] != 0.0) return true;
   }
   return false;
 }
@@ -20,12 +20,13 @@ bool Harmonics::active() const {
 SinCos harmonics_part(const Harmonics& p, double theta) {
   SinCos out{p.k0, p.k0};
   for (int n = 2; n <= Harmonics::kMaxOrder; ++n) {
-    const double kn = p.k[static_cast<std::size_t>(n)];
-    const double ko = p.k_opp[static_cast<std::size_t>(n)];
-    if (kn == 0.0 && ko == 0.0) continue;
+    const auto i = static_cast<std::size_t>(n);
+    const double kn = p.k[i], ko = p.k_opp[i], qn = p.k_q[i], qo = p.k_opp_q[i];
+    if (kn == 0.0 && ko == 0.0 && qn == 0.0 && qo == 0.0) continue;
     const double nt = static_cast<double>(n) * theta;
-    out.s += (kn + ko) * std::sin(nt);
-    out.c += (kn - ko) * std::cos(nt);
+    const double sn = std::sin(nt), cn = std::cos(nt);
+    out.s += (kn + ko) * sn + (qn + qo) * cn;
+    out.c += (kn - ko) * cn - (qn - qo) * sn;
   }
   return out;
 }
@@ -37,6 +38,10 @@ double harmonics_error(const Harmonics& p, double theta) {
     const double ko = p.k_opp[static_cast<std::size_t>(n)];
     if (kn != 0.0) eps -= kn * std::sin(static_cast<double>(n - 1) * theta);
     if (ko != 0.0) eps -= ko * std::sin(static_cast<double>(n + 1) * theta);
+    const double qn = p.k_q[static_cast<std::size_t>(n)];
+    const double qo = p.k_opp_q[static_cast<std::size_t>(n)];
+    if (qn != 0.0) eps -= qn * std::cos(static_cast<double>(n - 1) * theta);
+    if (qo != 0.0) eps -= qo * std::cos(static_cast<double>(n + 1) * theta);
   }
   return eps;
 }
@@ -48,17 +53,30 @@ constexpr int kOrders = Harmonics::kMaxOrder - 1;  // n = 2..kMaxOrder
 constexpr std::string_view kUnit = "[fraction of fundamental]";
 constexpr std::string_view kSame = "inductance harmonic K_n, same sign on both windings (Hanselman eq. 8)";
 constexpr std::string_view kOpp = "harmonic of opposite sign on the windings (odd nonlinearity)";
+constexpr std::string_view kSameQ = "quadrature part of K_n (its phase: K_n sin(n theta + phi))";
+constexpr std::string_view kOppQ = "quadrature part of the opposite-sign K_n";
 constexpr std::array<std::string_view, kOrders> kSameNames{"k2",  "k3",  "k4",  "k5",  "k6",  "k7",  "k8",
                                                            "k9",  "k10", "k11", "k12", "k13", "k14", "k15",
                                                            "k16", "k17", "k18", "k19", "k20"};
 constexpr std::array<std::string_view, kOrders> kOppNames{
     "k2_opp",  "k3_opp",  "k4_opp",  "k5_opp",  "k6_opp",  "k7_opp",  "k8_opp",  "k9_opp",  "k10_opp", "k11_opp",
     "k12_opp", "k13_opp", "k14_opp", "k15_opp", "k16_opp", "k17_opp", "k18_opp", "k19_opp", "k20_opp"};
+constexpr std::array<std::string_view, kOrders> kSameQNames{
+    "k2_q",  "k3_q",  "k4_q",  "k5_q",  "k6_q",  "k7_q",  "k8_q",  "k9_q",  "k10_q", "k11_q",
+    "k12_q", "k13_q", "k14_q", "k15_q", "k16_q", "k17_q", "k18_q", "k19_q", "k20_q"};
+constexpr std::array<std::string_view, kOrders> kOppQNames{
+    "k2_opp_q",  "k3_opp_q",  "k4_opp_q",  "k5_opp_q",  "k6_opp_q",  "k7_opp_q",  "k8_opp_q",
+    "k9_opp_q",  "k10_opp_q", "k11_opp_q", "k12_opp_q", "k13_opp_q", "k14_opp_q", "k15_opp_q",
+    "k16_opp_q", "k17_opp_q", "k18_opp_q", "k19_opp_q", "k20_opp_q"};
+/// Where each group of parameters starts (parameter order below).
+constexpr int kFirstSame = 1, kFirstOpp = 1 + kOrders, kFirstSameQ = 1 + 2 * kOrders, kFirstOppQ = 1 + 3 * kOrders;
+constexpr int kParamCount = 1 + 4 * kOrders;
 
-/// Parameter order: k0, k2..k20, k2_opp..k20_opp. Listed: the orders a bench
-/// meets most (k0..k5, k3_opp); the model names k3 when it names only "harmonics".
-constexpr std::array<ParamInfo, 1 + 2 * kOrders> make_params() {
-  std::array<ParamInfo, 1 + 2 * kOrders> out{};
+/// Parameter order: k0, k2..k20, k2_opp..k20_opp, k2_q..k20_q, k2_opp_q..k20_opp_q.
+/// Listed: the orders a bench meets most (k0..k5, k3_opp, k2_q..k5_q); the model
+/// names k3 when it names only "harmonics".
+constexpr std::array<ParamInfo, kParamCount> make_params() {
+  std::array<ParamInfo, kParamCount> out{};
   out[0] = ParamInfo{.name = "k0", .unit = kUnit, .description = "inductive DC component K_0 on both channels",
                      .min = -0.5, .max = 0.5, .default_fit = false};
   for (int i = 0; i < kOrders; ++i) {
@@ -69,6 +87,12 @@ constexpr std::array<ParamInfo, 1 + 2 * kOrders> make_params() {
     out[static_cast<std::size_t>(1 + kOrders + i)] =
         ParamInfo{.name = kOppNames[static_cast<std::size_t>(i)], .unit = kUnit, .description = kOpp,
                   .min = -0.5, .max = 0.5, .listed = n == 3, .default_fit = false};
+    out[static_cast<std::size_t>(kFirstSameQ + i)] =
+        ParamInfo{.name = kSameQNames[static_cast<std::size_t>(i)], .unit = kUnit, .description = kSameQ,
+                  .min = -0.5, .max = 0.5, .listed = n <= 5, .default_fit = false};
+    out[static_cast<std::size_t>(kFirstOppQ + i)] =
+        ParamInfo{.name = kOppQNames[static_cast<std::size_t>(i)], .unit = kUnit, .description = kOppQ,
+                  .min = -0.5, .max = 0.5, .listed = false, .default_fit = false};
   }
   return out;
 }
@@ -78,8 +102,11 @@ Harmonics from_values(Values v) {
   Harmonics h;
   h.k0 = v[0];
   for (int i = 0; i < kOrders; ++i) {
-    h.k[static_cast<std::size_t>(i + 2)] = v[static_cast<std::size_t>(1 + i)];
-    h.k_opp[static_cast<std::size_t>(i + 2)] = v[static_cast<std::size_t>(1 + kOrders + i)];
+    const auto n = static_cast<std::size_t>(i + 2);
+    h.k[n] = v[static_cast<std::size_t>(kFirstSame + i)];
+    h.k_opp[n] = v[static_cast<std::size_t>(kFirstOpp + i)];
+    h.k_q[n] = v[static_cast<std::size_t>(kFirstSameQ + i)];
+    h.k_opp_q[n] = v[static_cast<std::size_t>(kFirstOppQ + i)];
   }
   return h;
 }
@@ -99,9 +126,18 @@ class HarmonicsEffect final : public BasicEffect {
   [[nodiscard]] HarmonicOrders orders(std::span<const int> params) const override {
     // k0: 1 theta; k_n: (n - 1) theta in the angle, n theta in the envelopes; k_n_opp: (n + 1) theta.
     int top = 0;
-    for (int p : params) top = std::max(top, p == 0 ? 1 : (p <= kOrders ? p + 1 : p - kOrders + 2));
+    for (int p : params) {
+      if (p == 0) {
+        top = std::max(top, 1);
+        continue;
+      }
+      const int group = (p - 1) / kOrders;  // 0 same, 1 opposite, 2 same q, 3 opposite q
+      const int n = (p - 1) % kOrders + 2;
+      top = std::max(top, group % 2 == 0 ? n : n + 1);
+    }
     return {.theta = top};
   }
+  [[nodiscard]] bool envelope_only() const override { return true; }
   void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {
     if (stage != WindingStage::kAdditive) return;
     const SinCos h = harmonics_part(from_values(v), theta);
@@ -119,6 +155,10 @@ class HarmonicsEffect final : public BasicEffect {
           envelope_column(b, -b.rd_sin(n - 1), b.env_sin(n), b.env_cos(n));
       out.col(static_cast<std::size_t>(1 + kOrders + i)) =
           envelope_column(b, -b.rd_sin(n + 1), b.env_sin(n), -b.env_cos(n));
+      out.col(static_cast<std::size_t>(kFirstSameQ + i)) =
+          envelope_column(b, -b.rd_cos(n - 1), b.env_cos(n), -b.env_sin(n));
+      out.col(static_cast<std::size_t>(kFirstOppQ + i)) =
+          envelope_column(b, -b.rd_cos(n + 1), b.env_cos(n), b.env_sin(n));
     }
   }
 };

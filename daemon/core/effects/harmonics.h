@@ -9,6 +9,12 @@
 //   e.g. saturation x - a x^3 gives K_3_opp = a/4 ... of the fundamental):
 //     s += sum K_n_opp sin(n theta),            c -= sum K_n_opp cos(n theta)
 // (K_1 = 1 is the fundamental itself, so it is not a parameter.)
+// Each order has its own phase, as measured harmonics do: K_n sin(n theta + phi)
+// = K_n cos(phi) sin(n theta) + K_n sin(phi) cos(n theta), so every order has a
+// quadrature part K_n_q (k2_q .. k20_q, k2_opp_q .. k20_opp_q) beside its in-phase one:
+//     s += K_n_q cos(n theta),  c -= K_n_q sin(n theta)          (same sign)
+//     s += K_n_opp_q cos(n theta),  c += K_n_opp_q sin(n theta)  (opposite sign)
+//   eps ~= -K_n_q cos((n - 1) theta) - K_n_opp_q cos((n + 1) theta).
 // Signature, eps = theta - phi = sin(theta) dc - cos(theta) ds to first order:
 //   eps ~= -sqrt(2) K_0 cos(theta + pi/4) - sum K_n sin((n - 1) theta)   (Hanselman eq. 9)
 //          - sum K_n_opp sin((n + 1) theta)
@@ -32,6 +38,9 @@ struct Harmonics {
   std::array<double, kMaxOrder + 1> k{};
   /// [fraction of fundamental] opposite-sequence K_n at index n for n = 2..kMaxOrder.
   std::array<double, kMaxOrder + 1> k_opp{};
+  /// [fraction of fundamental] the quadrature parts of k and k_opp (header comment).
+  std::array<double, kMaxOrder + 1> k_q{};
+  std::array<double, kMaxOrder + 1> k_opp_q{};
 
   [[nodiscard]] bool active() const;
 };

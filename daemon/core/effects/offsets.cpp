@@ -30,6 +30,7 @@ class OffsetsEffect final : public BasicEffect {
                      "DC offsets on the demodulated envelopes: position error at 1x theta, envelopes shifted by a "
                      "constant"},
                     kParams, EffectStage::kWindings) {}
+  [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta = 1}; }
   void windings(Values v, WindingStage stage, double /*theta*/, SinCos& env) const override {
     if (stage == WindingStage::kOffset) env = apply_offsets(Offsets{v[0], v[1]}, env);

@@ -41,6 +41,7 @@ class QuadratureEffect final : public BasicEffect {
     const double th = b.env_angle();
     out.col(0) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + v[0]));
   }
+  [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double th = b.env_angle();

@@ -93,6 +93,7 @@ void Design::rebuild() {
   }
   columns_ = k;
   scratch_.resize(widest);
+  envelope_.valid = false;
 }
 
 std::vector<std::string> Design::column_names() const {
@@ -110,7 +111,8 @@ std::vector<std::string> Design::column_names() const {
 bool Design::nonlinear() const {
   for (const DesignTerm& t : terms_) {
     if (t.candidate) continue;
-    if (t.effect->shapes_basis()) return true;
+    // Envelope effects enter through atan2 and hypot (and with each other).
+    if (t.effect->shapes_basis() || t.effect->envelope_only()) return true;
     for (int p : t.params) {
       if (t.effect->params()[static_cast<std::size_t>(p)].nonlinear) return true;
     }
@@ -139,6 +141,7 @@ Eigen::VectorXd Design::z() const {
 }
 
 void Design::step(const Eigen::VectorXd& dz) {
+  envelope_.valid = false;
   const Eigen::VectorXd z0 = z();
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     DesignTerm& t = terms_[i];
@@ -182,9 +185,49 @@ std::vector<double> Design::values_with(std::size_t term, int column_in_term, do
   return v;
 }
 
+std::vector<EnvelopeMember> Design::envelope_members(std::size_t override_term,
+                                                     const std::vector<double>* override_values,
+                                                     std::size_t with_candidate) const {
+  std::vector<EnvelopeMember> out;
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    const bool override = override_values != nullptr && i == override_term;
+    if (!t.effect->envelope_only() || (t.candidate && !override && i != with_candidate)) continue;
+    out.push_back(EnvelopeMember{t.effect, override ? std::span<const double>(*override_values)
+                                                    : std::span<const double>(t.values)});
+  }
+  return out;
+}
+
+const Design::EnvelopeCache& Design::envelope() const {
+  if (envelope_.valid) return envelope_;
+  EnvelopeCache c;
+  const std::vector<EnvelopeMember> model = envelope_members(terms_.size(), nullptr, terms_.size());
+  c.series = envelope_series(model);
+  c.columns.resize(terms_.size());
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    if (!t.effect->envelope_only()) continue;
+    if (!t.candidate) c.model_terms.push_back(i);
+    // The column of a candidate is its derivative at the model's point: the model's
+    // members plus the candidate (at its neutral values: the envelopes unchanged).
+    const std::vector<EnvelopeMember> members =
+        t.candidate ? envelope_members(terms_.size(), nullptr, i) : model;
+    std::size_t member = 0;
+    while (members[member].values.data() != t.values.data()) ++member;
+    for (int p : t.params) {
+      c.columns[i].push_back(envelope_derivative_series(members, member, static_cast<std::size_t>(p)));
+    }
+  }
+  c.valid = true;
+  envelope_ = std::move(c);
+  return envelope_;
+}
+
 BasisTransform Design::transform(const SignatureRow& row, std::size_t extra_term,
                                  const std::vector<double>* extra_values) const {
   BasisTransform tr;
+  tr.shift = frame_shift_;
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = extra_values != nullptr && i == extra_term;
@@ -198,10 +241,17 @@ SignalValues Design::predict_with(const SignatureRow& row, AngleBasis& basis, st
                                   const std::vector<double>* override_values) const {
   basis.set(row, transform(row, override_term, override_values));
   SignalValues pred;
+  const bool envelope_override = override_values != nullptr && override_term < terms_.size() &&
+                                 terms_[override_term].effect->envelope_only();
+  // Every envelope effect at once, exactly (the cached series unless one is moved).
+  pred += envelope_override ? envelope_series(envelope_members(override_term, override_values, terms_.size()))
+                                  .at(basis)
+                            : envelope().series.at(basis);
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = override_values != nullptr && i == override_term;
     if (t.candidate && !override) continue;
+    if (t.effect->envelope_only()) continue;
     const std::vector<double>& v = override ? *override_values : t.values;
     if (!t.effect->linear_in_params()) {
       t.effect->contribution(row, basis, v, pred);
@@ -279,7 +329,10 @@ void Design::evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValu
     switch (n) {
       case Nuisance::kRdConstant: jac.rd[col] = 1.0; break;
       case Nuisance::kSaConstant: jac.sa[col] = 1.0; break;
-      case Nuisance::kScGain: jac.sr[col] = 1.0; break;
+      // The envelopes' amplitude scales the modelled radius: sr = g (1 + r) - 1 is
+      // exactly linear in g - 1 with the column 1 + r (an additive column would leave
+      // (g - 1) r: 5e-3 at alpha = 0.15, fifty times a 16-bit bench's floor).
+      case Nuisance::kScGain: jac.sr[col] = 1.0 + prediction.sr; break;
       case Nuisance::kIdConstant: jac.d[col] = 1.0; break;
       case Nuisance::kIqConstant: jac.q[col] = 1.0; break;
     }
@@ -289,6 +342,17 @@ void Design::evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValu
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const auto ps = t.effect->params();
+    if (t.effect->envelope_only()) {
+      // Exact derivatives of the joint envelope model (envelope_spectrum.h).
+      const std::vector<EnvelopeSeries>& d = envelope().columns[i];
+      for (std::size_t k = 0; k < t.params.size(); ++k, ++col) {
+        const SignalValues c = d[k].at(basis);
+        jac.rd[col] = c.rd;
+        jac.sa[col] = c.sa;
+        jac.sr[col] = c.sr;
+      }
+      continue;
+    }
     SignatureColumns cols(std::span<SignalValues>(scratch_.data(), ps.size()));
     cols.clear();
     t.effect->signature(row, basis, t.values, cols);

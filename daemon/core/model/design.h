@@ -6,6 +6,19 @@
 // linearisation point) and, for ranking, candidate terms (columns only, at their
 // neutral values, contributing nothing to the prediction).
 //
+// Envelope effects (Effect::envelope_only) are evaluated together and exactly
+// (envelope_spectrum.h): their prediction is the exact atan2/hypot of the modelled
+// envelopes and their columns the exact derivatives at the current point, so a
+// Gauss-Newton fit relinearised to convergence is the exact least-squares fit at
+// any magnitude, cross terms between effects included.
+//
+// The frame shift [rad, resolver electrical] is where the sensor's zero sits in the
+// frame of the fit's true angle (an unaligned reference's zero, or the self-
+// calibration's): the windings' errors are functions of the sensor's own angle, so
+// every basis turns by it (BasisTransform::shift). The fit takes it from the solved
+// position-error constant each pass (fit_design), so the parameters do not depend
+// on the reference's zero.
+//
 // Internal coordinates z (what Gauss-Newton moves): a linear parameter is its
 // value; a nonlinear one with FitScale::kInverseSquare is 1/value^2 (0 = neutral);
 // a polar pair is its Cartesian pair (effect.h). Linear parameters' Jacobian
@@ -19,6 +32,7 @@
 #include <vector>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/model/envelope_spectrum.h"
 #include "daemon/core/model/fit_row.h"
 #include "daemon/core/model/model_spec.h"
 
@@ -59,7 +73,14 @@ class Design {
   [[nodiscard]] int columns() const { return columns_; }
   [[nodiscard]] const std::vector<Nuisance>& nuisances() const { return nuisances_; }
   [[nodiscard]] const std::vector<DesignTerm>& terms() const { return terms_; }
-  [[nodiscard]] std::vector<DesignTerm>& terms() { return terms_; }
+  /// Mutable terms (the cached envelope series is recomputed on next use).
+  [[nodiscard]] std::vector<DesignTerm>& terms() {
+    envelope_.valid = false;
+    return terms_;
+  }
+  /// [rad, resolver electrical] the sensor's zero in the fit's frame (header comment).
+  [[nodiscard]] double frame_shift() const { return frame_shift_; }
+  void set_frame_shift(double shift) { frame_shift_ = shift; }
   /// "nuisance.sr_gain", "amplitude_imbalance.alpha", "eccentricity.e_x" ... per column.
   [[nodiscard]] std::vector<std::string> column_names() const;
   /// First column of term i.
@@ -95,13 +116,27 @@ class Design {
   [[nodiscard]] SignalValues predict_with(const SignatureRow& row, AngleBasis& basis, std::size_t override_term,
                                           const std::vector<double>* override_values) const;
   void rebuild();
+  /// The envelope terms' joint series and every envelope column's derivative series
+  /// at the current values (computed on first use after a change).
+  struct EnvelopeCache {
+    bool valid = false;
+    std::vector<std::size_t> model_terms;  ///< indices of non-candidate envelope terms
+    EnvelopeSeries series;                 ///< the model's e(phi), r(phi)
+    std::vector<std::vector<EnvelopeSeries>> columns;  ///< [term][k]: d/d(param k), empty for other terms
+  };
+  const EnvelopeCache& envelope() const;
+  [[nodiscard]] std::vector<EnvelopeMember> envelope_members(std::size_t override_term,
+                                                             const std::vector<double>* override_values,
+                                                             std::size_t with_candidate) const;
   void evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const;
 
   std::vector<Nuisance> nuisances_;
   std::vector<DesignTerm> terms_;
   std::vector<int> term_first_;
   int columns_ = 0;
+  double frame_shift_ = 0.0;
   mutable std::vector<SignalValues> scratch_;
+  mutable EnvelopeCache envelope_;
 };
 
 /// Internal coordinate of parameter `p` at `value` and back (design.h header).

@@ -151,6 +151,22 @@ double cost_at(const PassStatistics& s, const GroupFloors& floors, std::span<con
   return c;
 }
 
+/// [rad] a change of the frame shift that no longer matters: its effect on a
+/// harmonic error of 0.1 rad is 1e-11 rad, far below any floor.
+constexpr double kShiftSettled = 1e-10;
+
+/// The column of the position-error constant the frame shift follows: the sin/cos
+/// angle's where the log has it (the windings' own frame), else the R/D angle's; -1
+/// when the reference is aligned (no constant: mounting_offset is a parameter).
+int frame_constant_column(const Design& d) {
+  int rd = -1;
+  for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
+    if (d.nuisances()[j] == Nuisance::kSaConstant) return static_cast<int>(j);
+    if (d.nuisances()[j] == Nuisance::kRdConstant) rd = static_cast<int>(j);
+  }
+  return rd;
+}
+
 /// True when every term's prediction is linear in its fitted parameters: one pass solves it.
 bool strictly_linear(const Design& d) {
   for (const DesignTerm& t : d.terms()) {
@@ -177,6 +193,7 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     }
   }
   const bool linear = strictly_linear(design);
+  const int zero_col = linear ? -1 : frame_constant_column(design);
   double lambda = 0.0;
   double cost = std::numeric_limits<double>::infinity();
   Design last_good = design;
@@ -209,7 +226,11 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     // Judged on the undamped step: a damped one is small because of the damping
     // (and damps the nuisance constants the report takes from it), not because the
     // point is the solution.
-    if (pass > 0 && here - sol.rss_w <= tolerance) {
+    // The sensor's zero in the fit's frame is minus the solved position-error
+    // constant (design.h): the next pass turns every basis by it.
+    const double shift = zero_col >= 0 ? -sol.dz[zero_col] : design.frame_shift();
+    const bool shift_settled = std::abs(shift - design.frame_shift()) <= kShiftSettled;
+    if (pass > 0 && shift_settled && here - sol.rss_w <= tolerance) {
       const StepSolution free = lambda > 0.0 ? solve_step(stats.all, floors, model_cols, 0.0) : sol;
       if (free.ok && here - free.rss_w <= tolerance) {
         out.last = free;
@@ -221,6 +242,7 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     out.last = sol;
     out.stats = std::move(stats);
     design.step(sol.dz);
+    design.set_frame_shift(shift);
     if (linear) {
       // One linearised step is exact; the statistics move with it (RSS(dz) above).
       out.ok = true;

@@ -45,7 +45,11 @@ std::vector<ModelParameter> Model::parameters() const {
   return out;
 }
 
-Design Model::design(std::vector<Nuisance> nuisances) const { return Design(spec_, values_, std::move(nuisances)); }
+Design Model::design(std::vector<Nuisance> nuisances) const {
+  Design d(spec_, values_, std::move(nuisances));
+  d.set_frame_shift(frame_shift_);
+  return d;
+}
 
 void Model::take_values(const Design& design) {
   std::size_t i = 0;
@@ -54,6 +58,7 @@ void Model::take_values(const Design& design) {
     if (i < values_.size()) values_[i] = t.values;
     ++i;
   }
+  frame_shift_ = design.frame_shift();
   scratch_valid_ = false;
 }
 
@@ -65,6 +70,19 @@ SignalValues Model::predict(const SignatureRow& row) const {
   AngleBasis basis;
   FitRow r;
   r.sig = row;
+  scratch_.set_frame_shift(0.0);
+  return scratch_.predict(r, basis);
+}
+
+SignalValues Model::predict_in_log_frame(const SignatureRow& row) const {
+  if (!scratch_valid_) {
+    scratch_ = design({});
+    scratch_valid_ = true;
+  }
+  AngleBasis basis;
+  FitRow r;
+  r.sig = row;
+  scratch_.set_frame_shift(frame_shift_);
   return scratch_.predict(r, basis);
 }
 

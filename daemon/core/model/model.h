@@ -50,8 +50,14 @@ class Model {
   /// Takes the model terms' values from a fitted design (same spec).
   void take_values(const Design& design);
 
-  /// The model's prediction of every signal at a row of true angles.
+  /// The model's prediction of every signal at a row of the sensor's own angles
+  /// (compensation, the exported table).
   [[nodiscard]] SignalValues predict(const SignatureRow& row) const;
+  /// The same at a row of the fitted log's true angles (its reference's frame:
+  /// the sensor's zero sits at frame_shift() there; design.h).
+  [[nodiscard]] SignalValues predict_in_log_frame(const SignatureRow& row) const;
+  /// [rad, resolver electrical] the sensor's zero in the fitted log's frame.
+  [[nodiscard]] double frame_shift() const { return frame_shift_; }
   /// True when some term changes the R/D or sin/cos angle (compensation has work to do).
   [[nodiscard]] bool has_angle_terms() const;
   [[nodiscard]] bool empty() const { return spec_.terms.empty(); }
@@ -63,6 +69,7 @@ class Model {
   int p_r_ = 1, p_ = 1;
   std::vector<std::vector<double>> values_;
   std::vector<double> std_errors_;
+  double frame_shift_ = 0.0;
   std::shared_ptr<const CustomEffects> customs_;
   mutable Design scratch_;
   mutable bool scratch_valid_ = false;

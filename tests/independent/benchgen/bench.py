@@ -39,6 +39,7 @@ class BenchConfig:
     seed: int = 1
     effects: EffectSet = field(default_factory=EffectSet)
     drive_angle: str = "reference"  # "reference" | "rd" (currents.py)
+    ref_zero: float = 0.0  # [rad mech] the reference encoder reads theta_m - ref_zero
     start_angle: float = 0.0  # theta_m(0) [rad]
     rd_bits: int = 16  # R/D resolution when no quantization effect is given
     two_sensors: bool = False  # i_c = -(i_a + i_b) from the measured a, b
@@ -167,6 +168,6 @@ def simulate(config):
     _apply_stuck(config, samples, channels)
     samples.sin, samples.cos = channels["sin"], channels["cos"]
     samples.rd_code = channels["rd"]
-    samples.ref_angle = np.mod(channels["ref"], TWO_PI)
+    samples.ref_angle = np.mod(channels["ref"] - config.ref_zero, TWO_PI)
     samples.i_a, samples.i_b, samples.i_c = channels["i_a"], channels["i_b"], channels["i_c"]
     return samples

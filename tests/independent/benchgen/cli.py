@@ -56,6 +56,8 @@ def build_parser():
     bench.add_argument("--id", type=float, default=0.0, help="commanded d current [A] (0)")
     bench.add_argument("--drive-angle", choices=("reference", "rd"), default="reference",
                        help="drive frame: p theta_m + theta_0 (reference, default) or from the R/D angle (rd)")
+    bench.add_argument("--ref-zero", type=float, default=0.0,
+                       help="the reference encoder's zero against the rotor's [mech deg] (0): ref = theta_m - zero")
     bench.add_argument("--two-current-sensors", action="store_true", help="report i_c = -(i_a + i_b)")
     bench.add_argument("-e", "--effect", action="append", default=[], metavar="SPEC",
                        help="name:param=value,... (repeatable; --list-effects)")
@@ -149,7 +151,8 @@ def main(argv=None):
     config = BenchConfig(profile=profile_text, sample_rate=args.sample_rate, p_r=args.p_r, p=args.p,
                          amplitude=args.amplitude, i_d=args.id, i_q=args.iq, seed=args.seed, effects=effects,
                          drive_angle=args.drive_angle, start_angle=np.deg2rad(args.start_angle),
-                         rd_bits=args.rd_bits, two_sensors=args.two_current_sensors)
+                         rd_bits=args.rd_bits, two_sensors=args.two_current_sensors,
+                         ref_zero=np.deg2rad(args.ref_zero))
     samples = simulate(config)
     start_us = int(round(args.start_time * 1e6))
     outputs = {}

@@ -41,6 +41,11 @@ def _harmonic_params():
                for n in range(2, 21)]
     params += [Param(f"k{n}_opp", "1", 0.0, -0.5, 0.5, f"s += K sin({n} theta), c -= K cos({n} theta)")
                for n in range(2, 21)]
+    # Measured harmonics have their own phase: K sin(n theta + phase), K cos(n theta + phase).
+    params += [Param(f"k{n}_phase", "rad", 0.0, -7.0, 7.0, f"phase of K_{n} (both windings)")
+               for n in range(2, 21)]
+    params += [Param(f"k{n}_opp_phase", "rad", 0.0, -7.0, 7.0, f"phase of K_{n}_opp (both windings)")
+               for n in range(2, 21)]
     return tuple(params)
 
 

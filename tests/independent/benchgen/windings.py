@@ -20,8 +20,10 @@ class Windings:
         self.o_c = effects.param("offsets", "o_c")
         harm = effects.get("harmonics") or {}
         self.k0 = harm.get("k0", 0.0)
-        self.same = [(n, harm[f"k{n}"]) for n in range(2, 21) if harm.get(f"k{n}", 0.0)]
-        self.opposite = [(n, harm[f"k{n}_opp"]) for n in range(2, 21) if harm.get(f"k{n}_opp", 0.0)]
+        self.same = [(n, harm[f"k{n}"], harm.get(f"k{n}_phase", 0.0))
+                     for n in range(2, 21) if harm.get(f"k{n}", 0.0)]
+        self.opposite = [(n, harm[f"k{n}_opp"], harm.get(f"k{n}_opp_phase", 0.0))
+                         for n in range(2, 21) if harm.get(f"k{n}_opp", 0.0)]
         self.speed_k = effects.param("speed_gain", "k")
         self.steps = effects.all("temperature_step")
 
@@ -29,12 +31,12 @@ class Windings:
         """(s, c) at resolver electrical angle theta [rad], time t [s], speed omega [rad/s]."""
         s = np.sin(theta) + self.k0
         c = np.cos(theta + self.beta) + self.k0
-        for n, k in self.same:
-            s = s + k * np.sin(n * theta)
-            c = c + k * np.cos(n * theta)
-        for n, k in self.opposite:
-            s = s + k * np.sin(n * theta)
-            c = c - k * np.cos(n * theta)
+        for n, k, ph in self.same:
+            s = s + k * np.sin(n * theta + ph)
+            c = c + k * np.cos(n * theta + ph)
+        for n, k, ph in self.opposite:
+            s = s + k * np.sin(n * theta + ph)
+            c = c - k * np.cos(n * theta + ph)
         cos_gain = 1.0 + self.alpha + self.alpha_rate * t
         if self.speed_k:
             cos_gain = cos_gain * (1.0 + self.speed_k * np.abs(omega))

@@ -1,0 +1,220 @@
+#!/usr/bin/env python3
+"""Exact models at real-sensor magnitudes (issue 21), through the real programs.
+
+Real sensors carry gain errors of 3-13 %, degrees of quadrature, offsets and winding
+harmonics of a few percent with their own phases. For each hidden set (singly and in
+pairs) at each magnitude (1, 5, 10, 15 %), on logs of resolver-sim and of the independent
+tests/independent/benchgen.py (its own parameterisation: K sin(n theta + phase)):
+
+  named     the user's loop from the seed model (explain, add the first candidate, explain
+            again; at most 3 steps) ends `explained` with exactly the hidden effects (the
+            alpha-only case: the seed model is `explained` and proposes nothing);
+  floor     `fit --effects <the hidden set>` is `explained` with every signal's residual
+            <= 1.2x its noise floor, in-sample and held back;
+  coverage  the 95 % intervals (value +- 1.96 standard errors) cover the truth; over
+            --seeds N seeds per case the share must lie in the binomial band of 95 %
+            (two-sided 99.9 %: 0.95 +- 3.3 sqrt(0.95 0.05 / (N x params))).
+
+  run_magnitude_sweep.py --bin BUILD/bin --work DIR [--cases a,b] [--magnitudes 0.05,0.15]
+                         [--generators sim,benchgen] [--seeds N] [--table]
+
+Prints one row per case and magnitude (named, residual / floor, coverage) and exits 1 when
+a check fails. The ctest subset runs one seed of a few cases; the whole table is the
+script's (docs/ACCURACY.md).
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BENCHGEN = os.path.join(REPO, "tests", "independent", "benchgen.py")
+SYSTEM_PYTHON = "/usr/bin/python3"
+LIMIT = 1.2  # issue 21: the right model reaches 1.2x its floor at every magnitude
+Z95 = 1.959964
+MAGNITUDES = (0.01, 0.05, 0.10, 0.15)
+NOISE = "noise:sigma_sc=2,sigma_i=0.02"  # resolver-sim's default noise, given to both generators
+# [counts] below the generators' 26000: a 15 % gain with a 15 % harmonic peaks at 1.3x.
+AMPLITUDE = 20000
+BASE_ALPHA = 0.003  # every log but the alpha cases keeps the demo's small imbalance
+PHASE2, PHASE3 = 0.7, -1.1  # [rad] the harmonics' own phases
+
+
+def _harmonic(n, m, phase):
+    """(sim spec, benchgen spec, truth) of a same-sequence K_n of size m with a phase."""
+    kc, ks = m * math.cos(phase), m * math.sin(phase)
+    return (f"harmonics:k{n}={kc:.10g},k{n}_q={ks:.10g}", f"harmonics:k{n}={m:.10g},k{n}_phase={phase:.10g}",
+            {f"harmonics.k{n}": kc, f"harmonics.k{n}_q": ks}, f"harmonics(k{n},k{n}_q)")
+
+
+def effects_of(case, m):
+    """(sim specs, benchgen specs, truth {param: value}, model references) of a case."""
+    parts = case.split("+")
+    sim, bg, truth, refs = [], [], {}, ["amplitude_imbalance"]
+    alpha = m if "alpha" in parts else BASE_ALPHA
+    sim.append(f"amplitude_imbalance:alpha={alpha:.10g}")
+    truth["amplitude_imbalance.alpha"] = alpha
+    for p in parts:
+        if p == "alpha":
+            continue
+        if p == "beta":
+            spec = f"quadrature:beta={m:.10g}"
+            sim.append(spec)
+            bg.append(spec)
+            truth["quadrature.beta"] = m
+            refs.append("quadrature")
+        elif p == "offsets":
+            spec = f"offsets:o_s={m:.10g},o_c={-0.6 * m:.10g}"
+            sim.append(spec)
+            bg.append(spec)
+            truth["offsets.o_s"] = m
+            truth["offsets.o_c"] = -0.6 * m
+            refs.append("offsets")
+        elif p in ("k2", "k3"):
+            n = int(p[1])
+            s, b, t, r = _harmonic(n, m, PHASE2 if n == 2 else PHASE3)
+            sim.append(s)
+            bg.append(b)
+            truth.update(t)
+            refs.append(r)
+        else:
+            sys.exit(f"unknown case part {p}")
+    bg.insert(0, sim[0])
+    return sim, bg, truth, refs
+
+
+def run(cmd):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode not in (0,):
+        raise RuntimeError(f"{' '.join(cmd)} exited {p.returncode}\n{p.stderr[-2000:]}")
+    return p.stdout
+
+
+def generate(generator, bin_dir, log, specs, seed, args):
+    common = ["--out", log, "--seed", str(seed), "--rpm", str(args.rpm), "--duration", str(args.duration),
+              "--p-r", "3", "--amplitude", str(AMPLITUDE), "-e", NOISE]
+    for s in specs:
+        common += ["-e", s]
+    if generator == "sim":
+        # resolver-sim's R/D loop (omega_n = 3000 rad/s) is a hidden effect of its own here.
+        run([os.path.join(bin_dir, "resolver-sim")] + common + ["-e", "tracking_loop:omega_n=0"])
+    else:
+        run([SYSTEM_PYTHON, BENCHGEN] + common)
+
+
+def explain(bin_dir, log, refs):
+    out = run([os.path.join(bin_dir, "resolver-model"), "explain", log, "--json", "--reference-aligned",
+               "--effects", ",".join(refs)])
+    return json.loads(out)
+
+
+def worst_ratio(ex):
+    worst = 0.0
+    for s in ex["signals"]:
+        worst = max(worst, s["rms"] / s["floor"], s["held_back_rms"] / s["floor"])
+    return worst
+
+
+def loop(bin_dir, log, refs_wanted):
+    """The user's loop from the seed model: returns (model references, final explain)."""
+    refs = ["amplitude_imbalance"]
+    ex = explain(bin_dir, log, refs)
+    for _ in range(3):
+        if ex["verdict"] == "explained" or not ex["candidates"]:
+            break
+        refs.append(ex["candidates"][0]["effect"])
+        ex = explain(bin_dir, log, refs)
+    return refs, ex
+
+
+def one(generator, bin_dir, work, case, m, seed, args, named_too):
+    sim, bg, truth, refs = effects_of(case, m)
+    log = os.path.join(work, f"{generator}_{case}_{m:g}_{seed}.log")
+    generate(generator, bin_dir, log, sim if generator == "sim" else bg, seed, args)
+    result = {}
+    if named_too:
+        found, ex = loop(bin_dir, log, refs)
+        result["named"] = ex["verdict"] == "explained" and sorted(found) == sorted(refs)
+        result["loop"] = found
+    fit = explain(bin_dir, log, refs)
+    result["verdict"] = fit["verdict"]
+    result["ratio"] = worst_ratio(fit)
+    covered, total, worst_z = 0, 0, 0.0
+    for name, value in truth.items():
+        p = fit["params"].get(name)
+        if p is None or p["stderr"] is None or not p["stderr"] > 0:
+            total += 1
+            continue
+        z = abs(p["value"] - value) / p["stderr"]
+        worst_z = max(worst_z, z)
+        covered += z <= Z95
+        total += 1
+    result["covered"], result["total"], result["worst_z"] = covered, total, worst_z
+    return result
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--cases", default="alpha,beta,offsets,k2,k3,alpha+beta,alpha+offsets,alpha+k3")
+    ap.add_argument("--magnitudes", default=",".join(f"{m:g}" for m in MAGNITUDES))
+    ap.add_argument("--generators", default="sim,benchgen")
+    ap.add_argument("--seeds", type=int, default=1, help="seeds per case for the coverage (1)")
+    # Not a round 300 r/min: there 2 kHz gives exactly 400/3 samples per electrical turn, the
+    # 16-bit R/D quantization error repeats every 3 turns, is no longer noise and biases the
+    # harmonics by ~5 standard errors in every seed alike (measured: alpha, k2 at +4.9..+7.0
+    # sigma over 3 seeds at 300 r/min, -0.6..+0.1 sigma at 301.37). A real bench's speed
+    # ripple dithers it.
+    ap.add_argument("--rpm", type=float, default=301.37)
+    ap.add_argument("--duration", type=float, default=2.0)
+    args = ap.parse_args()
+    os.makedirs(args.work, exist_ok=True)
+    failures = []
+    print(f"{'generator':9} {'case':14} {'size':>5} {'named':>6} {'verdict':>10} {'res/floor':>9} "
+          f"{'coverage':>9} {'max |z|':>7}  loop")
+    for generator in args.generators.split(","):
+        for case in args.cases.split(","):
+            for m in (float(x) for x in args.magnitudes.split(",")):
+                rows = []
+                for seed in range(1, args.seeds + 1):
+                    try:
+                        rows.append(one(generator, args.bin, args.work, case, m, seed, args, seed == 1))
+                    except RuntimeError as e:
+                        failures.append(f"{generator} {case} {m:g} seed {seed}: {e}")
+                        break
+                if not rows:
+                    continue
+                first = rows[0]
+                covered = sum(r["covered"] for r in rows)
+                total = sum(r["total"] for r in rows)
+                ratio = max(r["ratio"] for r in rows)
+                explained = all(r["verdict"] == "explained" for r in rows)
+                print(f"{generator:9} {case:14} {m:5.2f} {str(first['named']):>6} "
+                      f"{'explained' if explained else 'NO':>10} {ratio:9.2f} {covered:4d}/{total:<4d} "
+                      f"{max(r['worst_z'] for r in rows):7.2f}  {','.join(first['loop'])}", flush=True)
+                tag = f"{generator} {case} {m:g}"
+                if not first["named"]:
+                    failures.append(f"{tag}: the loop from the seed model ended at {first['loop']}")
+                if not explained or ratio > LIMIT:
+                    failures.append(f"{tag}: the true model is not explained at <= {LIMIT}x its floor ({ratio:.2f}x)")
+                if args.seeds == 1:
+                    # One seed: every parameter within 4 standard errors (1 in 16000 by chance).
+                    if max(r["worst_z"] for r in rows) > 4.0:
+                        failures.append(f"{tag}: a parameter {first['worst_z']:.1f} standard errors from the truth")
+                elif total > 0:
+                    share = covered / total
+                    band = 3.29 * math.sqrt(0.95 * 0.05 / total)
+                    if abs(share - 0.95) > band:
+                        failures.append(f"{tag}: coverage {share:.3f} outside 0.95 +- {band:.3f}")
+    if failures:
+        print("\nFAILED:\n  " + "\n  ".join(failures))
+        return 1
+    print("\nall checks passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
