@@ -78,13 +78,18 @@ K5_K3OPP = (
     "its odd-nonlinearity sibling); at p_r = 1 mechanical order 4 too; only sin/cos (K at 5 "
     "theta vs 3 theta on the envelopes) tell them apart")
 ECC_OFFSETS_P1 = (
-    "with p_r = 1 eccentricity's 1x mechanical error is at 1 theta, like offsets in the angle; "
-    "without sin/cos nothing tells them apart")
+    "with p_r = 1 eccentricity's 1x mechanical error is at 1 theta, like offsets in the angle, and so is "
+    "K_2 with its phase (K_2 sin(2 theta + phi) lands on 1 theta: Hanselman eq. 9); without sin/cos nothing "
+    "tells them apart")
+B2_K3Q_P1 = (
+    "at p_r = 1 the cos part b2 of the 2nd mechanical order puts -b2 cos 2theta on the angle, and K_3's "
+    "quadrature part k3_q puts -k3_q cos 2theta there too (harmonics.h); only the radius of sin/cos tells them "
+    "apart, and this log has none")
 
 HIDDEN = {h.key: h for h in [
     _h("quadrature", "quadrature:beta=0.002", ["quadrature"], ["quadrature.beta"], MOVING_WINDING),
     _h("offsets", "offsets:o_s=0.001,o_c=-0.0015", ["offsets"], ["offsets.o_s", "offsets.o_c"], MOVING_WINDING,
-       {"angle1": (("eccentricity",), ECC_OFFSETS_P1)}),
+       {"angle1": (("eccentricity", "harmonics(k2,k2_q)"), ECC_OFFSETS_P1)}),
     _h("k3", "harmonics:k3=0.001", ["harmonics(k3)", "harmonics"], ["harmonics.k3"], MOVING_WINDING,
        {"angle1": (("amplitude_imbalance",), K3_ALPHA),
         **{p: (("mechanical_harmonics(a6,b6)",), K3_MECH) for p in ("const", "oab3", "steps", "reversals")},
@@ -97,13 +102,14 @@ HIDDEN = {h.key: h for h in [
     _h("mechanical_harmonics", "mechanical_harmonics:a2=2e-4,b2=-1e-4",
        ["mechanical_harmonics(a2,b2)", "mechanical_harmonics"],
        ["mechanical_harmonics.a2", "mechanical_harmonics.b2"], MOVING_WINDING,
+       {"angle1": (("harmonics(k3_q)",), B2_K3Q_P1)},
        part={"angle1": ("mechanical_harmonics(b2)", ["mechanical_harmonics.b2"],
                         "at p_r = 1 the order 2 of theta_m is 2 theta: its sin part a2 puts -a2 sin 2theta on "
                         "the angle, which the model's alpha takes ((alpha/2) sin 2theta, alpha -> alpha - 2 a2), "
                         "and without sin/cos nothing tells them apart; the cos part b2 is left to name")}),
     _h("eccentricity", "eccentricity:e=5e-4,phase=1", ["eccentricity"],
        ["eccentricity.e", "eccentricity.phase"], MOVING_WINDING,
-       {"angle1": (("offsets",), ECC_OFFSETS_P1)}),
+       {"angle1": (("offsets", "harmonics(k2,k2_q)"), ECC_OFFSETS_P1)}),
     _h("mounting_offset", "mounting_offset:theta_0=0.05", ["mounting_offset"], ["mounting_offset.theta_0"],
        MOVING_WINDING,
        {"const": (("delay", "backlash"), CONST_OFFSET), "steps": (("backlash",), ONE_DIRECTION)}),

@@ -203,7 +203,8 @@ def hidden_case(check, bin_dir, log, hidden, profile, config):
         # hidden effect itself is right (transients such as the take-up after a reversal
         # or a speed step can tell them apart); naming a twin is right only with the
         # hidden effect in its fits_as_well.
-        ok = is_hidden or (name in twins and any(o in hidden.refs for o in others))
+        named_refs = set(hidden.refs) | ({hidden.part[profile.name][0]} if profile.name in hidden.part else set())
+        ok = is_hidden or (name in twins and any(o in named_refs for o in others))
         check("twins", ok, f"first candidate is {hidden.refs[0]}, or one of {', '.join(twins)} with "
                            f"{hidden.refs[0]} in fits_as_well (got {describe(best)})")
     for ref in hidden.apart.get(profile.name, ()):

@@ -89,7 +89,7 @@ class TruthJsonTest(unittest.TestCase):
         harmonics = next(e for e in truth["effects"] if e["name"] == "harmonics")
         self.assertEqual(harmonics["params"]["k3"], 0.001)
         self.assertEqual(harmonics["params"]["k4_opp"], 2e-4)
-        self.assertEqual(len(harmonics["params"]), 1 + 2 * 19)  # k0, k2..k20, k2_opp..k20_opp
+        self.assertEqual(len(harmonics["params"]), 1 + 4 * 19)  # k0, k2..k20, k2_opp..k20_opp and their phases
         loop = next(e for e in truth["effects"] if e["name"] == "tracking_loop")
         self.assertEqual(loop["params"]["zeta"], 0.7)  # defaults are written out
         self.assertEqual(truth["converter"]["kind"], "tracking_loop")

@@ -145,14 +145,17 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   NuisanceValues nv;
   for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
     const double v = fr.last.dz[static_cast<Eigen::Index>(j)];
+    // The position errors' constants: the prediction carries -frame_shift (design.h),
+    // the solution what is left.
+    double total = v;
     switch (d.nuisances()[j]) {
-      case Nuisance::kRdConstant: nv.rd = v; break;
-      case Nuisance::kSaConstant: nv.sa = v; break;
+      case Nuisance::kRdConstant: nv.rd = v; total -= d.frame_shift(); break;
+      case Nuisance::kSaConstant: nv.sa = v; total -= d.frame_shift(); break;
       case Nuisance::kScGain: nv.sr = v; break;
       case Nuisance::kIdConstant: nv.d = v; break;
       case Nuisance::kIqConstant: nv.q = v; break;
     }
-    f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])), v, kNaN, ""});
+    f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])), total, kNaN, ""});
   }
   // One pass at the solution: breakdowns, whiteness, robust scores, series.
   const ResidualPass pass = residual_pass(d, log, floors, cols, options, nv);

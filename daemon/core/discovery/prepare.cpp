@@ -107,6 +107,56 @@ void check_sincos_centred(const std::vector<Sample>& samples) {
   }
 }
 
+/// The measured angles must turn with the reference, p_r electrical turns per
+/// mechanical one. A channel wired the other way (or sin and cos swapped) makes the
+/// sin/cos angle run backwards, a reference mounted the other way or another ratio
+/// makes every sample's error grow with the angle: no catalog effect is either, and a
+/// fit would be nonsense at hundreds of times the floor (issue 21), so this is an
+/// input error naming the fix. Judged on the summed wrapped steps of moving samples
+/// where the reference steps less than pi/4 electrical per sample (no aliasing).
+void check_turns_with_reference(const std::vector<const Sample*>& s, const std::vector<double>& theta,
+                                const std::vector<MotionSample>& motion, bool rd, bool sincos, int p_r) {
+  double ref = 0.0, r = 0.0, sc = 0.0;
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    if (!motion[i].moving) continue;
+    const double dref = theta[i] - theta[i - 1];
+    if (!(std::abs(dref) < 0.25 * kPi)) continue;
+    ref += dref;
+    if (rd && s[i]->has_rd && s[i - 1]->has_rd) r += wrap_pi(s[i]->theta_rd - s[i - 1]->theta_rd);
+    if (sincos && s[i]->has_sincos && s[i - 1]->has_sincos) {
+      sc += wrap_pi(std::atan2(s[i]->sin, s[i]->cos) - std::atan2(s[i - 1]->sin, s[i - 1]->cos));
+    }
+  }
+  // Half an electrical turn of net travel tells a direction; less is a note-free pass.
+  if (!(std::abs(ref) > kPi)) return;
+  const auto judge = [&](double travel, const char* what, const char* fix_reversed) {
+    const double ratio = travel / ref;
+    if (ratio < -0.5) {
+      throw std::invalid_argument(fmt::format(
+          "the {} turns the other way from the reference ({:.3g} electrical turns against the reference's {:.3g} "
+          "x p_r = {}): {}",
+          what, travel / kTwoPi, ref / kTwoPi, p_r, fix_reversed));
+    }
+    if (std::abs(ratio - 1.0) > 0.05) {
+      throw std::invalid_argument(fmt::format(
+          "the {} turns {:.4g} times as far as the reference x p_r = {} ({:.3g} against {:.3g} electrical turns): "
+          "the resolver's pole pairs are p_r = {:.4g}? set [bench] p_r (or the reference's ratio: [input.csv.columns] "
+          "ref_angle divide = N)",
+          what, ratio, p_r, travel / kTwoPi, ref / kTwoPi, ratio * p_r));
+    }
+  };
+  if (rd) {
+    judge(r, "R/D angle",
+          "the reference or the R/D angle counts the other way: negate one (CSV column scale = -1, or the DBC "
+          "signal's factor)");
+  }
+  if (sincos) {
+    judge(sc, "sin/cos angle atan2(sin, cos)",
+          "one channel is wired with the opposite sign, or sin and cos are swapped: negate one channel (CSV column "
+          "scale = -1, or the DBC signal's factor) or swap the sin and cos roles");
+  }
+}
+
 }  // namespace
 
 std::int64_t PreparedLog::fitted_rows() const {
@@ -218,6 +268,7 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
       theta[i] = p.p_r * theta_m[i];
     }
     motion = analyse_motion(t, theta_m, p.motion);
+    check_turns_with_reference(s, theta, motion, p.rd, p.sincos, p.p_r);
   } else {
     std::vector<double> cont(n), mech(n);
     AngleUnwrapper un;

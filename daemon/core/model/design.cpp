@@ -270,6 +270,9 @@ SignalValues Design::predict_with(const SignatureRow& row, AngleBasis& basis, st
       pred.q += c.q * x;
     }
   }
+  // The position error's constant in the log's frame: the sensor's zero (header).
+  pred.rd -= frame_shift_;
+  pred.sa -= frame_shift_;
   return pred;
 }
 

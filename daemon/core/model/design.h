@@ -15,9 +15,10 @@
 // The frame shift [rad, resolver electrical] is where the sensor's zero sits in the
 // frame of the fit's true angle (an unaligned reference's zero, or the self-
 // calibration's): the windings' errors are functions of the sensor's own angle, so
-// every basis turns by it (BasisTransform::shift). The fit takes it from the solved
-// position-error constant each pass (fit_design), so the parameters do not depend
-// on the reference's zero.
+// every basis turns by it (BasisTransform::shift), and the position errors carry it
+// as a constant (-shift on rd and sa). It is the coordinate of the position error's
+// nuisance constant: the fit moves it by that column's step (fit_design), so the
+// parameters do not depend on the reference's zero.
 //
 // Internal coordinates z (what Gauss-Newton moves): a linear parameter is its
 // value; a nonlinear one with FitScale::kInverseSquare is 1/value^2 (0 = neutral);

@@ -194,6 +194,16 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
   }
   const bool linear = strictly_linear(design);
   const int zero_col = linear ? -1 : frame_constant_column(design);
+  if (zero_col >= 0) {
+    // Start in the sensor's frame: the constant alone at the starting values (its
+    // error is the windings' mean angle error, ~beta/2). From a frame half a turn
+    // away the first step would fit every harmonic turned and could only go uphill.
+    PassStatistics start(design.columns());
+    accumulate(design, rows, floors, start);
+    ++out.passes;
+    const StepSolution c = solve_step(start.all, floors, std::vector<int>{zero_col});
+    if (c.ok) design.set_frame_shift(design.frame_shift() - c.dz[zero_col]);
+  }
   double lambda = 0.0;
   double cost = std::numeric_limits<double>::infinity();
   Design last_good = design;
@@ -226,9 +236,9 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     // Judged on the undamped step: a damped one is small because of the damping
     // (and damps the nuisance constants the report takes from it), not because the
     // point is the solution.
-    // The sensor's zero in the fit's frame is minus the solved position-error
-    // constant (design.h): the next pass turns every basis by it.
-    const double shift = zero_col >= 0 ? -sol.dz[zero_col] : design.frame_shift();
+    // The frame shift is the position-error constant's coordinate (the prediction
+    // carries -shift: design.h); the constant's step moves it like any parameter.
+    const double shift = zero_col >= 0 ? design.frame_shift() - sol.dz[zero_col] : design.frame_shift();
     const bool shift_settled = std::abs(shift - design.frame_shift()) <= kShiftSettled;
     if (pass > 0 && shift_settled && here - sol.rss_w <= tolerance) {
       const StepSolution free = lambda > 0.0 ? solve_step(stats.all, floors, model_cols, 0.0) : sol;

@@ -72,12 +72,15 @@ TEST(EffectRegistry, NamesAreStable) {
       EXPECT_EQ(params.size(), want.size()) << e.name() << ": a parameter was added; list it here";
     }
   }
-  // The long ones: harmonics k0, k2..k20 and k2_opp..k20_opp; mechanical orders a1/b1..a16/b16.
+  // The long ones: harmonics k0, k2..k20, k2_opp..k20_opp and their quadrature parts
+  // (each order's own phase); mechanical orders a1/b1..a16/b16.
   const Effect& h = *find_effect("harmonics");
-  EXPECT_EQ(h.params().size(), 1U + 2U * 19U);
+  EXPECT_EQ(h.params().size(), 1U + 4U * 19U);
   for (int n = 2; n <= 20; ++n) {
     EXPECT_GE(find_param(h, "k" + std::to_string(n)), 0) << n;
     EXPECT_GE(find_param(h, "k" + std::to_string(n) + "_opp"), 0) << n;
+    EXPECT_GE(find_param(h, "k" + std::to_string(n) + "_q"), 0) << n;
+    EXPECT_GE(find_param(h, "k" + std::to_string(n) + "_opp_q"), 0) << n;
   }
   EXPECT_LT(find_param(h, "k1"), 0) << "K_1 is the fundamental itself";
   EXPECT_LT(find_param(h, "k21"), 0);

@@ -44,7 +44,7 @@ TEST(SimTruth, RecordsConfigurationAndActiveEffects) {
               std::string::npos)
         << e->name();
   }
-  EXPECT_NE(chain_part.find("\"k20_opp\": 0}"), std::string::npos) << "the chain lists the long effects in full";
+  EXPECT_NE(chain_part.find("\"k20_opp_q\": 0}"), std::string::npos) << "the chain lists the long effects in full";
   // Braces and brackets balance (outside strings there are no others).
   int depth = 0;
   bool in_string = false;
