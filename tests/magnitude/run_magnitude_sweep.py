@@ -17,7 +17,7 @@ tests/independent/benchgen.py (its own parameterisation: K sin(n theta + phase))
 
   run_magnitude_sweep.py --bin BUILD/bin --work DIR [--cases a,b] [--magnitudes 0.05,0.15]
                          [--generators sim,benchgen] [--seeds N]
-  run_magnitude_sweep.py --bin BUILD/bin --work DIR --reference-zero
+  run_magnitude_sweep.py --bin BUILD/bin --work DIR --reference-zero | --geometry
 
 Prints one row per case and magnitude (named, residual / floor, coverage) and exits 1 when
 a check fails. The ctest subset runs one seed of a few cases; the whole table is the
@@ -189,6 +189,54 @@ def reference_zero(bin_dir, work):
     return failures
 
 
+GEOMETRY_CONFIG = """[bench]
+p_r = {p_r}
+[input.csv]
+delimiter = ";"
+decimal = ","
+header_lines = 4
+column_names = true
+time_column = "Time [FILETIME]"
+time_unit = "filetime"
+[input.csv.columns]
+sin = {{ column = "Sin [counts]", scale = {sin_scale}, full_scale = 32767 }}
+cos = {{ column = "Cos [counts]", full_scale = 32767 }}
+ref_angle = {{ column = "Reference angle [deg]", unit = "deg", scale = {ref_scale} }}
+rd_angle = {{ column = "RD angle [deg]", unit = "deg" }}
+"""
+
+
+def geometry(bin_dir, work):
+    """Issue 21: a channel wired the other way, a reference counting the other way, or a
+    reference at another ratio than p_r is named with its fix, never fitted into nonsense.
+    One scope export of benchgen (p_r = 3, alpha 0.05), read through four column maps."""
+    csv = os.path.join(work, "geometry.csv")
+    run([SYSTEM_PYTHON, BENCHGEN, "--csv", csv, "--csv-columns", "sin,cos,ref_angle,rd_angle", "--seed", "1",
+         "--rpm", "301.37", "--duration", "2", "--p-r", "3", "-e", NOISE, "-e", "amplitude_imbalance:alpha=0.05"])
+    cases = [  # (name, p_r, sin scale, reference scale, words the message must hold; None = fits)
+        ("as wired", 3, 1, 1, None),
+        ("sin reversed", 3, -1, 1, ["sin/cos angle", "turns the other way", "scale = -1"]),
+        ("reference reversed", 3, 1, -1, ["R/D angle", "turns the other way", "negate one"]),
+        ("p_r = 2 configured", 2, 1, 1, ["1.5 times", "p_r = 3?"]),
+    ]
+    failures = []
+    for name, p_r, sin_scale, ref_scale, words in cases:
+        config = os.path.join(work, f"geometry_{name.replace(' ', '_')}.toml")
+        with open(config, "w", encoding="utf-8") as f:
+            f.write(GEOMETRY_CONFIG.format(p_r=p_r, sin_scale=sin_scale, ref_scale=ref_scale))
+        p = subprocess.run([os.path.join(bin_dir, "resolver-model"), "explain", csv, "--config", config,
+                            "--reference-aligned", "--json"], capture_output=True, text=True)
+        if words is None:
+            ok = p.returncode == 0 and json.loads(p.stdout)["verdict"] == "explained"
+            print(f"{name:20} exit {p.returncode}, {json.loads(p.stdout)['verdict'] if p.returncode == 0 else ''}")
+        else:
+            ok = p.returncode != 0 and all(w in p.stderr for w in words)
+            print(f"{name:20} exit {p.returncode}: {p.stderr.strip()[:200]}")
+        if not ok:
+            failures.append(f"{name}: exit {p.returncode}, expected {words or 'explained'}: {p.stderr.strip()[:300]}")
+    return failures
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", required=True)
@@ -206,10 +254,12 @@ def main():
     ap.add_argument("--duration", type=float, default=2.0)
     ap.add_argument("--reference-zero", action="store_true",
                     help="instead: the same fit with the reference's zero at 0, 0.1, 0.325 and 0.5 turn")
+    ap.add_argument("--geometry", action="store_true",
+                    help="instead: a reversed channel, a reversed reference and a wrong p_r are named with the fix")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
-    if args.reference_zero:
-        failures = reference_zero(args.bin, args.work)
+    if args.reference_zero or args.geometry:
+        failures = reference_zero(args.bin, args.work) if args.reference_zero else geometry(args.bin, args.work)
         print("\nFAILED:\n  " + "\n  ".join(failures) if failures else "\nall checks passed")
         return 1 if failures else 0
     failures = []
