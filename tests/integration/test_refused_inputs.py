@@ -6,6 +6,11 @@ message that names the option or file and says what to do (README: exit codes).
                    [model] effects: exit 2 (usage/config), naming the option or key,
                    the bad name and "did you mean 'amplitude_imbalance'?"
                    (was: resolver-model read the log and exited 1, "no usable data")
+  ConfigDirectory  --config naming a directory, in resolverd, resolver-model and
+                   resolver-sim: exit 3 (I/O), naming the path and saying it is a
+                   directory (was: read as an empty file, all defaults, exit 0);
+                   likewise a directory as resolverd --replay, resolver-model's LOG
+                   or resolver-echo --log
 
   test_refused_inputs.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -87,6 +92,47 @@ class UnknownEffect(unittest.TestCase):
 
     def test_control_right_name_is_accepted(self):
         p = run([f"{ARGS.bin}/resolver-model", "fit", sim_log(), "--effects", "amplitude_imbalance"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+
+
+class ConfigDirectory(unittest.TestCase):
+    def setUp(self):
+        self.dir = work("config_dir.toml")  # a directory with a config's name
+        os.makedirs(self.dir, exist_ok=True)
+
+    def assert_directory_refused(self, p, option, path):
+        self.assertEqual(p.returncode, IO, p.stderr)
+        self.assertIn(f"{option} {path}", p.stderr)
+        self.assertIn("is a directory", p.stderr)
+
+    def test_resolverd(self):
+        p = run([f"{ARGS.bin}/resolverd", "--replay", sim_log(), "--once", "--fast", "--quiet", "--lcm", "memq://",
+                 "--config", self.dir])
+        self.assert_directory_refused(p, "--config", self.dir)
+
+    def test_resolver_model(self):
+        for sub in ("fit", "explain"):
+            with self.subTest(sub=sub):
+                p = run([f"{ARGS.bin}/resolver-model", sub, sim_log(), "--config", self.dir])
+                self.assert_directory_refused(p, "--config", self.dir)
+
+    def test_resolver_sim(self):
+        out = work("config_dir_sim.log")
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", out, "--duration", "0.2", "--config", self.dir])
+        self.assert_directory_refused(p, "--config", self.dir)
+        self.assertFalse(os.path.exists(out), "nothing is simulated with a directory for a config")
+
+    def test_directory_as_the_log(self):
+        p = run([f"{ARGS.bin}/resolverd", "--replay", self.dir, "--once", "--fast", "--quiet", "--lcm", "memq://"])
+        self.assert_directory_refused(p, "--replay", self.dir)
+        p = run([f"{ARGS.bin}/resolver-model", "fit", self.dir])
+        self.assert_directory_refused(p, "LOG", self.dir)
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", self.dir])
+        self.assert_directory_refused(p, "--log", self.dir)
+
+    def test_control_a_config_file_is_read(self):
+        cfg = write("config_file.toml", "[model]\nwindow_revolutions = 16\n")
+        p = run([f"{ARGS.bin}/resolver-model", "fit", sim_log(), "--config", cfg])
         self.assertEqual(p.returncode, 0, p.stderr)
 
 
