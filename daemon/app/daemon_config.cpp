@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -600,6 +601,12 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
 }
 
 DaemonConfig load_daemon_config(const std::string& path) {
+  // A directory opens and reads as empty, which would be a config of defaults
+  // (e.g. a SIGHUP after the file was replaced by a directory).
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw ConfigError("cannot read config file " + path + ": it is a directory, not a file");
+  }
   std::ifstream in(path);
   if (!in) throw ConfigError("cannot read config file " + path + ": " + std::strerror(errno));
   std::ostringstream text;

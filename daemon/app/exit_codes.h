@@ -5,13 +5,14 @@
 //   0  done
 //   1  the input had no usable data (nothing decoded, a damaged log)
 //   2  usage or configuration error (bad option, bad config file or DBC)
-//   3  I/O error (a file missing or unreadable, a write that failed)
+//   3  I/O error (a file missing or unreadable, a directory for a file, a write that failed)
 //   70 internal error (an unexpected exception: a bug, please report it)
 //
 // CLI11's own codes (105 for a missing --config file, 106 for a missing
 // option, ...) never leave a program: parse_command_line() maps them.
 #pragma once
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -47,11 +48,17 @@ inline constexpr const char* kHelpText =
   return std::nullopt;
 }
 
-/// nullopt when `path` exists and may be read, else "cannot read <option> <path>: <strerror>".
-/// access(2), not open(2): opening a FIFO would briefly be its reader and let a
-/// waiting writer write into a pipe nobody reads.
+/// nullopt when `path` exists, may be read and is not a directory, else "cannot read
+/// <option> <path>: <strerror>" or "...: it is a directory, not a file" (a directory
+/// opens and reads as an empty file: a config would silently be all defaults).
+/// access(2) and stat(2), not open(2): opening a FIFO would briefly be its reader
+/// and let a waiting writer write into a pipe nobody reads.
 [[nodiscard]] inline std::optional<std::string> unreadable(const std::string& option, const std::string& path) {
   if (::access(path.c_str(), R_OK) != 0) return "cannot read " + option + " " + path + ": " + std::strerror(errno);
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
+    return "cannot read " + option + " " + path + ": it is a directory, not a file";
+  }
   return std::nullopt;
 }
 

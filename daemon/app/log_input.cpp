@@ -1,6 +1,11 @@
 #include "daemon/app/log_input.h"
 
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <fstream>
 #include <utility>
 
 #include "daemon/decode/row_decoder.h"
@@ -108,7 +113,61 @@ class CsvInput final : public ReaderInput<CsvReader> {
   std::optional<CsvReader::Status> first_;
 };
 
+/// The extension of `path`, lower case, without the dot ("" when none).
+std::string extension(const std::string& path) {
+  const auto dot = path.rfind('.');
+  const auto slash = path.rfind('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot + 1);
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext;
+}
+
+/// The first bytes of a regular file ("" for a FIFO or device: reading would take
+/// them from the reader that follows, or block).
+std::string leading_bytes(const std::string& path, std::size_t n) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return "";
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes(n, '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(n));
+  bytes.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return bytes;
+}
+
+/// `path` with its extension replaced by `ext` (or `ext` appended).
+std::string with_extension(const std::string& path, const std::string& ext) {
+  const std::string old = extension(path);
+  return (old.empty() ? path : path.substr(0, path.size() - old.size() - 1)) + "." + ext;
+}
+
 }  // namespace
+
+void refuse_unreadable_format(const std::string& path) {
+  const std::string ext = extension(path);
+  const std::string head = leading_bytes(path, 8);
+  // BLF: "LOGG" and the file header's size as a little-endian u32 (144 in python-can's
+  // and Vector's files), so its two high bytes are 0: no text file starts like that.
+  const bool blf_magic = head.size() == 8 && head.rfind("LOGG", 0) == 0 && head[6] == '\0' && head[7] == '\0';
+  // gzip: 1f 8b and the method, 08 = deflate (RFC 1952).
+  const bool gzip_magic = head.rfind("\x1f\x8b\x08", 0) == 0;
+  if (ext == "blf" || blf_magic) {
+    const std::string asc = with_extension(path, "asc");
+    throw ConfigError(path + " is a Vector BLF (binary logging format) file" +
+                      (ext == "blf" ? "" : " (it starts with 'LOGG')") +
+                      ", which is not read here (candump, Vector ASC and CSV are); convert it to ASC with python-can "
+                      "(Debian: apt install python3-can) and give that: python3 -c \"import can; w=can.ASCWriter('" +
+                      asc + "'); [w.on_message_received(m) for m in can.BLFReader('" + path + "')]; w.stop()\"");
+  }
+  if (ext == "gz" || gzip_magic) {
+    // x.log.gz -> x.log; a compressed file without .gz keeps its extension (and so its format).
+    const std::string plain = ext == "gz"   ? path.substr(0, path.size() - 3)
+                              : ext.empty() ? path + ".log"
+                                            : with_extension(path, "unzipped." + ext);
+    throw ConfigError(path + " is gzip-compressed" + (ext == "gz" ? "" : " (it starts with the bytes 1f 8b)") +
+                      ", which is not read here; decompress it and give that: zcat '" + path + "' > '" + plain + "'");
+  }
+}
 
 LogFormat resolve_log_format(const std::string& path, std::optional<LogFormat> forced, const DaemonConfig& config) {
   if (forced) return *forced;
@@ -117,6 +176,7 @@ LogFormat resolve_log_format(const std::string& path, std::optional<LogFormat> f
 }
 
 std::unique_ptr<LogInput> open_log_input(const std::string& path, LogFormat format, const DaemonConfig& config) {
+  refuse_unreadable_format(path);
   switch (format) {
     case LogFormat::kCandump: return std::make_unique<CandumpInput>(path);
     case LogFormat::kAsc: return std::make_unique<AscInput>(path);

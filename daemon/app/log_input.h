@@ -60,8 +60,15 @@ class LogInput {
 [[nodiscard]] LogFormat resolve_log_format(const std::string& path, std::optional<LogFormat> forced,
                                            const DaemonConfig& config);
 
+/// Throws ConfigError, naming the file and the command that converts it, when
+/// `path` is a format no reader here takes but a text reader would misread line by
+/// line: Vector BLF (extension .blf, or the magic "LOGG") and gzip (.gz, or the
+/// magic 1f 8b). The content is looked at only in a regular file.
+void refuse_unreadable_format(const std::string& path);
+
 /// Opens `path`. Throws std::runtime_error when it cannot be opened, and
-/// ConfigError when a CSV has no column map or names a column the export lacks.
+/// ConfigError when a CSV has no column map or names a column the export lacks,
+/// or the file is BLF or gzip (refuse_unreadable_format).
 [[nodiscard]] std::unique_ptr<LogInput> open_log_input(const std::string& path, LogFormat format,
                                                        const DaemonConfig& config);
 

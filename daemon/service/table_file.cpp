@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -59,6 +60,23 @@ double number(std::string_view text, const std::string& where) {
 
 }  // namespace
 
+std::string c_float_literal(double value, bool single) {
+  const double limit = single ? static_cast<double>(std::numeric_limits<float>::max())
+                              : std::numeric_limits<double>::max();
+  if (!(std::abs(value) <= limit)) {  // NaN too
+    throw std::invalid_argument(fmt::format("{} has no C {} literal (a table entry must be finite and within "
+                                            "the type's range)",
+                                            value, single ? "float" : "double"));
+  }
+  // Written as the float it becomes: a value below float's range is 0.0f, not a
+  // literal the compiler warns about.
+  const double v = single ? static_cast<double>(static_cast<float>(value)) : value;
+  std::string text = single ? fmt::format("{:.9g}", v) : fmt::format("{}", v);
+  // "%.9g" and fmt's shortest form drop the point of an integral value ("0", "-0", "100").
+  if (text.find_first_of(".eE") == std::string::npos) text += ".0";
+  return single ? text + "f" : text;
+}
+
 std::string format_table_csv(const CalibrationTable& t, const TableOrigin& o) {
   std::string out = std::string(kMagic) + "\n" + header_lines(t, o, "#");
   out += "index,theta_m_rad,correction_rad\n";
@@ -93,12 +111,12 @@ std::string format_table_c_header(const CalibrationTable& t, const TableOrigin& 
   out += "#ifndef RESOLVER_CALIBRATION_TABLE_H\n#define RESOLVER_CALIBRATION_TABLE_H\n\n";
   out += fmt::format("#define RESOLVER_CAL_POINTS {}\n#define RESOLVER_CAL_P_R {}\n#define RESOLVER_CAL_P {}\n",
                      t.correction.size(), t.p_r, t.p);
-  out += fmt::format("static const double resolver_cal_delay_s = {};\n", t.delay);
-  out += fmt::format("static const double resolver_cal_backlash_rad = {};\n", t.backlash);
+  out += fmt::format("static const double resolver_cal_delay_s = {};\n", c_float_literal(t.delay, false));
+  out += fmt::format("static const double resolver_cal_backlash_rad = {};\n", c_float_literal(t.backlash, false));
   out += "/* [rad, resolver electrical] at the measured mechanical angle 2 pi i / RESOLVER_CAL_POINTS */\n";
   out += "static const float resolver_cal_correction_rad[RESOLVER_CAL_POINTS] = {\n";
   for (std::size_t i = 0; i < t.correction.size(); ++i) {
-    out += fmt::format("{}{:.9g}f,{}", i % 6 == 0 ? "  " : " ", t.correction[i], i % 6 == 5 ? "\n" : "");
+    out += fmt::format("{}{},{}", i % 6 == 0 ? "  " : " ", c_float_literal(t.correction[i]), i % 6 == 5 ? "\n" : "");
   }
   out += "\n};\n\n#endif /* RESOLVER_CALIBRATION_TABLE_H */\n";
   return out;

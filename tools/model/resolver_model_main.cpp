@@ -259,6 +259,16 @@ int run(int argc, char** argv) {
     resolver::DaemonConfig config;
     if (!config_path.empty()) config = resolver::load_daemon_config(config_path);  // throws naming file and key
     std::vector<std::string> effects = split_effects(effects_args);
+    if (!effects.empty()) {
+      // A misspelt effect is a usage error, found before the log is read (the
+      // config's [model] effects were checked when it was loaded).
+      try {
+        (void)resolver::ModelSpec::parse(effects, config.model.customs.get());
+      } catch (const std::invalid_argument& e) {
+        std::cerr << "resolver-model: --effects: " << e.what() << "\n";
+        return resolver::exit_code::kUsage;
+      }
+    }
     if (effects.empty()) effects = config.model.effects;  // default ["amplitude_imbalance"]
     resolver::LogSamples samples;
     {

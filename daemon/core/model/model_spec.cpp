@@ -1,6 +1,7 @@
 #include "daemon/core/model/model_spec.h"
 
 #include <algorithm>
+#include <cctype>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -26,15 +27,49 @@ std::string fittable_names(const CustomEffects* customs) {
   return out;
 }
 
+/// " (did you mean 'x'?)" for the fittable effect or custom name closest to `name`, or "".
+std::string did_you_mean(std::string_view name, const CustomEffects* customs) {
+  std::vector<std::string> names;
+  for (const Effect* e : effect_registry()) {
+    if (e->fittable()) names.emplace_back(e->name());
+  }
+  if (customs != nullptr) {
+    for (const auto& c : customs->all()) names.emplace_back(c->name());
+  }
+  const std::string best = closest_name(name, names);
+  return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+}
+
+/// Optimal string alignment distance (Levenshtein plus the swap of two neighbours), case ignored.
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  const auto lower = [](char ch) { return static_cast<char>(std::tolower(static_cast<unsigned char>(ch))); };
+  // d[i][j] = distance between a[0, i) and b[0, j); three rows are enough for the swap.
+  std::vector<std::size_t> before(b.size() + 1), previous(b.size() + 1), row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t cost = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+      row[j] = std::min({previous[j] + 1, row[j - 1] + 1, previous[j - 1] + cost});
+      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1])) {
+        row[j] = std::min(row[j], before[j - 2] + 1);
+      }
+    }
+    std::swap(before, previous);
+    std::swap(previous, row);
+  }
+  return previous[b.size()];
+}
+
 ModelTerm parse_one(std::string_view ref, const CustomEffects* customs) {
   const std::size_t open = ref.find('(');
   const std::string_view name = trim(ref.substr(0, open));
   const Effect* e = find_effect(name);
   if (e == nullptr && customs != nullptr) e = customs->find(name);
   if (e == nullptr) {
-    throw std::invalid_argument(fmt::format("'{}' is not a fittable catalog effect or a [[model.custom]] name; one "
-                                            "of: {}",
-                                            name, fittable_names(customs)));
+    throw std::invalid_argument(fmt::format("'{}' is not a fittable catalog effect or a [[model.custom]] name{}; "
+                                            "one of: {}",
+                                            name, did_you_mean(name, customs), fittable_names(customs)));
   }
   if (!e->fittable()) {
     throw std::invalid_argument(fmt::format("effect '{}' sets the noise floor and is not part of a model; "
@@ -59,8 +94,13 @@ ModelTerm parse_one(std::string_view ref, const CustomEffects* customs) {
     if (p.empty()) continue;
     const int i = find_param(*e, p);
     if (i < 0) {
-      throw std::invalid_argument(fmt::format("effect reference '{}': {} has no parameter '{}'; its parameters: {}",
-                                              ref, name, p, parameter_names(*e, true)));
+      std::vector<std::string> params;
+      for (const ParamInfo& info : e->params()) params.emplace_back(info.name);
+      const std::string best = closest_name(p, params);
+      throw std::invalid_argument(fmt::format("effect reference '{}': {} has no parameter '{}'{}; its parameters: {}",
+                                              ref, name, p,
+                                              best.empty() ? std::string() : " (did you mean '" + best + "'?)",
+                                              parameter_names(*e, true)));
     }
     if (std::find(term.params.begin(), term.params.end(), i) == term.params.end()) term.params.push_back(i);
   }
@@ -102,6 +142,20 @@ std::string ModelTerm::reference() const {
 std::string ModelTerm::param_name(std::size_t i) const {
   return std::string(effect->name()) + "." +
          std::string(effect->params()[static_cast<std::size_t>(params[i])].name);
+}
+
+std::string closest_name(std::string_view name, std::span<const std::string> candidates) {
+  const std::size_t allowed = std::clamp<std::size_t>(name.size() / 3, 1, 3);
+  std::string best;
+  std::size_t best_distance = allowed + 1;
+  for (const std::string& c : candidates) {
+    const std::size_t d = edit_distance(name, c);
+    if (d < best_distance) {
+      best_distance = d;
+      best = c;
+    }
+  }
+  return best;
 }
 
 std::vector<std::string> split_effect_list(std::string_view text) {

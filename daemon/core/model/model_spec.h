@@ -52,6 +52,13 @@ struct ModelSpec {
 /// Splits "a,b(c,d),e" at the commas outside parentheses; trims blanks; drops empties.
 [[nodiscard]] std::vector<std::string> split_effect_list(std::string_view text);
 
+/// The candidate closest to `name` for a "did you mean" hint, or "" when none is
+/// close enough to be a typo: the edit distance (insert, delete, replace, swap two
+/// neighbours; case ignored) is at most a third of the name's length, at most 3 and
+/// at least 1 ("amplitude_imbalanse" -> "amplitude_imbalance", "nope" -> ""). Ties go
+/// to the first candidate. Cannot fail.
+[[nodiscard]] std::string closest_name(std::string_view name, std::span<const std::string> candidates);
+
 /// The default parameters of an effect (ParamInfo::default_fit), as indices.
 [[nodiscard]] std::vector<int> default_params(const Effect& effect);
 

@@ -152,6 +152,17 @@ TEST(DaemonConfig, MissingFileSaysSo) {
   }
 }
 
+// A directory opens and reads as an empty file: it must not be a config of defaults
+// (resolverd's SIGHUP reload reads the path again with no access check before it).
+TEST(DaemonConfig, DirectorySaysSo) {
+  try {
+    (void)load_daemon_config("/tmp");
+    FAIL() << "a directory was loaded as a config";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("/tmp: it is a directory"), std::string::npos) << e.what();
+  }
+}
+
 TEST(DaemonConfig, CsvScopeExportColumnMap) {
   const DaemonConfig c = parse_daemon_config(R"(
 [input]
