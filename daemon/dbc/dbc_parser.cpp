@@ -34,7 +34,7 @@ constexpr std::string_view kNoNode = "Vector__XXX";
 // Statements that end with ';' and carry nothing we use.
 constexpr std::string_view kIgnoredStatements[] = {
     "BA_DEF_",    "BA_",          "BA_DEF_DEF_",      "BA_DEF_REL_", "BA_REL_",    "BA_DEF_DEF_REL_",
-    "BA_DEF_SGTYPE_", "BA_SGTYPE_", "SIG_GROUP_",     "BO_TX_BU_",   "SG_MUL_VAL_", "SIG_TYPE_REF_",
+    "BA_DEF_SGTYPE_", "BA_SGTYPE_", "SIG_GROUP_",     "BO_TX_BU_",   "SIG_TYPE_REF_",
     "SGTYPE_",    "SGTYPE_VAL_",  "EV_",              "ENVVAR_DATA_", "SIGTYPE_VALTYPE_", "CAT_DEF_",
     "CAT_",       "FILTER",       "BU_SG_REL_",       "BU_EV_REL_",  "BU_BO_REL_"};
 
@@ -52,7 +52,7 @@ std::string hex(std::uint64_t v) {
 
 class Parser {
  public:
-  Parser(std::string_view text, std::string_view source) : lex_(text), source_(source) {}
+  Parser(std::string_view text, std::string_view source) : lex_(text), source_(source) { db_.source = source_; }
 
   Database run() {
     while (true) {
@@ -172,6 +172,8 @@ class Parser {
       value_table();
     } else if (k == "SIG_VALTYPE_") {
       signal_value_type(kw);
+    } else if (k == "SG_MUL_VAL_") {
+      multiplexer_ranges(kw);
     } else if (is_ignored(k)) {
       skip_statement(kw);
     } else {
@@ -233,11 +235,14 @@ class Parser {
     if (m.extended && m.id > kMaxExtendedId) {
       fail(kw.line, "message '" + m.name + "' has extended ID " + hex(m.id) + ", more than 29 bits");
     }
-    if (by_raw_id_.count(raw_id) != 0) {
-      warn(kw.line, "message ID " + hex(m.id) + " ('" + m.name + "') is defined twice; lookups find the first");
-    } else {
-      by_raw_id_[raw_id] = db_.messages.size();
+    if (const Message* first = message_by_raw_id(raw_id)) {
+      // Frames of that ID would decode as whichever message a lookup finds first.
+      fail(kw.line, "message '" + m.name + "' has ID " + hex(m.id) + (m.extended ? " (extended)" : "") +
+                        ", already used by message '" + first->name + "' at " + source_ + ":" +
+                        std::to_string(first->line) + "; each message needs its own ID: remove or renumber one");
     }
+    by_raw_id_[raw_id] = db_.messages.size();
+    m.line = kw.line;
     current_ = db_.messages.size();
     signal_lines_.emplace_back();
     db_.messages.push_back(std::move(m));
@@ -249,8 +254,10 @@ class Parser {
     }
     Message& m = *current_ == kScratch ? scratch_ : db_.messages[*current_];
     Signal s;
+    s.line = kw.line;
     s.name = expect_ident("the signal name after SG_");
     if (lex_.peek().kind == TokenKind::kIdent) multiplexer_indicator(lex_.next(), s);
+    if (s.is_multiplexor) note_switch(m, s);
     expect_punct(':', "after the signal name (or its multiplexer indicator M / m<value>)");
     s.start_bit = expect_u32("the start bit");
     expect_punct('|', "between start bit and length");
@@ -310,6 +317,55 @@ class Parser {
     const auto [p, ec] = std::from_chars(x.data() + 1, x.data() + digits_end, v);
     if (ec != std::errc{} || p != x.data() + digits_end || digits_end == 1) bad();
     s.multiplexed_by = v;
+  }
+
+  // A second switch in a message (`m<n>M`, or a second `M`) is extended multiplexing.
+  static void note_switch(Message& m, const Signal& s) {
+    if (m.extended_mux_line != 0) return;
+    if (s.multiplexed_by.has_value()) {
+      m.extended_mux_line = s.line;
+      m.extended_mux_note = "signal '" + s.name + "' is a second-level multiplexor (m" +
+                            std::to_string(*s.multiplexed_by) + "M)";
+    } else if (const Signal* first = m.multiplexor()) {
+      m.extended_mux_line = s.line;
+      m.extended_mux_note = "signal '" + s.name + "' is a second multiplexor (M) beside '" + first->name + "'";
+    }
+  }
+
+  // SG_MUL_VAL_ id signal switch a-b[, c-d]* ;  (extended multiplexing: the
+  // signal is present while `switch` is in one of the ranges). A single range
+  // n-n of the top-level switch only restates `m<n>` and is accepted as simple.
+  void multiplexer_ranges(const Token& kw) {
+    const std::uint32_t raw_id = expect_u32("the message ID after SG_MUL_VAL_");
+    const std::string name = expect_ident("the signal name after SG_MUL_VAL_ <id>");
+    const std::string switch_name = expect_ident("the multiplexor switch name after SG_MUL_VAL_ <id> <signal>");
+    // The ranges lex as numbers and '-' / ',' punctuation ("1-1" is the numbers 1 and -1).
+    std::vector<std::string> parts;
+    while (true) {
+      Token t = lex_.next();
+      if (t.is_punct(';')) break;
+      if (t.kind == TokenKind::kEnd) fail(kw.line, "SG_MUL_VAL_ statement has no terminating ';' before the end of the file; add it");
+      parts.push_back(t.text);
+    }
+    Message* m = message_by_raw_id(raw_id);
+    Signal* s = signal_by(raw_id, name);
+    if (m == nullptr || s == nullptr) {
+      warn(kw.line, "SG_MUL_VAL_ refers to unknown signal " + std::to_string(raw_id) + " " + name + "; ignored");
+      return;
+    }
+    const Signal* top = m->multiplexor();
+    const bool restates_simple =
+        top != nullptr && top->name == switch_name && s->multiplexed_by.has_value() && parts.size() == 2 &&
+        parts[0] == std::to_string(*s->multiplexed_by) && parts[1] == "-" + std::to_string(*s->multiplexed_by);
+    if (restates_simple) return;
+    s->mul_val_line = kw.line;
+    if (m->extended_mux_line == 0) {
+      m->extended_mux_line = kw.line;
+      std::string ranges;
+      for (const std::string& p : parts) ranges += p;
+      m->extended_mux_note = "SG_MUL_VAL_ makes signal '" + name + "' present for switch '" + switch_name +
+                             "' in " + ranges;
+    }
   }
 
   void receivers(std::size_t line, Signal& s) {

@@ -13,6 +13,7 @@
 // byte, then continues at bit 7 of the next byte (the "sawtooth").
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -48,6 +49,8 @@ struct Signal {
   std::map<std::int64_t, std::string> value_table;  ///< from VAL_ for this signal
   std::string comment;                              ///< from CM_ SG_
   ValueType value_type = ValueType::kInteger;        ///< from SIG_VALTYPE_
+  std::size_t line = 0;          ///< its SG_ line in the source (0 for a Signal built in code)
+  std::size_t mul_val_line = 0;  ///< an SG_MUL_VAL_ line that gives it value ranges of a switch (0: none)
 };
 
 struct Message {
@@ -58,6 +61,12 @@ struct Message {
   std::string sender;
   std::vector<Signal> signals;
   std::string comment;  ///< from CM_ BO_
+  std::size_t line = 0;  ///< its BO_ line in the source (0 for a Message built in code)
+  /// Extended multiplexing (a second-level switch `m<n>M`, a second `M`, or
+  /// SG_MUL_VAL_ ranges): the first line that uses it and what it is, for
+  /// errors; 0 when the message multiplexes simply (one `M`, `m<value>` signals) or not at all.
+  std::size_t extended_mux_line = 0;
+  std::string extended_mux_note;
 
   /// nullptr when the message has no signal of that name.
   [[nodiscard]] const Signal* find_signal(std::string_view signal_name) const;
@@ -66,6 +75,7 @@ struct Message {
 };
 
 struct Database {
+  std::string source;                 ///< the file (or name given to parse_dbc): errors say source:line
   std::vector<Message> messages;
   std::string version;                ///< VERSION "..."
   std::vector<std::string> nodes;     ///< BU_

@@ -164,6 +164,50 @@ TEST(DbcParser, MultiplexedSignalsDecodeOnlyForTheirMuxValue) {
   }
 }
 
+TEST(DbcParser, DuplicateMessageIdIsAnErrorNamingBothMessagesAndLines) {
+  const DbcError e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+                                         "BO_ 292 OTHER: 8 ECU\n"
+                                         "BO_ 291 AGAIN: 8 ECU\n");
+  EXPECT_EQ(e.line, 6U) << e.what();
+  EXPECT_NE(e.message.find("message 'AGAIN' has ID 0x123, already used by message 'TEST' at bad.dbc:3"),
+            std::string::npos)
+      << e.what();
+  // The same number as a standard and as an extended ID are two messages.
+  const Database db = parse_ok(kHeader + "BO_ " + std::to_string(0x80000000U | 291U) + " EXT: 8 ECU\n");
+  EXPECT_EQ(db.messages.size(), 2U);
+  EXPECT_EQ(db.messages.at(0).line, 3U);
+}
+
+TEST(DbcParser, ExtendedMultiplexingIsRecordedWithItsLine) {
+  // Lines 4..7: the top switch, a second-level switch m1M, and signals of each.
+  const Database nested = parse_ok(kHeader +
+                                   " SG_ mode M : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+                                   " SG_ sub m1M : 8|8@1+ (1,0) [0|0] \"\" ECU\n"
+                                   " SG_ x m2 : 16|8@1+ (1,0) [0|0] \"\" ECU\n"
+                                   " SG_ y m0 : 8|8@1+ (1,0) [0|0] \"\" ECU\n");
+  const Message& m = nested.messages.at(0);
+  EXPECT_EQ(m.extended_mux_line, 5U);
+  EXPECT_NE(m.extended_mux_note.find("'sub' is a second-level multiplexor (m1M)"), std::string::npos)
+      << m.extended_mux_note;
+  EXPECT_EQ(m.find_signal("x")->line, 6U);
+
+  // SG_MUL_VAL_ with a range is extended; a single n-n range of the top switch only restates m<n>.
+  const std::string simple = kHeader +
+                             " SG_ mode M : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+                             " SG_ a m1 : 8|8@1+ (1,0) [0|0] \"\" ECU\n"
+                             " SG_ b m2 : 8|8@1+ (1,0) [0|0] \"\" ECU\n";
+  const Database restated = parse_ok(simple + "SG_MUL_VAL_ 291 a mode 1-1;\n");
+  EXPECT_EQ(restated.messages.at(0).extended_mux_line, 0U);
+  EXPECT_EQ(restated.messages.at(0).find_signal("a")->mul_val_line, 0U);
+  const Database ranged = parse_ok(simple + "SG_MUL_VAL_ 291 a mode 1-1, 3-5;\n");
+  EXPECT_EQ(ranged.messages.at(0).extended_mux_line, 7U);
+  EXPECT_EQ(ranged.messages.at(0).find_signal("a")->mul_val_line, 7U);
+  EXPECT_EQ(ranged.messages.at(0).find_signal("b")->mul_val_line, 0U);
+  EXPECT_NE(ranged.messages.at(0).extended_mux_note.find("'a' present for switch 'mode' in 1-1,3-5"),
+            std::string::npos)
+      << ranged.messages.at(0).extended_mux_note;
+}
+
 TEST(DbcParser, MultiplexedSignalWithoutMultiplexorIsAnError) {
   const DbcError e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ b m3 : 8|8@1+ (1,0) [0|0] \"\" ECU\n");
   EXPECT_EQ(e.line, 5U) << e.what();
