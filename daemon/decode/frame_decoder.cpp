@@ -79,6 +79,30 @@ void FrameDecoder::check_overlaps(const Slot& slot, const std::function<void(con
   }
 }
 
+void FrameDecoder::check_multiplexing(Slot& slot, const std::function<void(const std::string&)>& problem) const {
+  const dbc::Message& msg = *slot.message;
+  std::vector<std::pair<std::string, const dbc::Signal*>> read;  // what reads it, the signal
+  for (const RoleSignal& r : slot.roles) read.emplace_back("role '" + std::string(role_name(r.role)) + "'", r.signal);
+  if (slot.counter != nullptr) read.emplace_back("the counter", slot.counter);
+  if (slot.crc != nullptr) read.emplace_back("the CRC", slot.crc);
+  // More than one switch: which one an m<value> refers to is not simple any more.
+  std::size_t switches = 0;
+  for (const dbc::Signal& s : msg.signals) switches += s.is_multiplexor ? 1U : 0U;
+  for (const auto& [who, sig] : read) {
+    const bool switched = sig->multiplexed_by.has_value() || sig->mul_val_line != 0;
+    if (!switched) continue;
+    if (switches > 1 || sig->mul_val_line != 0) {
+      const std::size_t line = sig->mul_val_line != 0 ? sig->mul_val_line : msg.extended_mux_line;
+      problem(db_->source + ":" + std::to_string(line) + ": message '" + msg.name +
+              "' uses extended multiplexing (" + msg.extended_mux_note + "), which resolverd does not decode; " + who +
+              " reads '" + sig->name + "', whose presence depends on it (use one multiplexor M with m<value> " +
+              "signals for what resolverd reads, or a plain signal)");
+      continue;
+    }
+    slot.mux = msg.multiplexor();
+  }
+}
+
 std::string_view to_string(FrameReject reject) {
   switch (reject) {
     case FrameReject::kUnknownId: return "unknown_id";
@@ -86,6 +110,7 @@ std::string_view to_string(FrameReject reject) {
     case FrameReject::kCrc: return "crc";
     case FrameReject::kRemoteFrame: return "remote_frame";
     case FrameReject::kBenchInfoVersion: return "bench_info_version";
+    case FrameReject::kMuxPageUnmapped: return "mux_page_unmapped";
   }
   return "unknown";
 }
@@ -161,7 +186,10 @@ FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const Signal
     slots_[static_cast<std::size_t>(slot_index)].roles.push_back(RoleSignal{role, sig, factor.value_or(1.0), is_angle(role)});
     mapped_roles_ = static_cast<std::uint16_t>(mapped_roles_ | role_bit(role));
   }
-  for (const Slot& slot : slots_) check_overlaps(slot, problem);
+  for (Slot& slot : slots_) {
+    check_overlaps(slot, problem);
+    check_multiplexing(slot, problem);
+  }
   if (!map_.bench_info_message.empty()) {
     bench_info_ = db_->find_message(map_.bench_info_message);
     if (bench_info_ == nullptr) {
@@ -195,6 +223,20 @@ DecodeResult FrameDecoder::decode(const CanFrame& frame, DecodedPart& part, Benc
   if (map_.crc == CrcAlgorithm::kBenchJ1850 && !map_.crc_signal.empty()) {
     crc_signal = is_bench_info ? msg->find_signal(map_.crc_signal) : slots_[static_cast<std::size_t>(it->second)].crc;
   }
+  // Multiplexed slots: the page this frame carries (dbc_types.h: m<value> signals exist only on their page).
+  const Slot* slot = is_bench_info ? nullptr : &slots_[static_cast<std::size_t>(it->second)];
+  const bool muxed = slot != nullptr && slot->mux != nullptr;
+  const std::uint64_t mux_value = muxed ? dbc::extract_raw(*slot->mux, data) : 0;
+  auto on_page = [&](const dbc::Signal& s) { return !s.multiplexed_by || *s.multiplexed_by == mux_value; };
+  if (muxed) {
+    bool any_role = false;
+    for (const RoleSignal& r : slot->roles) any_role = any_role || on_page(*r.signal);
+    if (!any_role || (slot->counter != nullptr && !on_page(*slot->counter))) {
+      result.mux_value = mux_value;
+      return reject(FrameReject::kMuxPageUnmapped);
+    }
+    if (crc_signal != nullptr && !on_page(*crc_signal)) crc_signal = nullptr;  // this page has no CRC
+  }
   if (crc_signal != nullptr && frame.len >= 8) {
     const auto sent = static_cast<std::uint8_t>(dbc::extract_raw(*crc_signal, data));
     if (sent != bench_frame_crc(frame.data.data(), frame.id)) return reject(FrameReject::kCrc);
@@ -215,13 +257,18 @@ DecodeResult FrameDecoder::decode(const CanFrame& frame, DecodedPart& part, Benc
     return result;
   }
 
-  const Slot& slot = slots_[static_cast<std::size_t>(it->second)];
   part.slot = it->second;
-  part.has_counter = slot.counter != nullptr;
-  part.counter = part.has_counter ? static_cast<std::uint8_t>(dbc::extract_raw(*slot.counter, data)) : 0;
+  part.has_counter = slot->counter != nullptr;
+  part.counter = part.has_counter ? static_cast<std::uint8_t>(dbc::extract_raw(*slot->counter, data)) : 0;
   part.roles = 0;
+  part.roles_absent = 0;
+  part.mux_value = mux_value;
   part.timestamp_us = frame.timestamp_us;
-  for (const RoleSignal& r : slot.roles) {
+  for (const RoleSignal& r : slot->roles) {
+    if (muxed && !on_page(*r.signal)) {
+      part.roles_absent = static_cast<std::uint16_t>(part.roles_absent | role_bit(r.role));
+      continue;
+    }
     const double value = dbc::decode_physical(*r.signal, data) * r.to_role_unit;
     part.values[static_cast<std::size_t>(r.role)] = r.wrap ? wrap_2pi(value) : value;
     part.roles = static_cast<std::uint16_t>(part.roles | role_bit(r.role));

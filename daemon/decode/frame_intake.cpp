@@ -47,6 +47,38 @@ void FrameIntake::reject(std::string_view reason, const CanFrame& frame, std::ui
   callbacks_.on_problem(reason, msg);
 }
 
+std::string FrameIntake::mux_page_detail(const CanFrame& frame, std::uint64_t mux_value) const {
+  const FrameDecoder::Slot* slot = decoder_->slot_for(frame);
+  if (slot == nullptr || slot->mux == nullptr) return "multiplexor page not read";
+  std::string pages;
+  for (const FrameDecoder::RoleSignal& r : slot->roles) {
+    pages += (pages.empty() ? "" : ", ") + std::string(role_name(r.role)) +
+             (r.signal->multiplexed_by ? " on page " + std::to_string(*r.signal->multiplexed_by) : " on every page");
+  }
+  if (slot->counter != nullptr && slot->counter->multiplexed_by) {
+    pages += ", counter on page " + std::to_string(*slot->counter->multiplexed_by);
+  }
+  return slot->message->name + " multiplexor '" + slot->mux->name + "' = " + std::to_string(mux_value) +
+         " selects a page without what resolverd reads (" + pages + "); frame not used";
+}
+
+void FrameIntake::report_absent_roles(const CanFrame& frame, std::uint64_t line) {
+  std::string names;
+  std::int64_t n = 0;
+  for (std::size_t r = 0; r < kRoleCount; ++r) {
+    if ((part_.roles_absent & role_bit(static_cast<Role>(r))) == 0) continue;
+    names += (names.empty() ? "" : ", ") + std::string(role_name(static_cast<Role>(r)));
+    ++n;
+  }
+  rejects_.add("mux_role_absent", n);
+  if (!callbacks_.on_problem) return;
+  const std::string& message = decoder_->slots()[static_cast<std::size_t>(part_.slot)].message->name;
+  callbacks_.on_problem("mux_role_absent", (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) +
+                                               describe_frame(frame) + ": " + message + " multiplexor page " +
+                                               std::to_string(part_.mux_value) + " does not carry " + names +
+                                               "; missing from this frame (not decoded from another page's bits)");
+}
+
 void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
   ++stats_.frames_seen;
   if (frame.error) {
@@ -62,6 +94,7 @@ void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
       case FrameReject::kCrc: detail = "CRC-8 J1850 mismatch: frame corrupted, dropped"; break;
       case FrameReject::kRemoteFrame: detail = "remote (RTR) frame carries no data"; break;
       case FrameReject::kBenchInfoVersion: detail = "BENCH_INFO layout version is not 1"; break;
+      case FrameReject::kMuxPageUnmapped: detail = mux_page_detail(frame, r.mux_value); break;
     }
     reject(to_string(r.reject), frame, line, detail);
     return;
@@ -71,6 +104,7 @@ void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
     if (callbacks_.on_bench_info) callbacks_.on_bench_info(info_);
     return;
   }
+  if (part_.roles_absent != 0) report_absent_roles(frame, line);
   if (!part_.has_counter) {
     order_joiner_.add(part_);
     ++stats_.frames_decoded;

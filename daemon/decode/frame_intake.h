@@ -75,6 +75,10 @@ class FrameIntake {
  private:
   void reject(std::string_view reason, const CanFrame& frame, std::uint64_t line, const std::string& detail);
   void on_joined(const BenchSample& sample);
+  /// The message for a kMuxPageUnmapped reject: switch value and where the roles are.
+  [[nodiscard]] std::string mux_page_detail(const CanFrame& frame, std::uint64_t mux_value) const;
+  /// Counts (mux_role_absent, one per role) and reports the roles the frame's page lacks.
+  void report_absent_roles(const CanFrame& frame, std::uint64_t line);
 
   std::shared_ptr<const FrameDecoder> decoder_;
   int max_counter_delta_;
