@@ -33,7 +33,7 @@ constexpr std::string_view kNoNode = "Vector__XXX";
 
 // Statements that end with ';' and carry nothing we use.
 constexpr std::string_view kIgnoredStatements[] = {
-    "BA_DEF_",    "BA_",          "BA_DEF_DEF_",      "BA_DEF_REL_", "BA_REL_",    "BA_DEF_DEF_REL_",
+    "BA_DEF_",    "BA_DEF_DEF_",      "BA_DEF_REL_", "BA_REL_",    "BA_DEF_DEF_REL_",
     "BA_DEF_SGTYPE_", "BA_SGTYPE_", "SIG_GROUP_",     "BO_TX_BU_",   "SIG_TYPE_REF_",
     "SGTYPE_",    "SGTYPE_VAL_",  "EV_",              "ENVVAR_DATA_", "SIGTYPE_VALTYPE_", "CAT_DEF_",
     "CAT_",       "FILTER",       "BU_SG_REL_",       "BU_EV_REL_",  "BU_BO_REL_"};
@@ -174,6 +174,8 @@ class Parser {
       signal_value_type(kw);
     } else if (k == "SG_MUL_VAL_") {
       multiplexer_ranges(kw);
+    } else if (k == "BA_") {
+      attribute(kw);
     } else if (is_ignored(k)) {
       skip_statement(kw);
     } else {
@@ -319,6 +321,39 @@ class Parser {
     s.multiplexed_by = v;
   }
 
+  // BA_ "name" [BU_ node | BO_ id | SG_ id signal | EV_ name] value ;
+  // Only the long names (over 32 characters) that CANdb++ and cantools keep in
+  // attributes are used; every other attribute is skipped to its ';'.
+  void attribute(const Token& kw) {
+    const std::string name = expect_string("the attribute name string after BA_");
+    if (name == "SystemSignalLongSymbol" && lex_.peek().is_ident("SG_")) {
+      lex_.next();
+      const std::uint32_t raw_id = expect_u32("the message ID after BA_ \"SystemSignalLongSymbol\" SG_");
+      const std::string signal = expect_ident("the signal name after BA_ \"SystemSignalLongSymbol\" SG_ <id>");
+      std::string long_name = expect_string("the long signal name string");
+      expect_semicolon("BA_");
+      if (Signal* s = signal_by(raw_id, signal)) {
+        s->long_name = std::move(long_name);
+      } else {
+        warn(kw.line, "BA_ \"SystemSignalLongSymbol\" refers to unknown signal " + std::to_string(raw_id) + " " +
+                          signal + "; its long name '" + long_name + "' is not known to the signal map");
+      }
+    } else if (name == "SystemMessageLongSymbol" && lex_.peek().is_ident("BO_")) {
+      lex_.next();
+      const std::uint32_t raw_id = expect_u32("the message ID after BA_ \"SystemMessageLongSymbol\" BO_");
+      std::string long_name = expect_string("the long message name string");
+      expect_semicolon("BA_");
+      if (Message* m = message_by_raw_id(raw_id)) {
+        m->long_name = std::move(long_name);
+      } else {
+        warn(kw.line, "BA_ \"SystemMessageLongSymbol\" refers to unknown message " + std::to_string(raw_id) +
+                          "; its long name '" + long_name + "' is not known to the signal map");
+      }
+    } else {
+      skip_statement(kw);
+    }
+  }
+
   // A second switch in a message (`m<n>M`, or a second `M`) is extended multiplexing.
   static void note_switch(Message& m, const Signal& s) {
     if (m.extended_mux_line != 0) return;
@@ -371,7 +406,8 @@ class Parser {
   void receivers(std::size_t line, Signal& s) {
     while (true) {
       const Token& t = lex_.peek();
-      if (t.line != line) return;
+      // The list ends with its line, or with the file when the last line has no newline.
+      if (t.line != line || t.kind == TokenKind::kEnd) return;
       if (t.is_punct(',')) {
         lex_.next();
         continue;
@@ -558,7 +594,7 @@ std::variant<Database, DbcError> load_dbc_file(const std::string& path) {
     const int err = errno;
     return DbcError{path, 0,
                     std::string("cannot open DBC file: ") + std::strerror(err) +
-                        "; check the path (relative paths are from the working directory)"};
+                        "; check the path (a relative [layout] dbc is taken from the config file's folder)"};
   }
   std::ostringstream content;
   content << in.rdbuf();

@@ -4,14 +4,17 @@
 // marks a 29-bit ID), SG_ with multiplexer indicators M / m<n> / m<n>M,
 // Intel (@1) and Motorola (@0) order, +/- sign, (factor,offset) [min|max]
 // "unit" receivers, CM_ (global, BU_, BO_, SG_, EV_; strings may span lines),
-// VAL_, VAL_TABLE_, SIG_VALTYPE_ (IEEE float/double signals). BA_DEF_, BA_,
-// BA_DEF_DEF_ and the other ';'-terminated attribute/relation statements are
-// parsed up to their ';' and ignored. Any other keyword is skipped to the end
-// of its line and noted in Database::warnings.
+// VAL_, VAL_TABLE_, SIG_VALTYPE_ (IEEE float/double signals), SG_MUL_VAL_
+// (recorded as extended multiplexing unless it only restates m<n>), BA_
+// "SystemSignalLongSymbol" / "SystemMessageLongSymbol" (long names). BA_DEF_,
+// other BA_, BA_DEF_DEF_ and the other ';'-terminated attribute/relation
+// statements are parsed up to their ';' and ignored. Any other keyword is
+// skipped to the end of its line and noted in Database::warnings. The last
+// line may end without a newline.
 //
 // Failure: parse_dbc never throws; a syntax error, a signal that does not fit
-// its message's DLC, a bad ID or length returns a DbcError naming the source,
-// the line and what was expected. References to unknown messages/signals in
+// its message's DLC, a bad ID or length, two messages with one ID returns a
+// DbcError naming the source, the line and what was expected. References to unknown messages/signals in
 // CM_/VAL_/SIG_VALTYPE_ are not fatal (warnings), as real-world files have them.
 #pragma once
 

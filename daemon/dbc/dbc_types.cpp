@@ -4,7 +4,7 @@ namespace resolver::dbc {
 
 const Signal* Message::find_signal(std::string_view signal_name) const {
   for (const Signal& s : signals) {
-    if (s.name == signal_name) return &s;
+    if (s.name == signal_name || (!s.long_name.empty() && s.long_name == signal_name)) return &s;
   }
   return nullptr;
 }
@@ -26,7 +26,7 @@ const Message* Database::find_message(std::uint32_t id, bool extended) const {
 
 const Message* Database::find_message(std::string_view message_name) const {
   for (const Message& m : messages) {
-    if (m.name == message_name) return &m;
+    if (m.name == message_name || (!m.long_name.empty() && m.long_name == message_name)) return &m;
   }
   return nullptr;
 }

@@ -36,7 +36,10 @@ enum class ValueType : std::uint8_t {
 };
 
 struct Signal {
-  std::string name;
+  std::string name;       ///< as on the SG_ line (at most 32 characters in files of Vector's tools)
+  /// The full name when it is longer (BA_ "SystemSignalLongSymbol", written by CANdb++ and
+  /// cantools); "" when none. find_signal() answers to either.
+  std::string long_name;
   std::uint32_t start_bit = 0;  ///< DBC numbering (see file comment)
   std::uint32_t length = 0;     ///< [bits] 1..64
   ByteOrder order = ByteOrder::kLittleEndian;
@@ -56,7 +59,8 @@ struct Signal {
 struct Message {
   std::uint32_t id = 0;   ///< arbitration ID without the DBC's extended flag (bit 31)
   bool extended = false;  ///< 29-bit ID
-  std::string name;
+  std::string name;       ///< as on the BO_ line
+  std::string long_name;  ///< BA_ "SystemMessageLongSymbol"; "" when none. find_message() answers to either.
   std::uint32_t dlc = 0;  ///< [bytes] payload length declared in the DBC (0..64)
   std::string sender;
   std::vector<Signal> signals;
@@ -68,7 +72,7 @@ struct Message {
   std::size_t extended_mux_line = 0;
   std::string extended_mux_note;
 
-  /// nullptr when the message has no signal of that name.
+  /// nullptr when the message has no signal of that name (or long name).
   [[nodiscard]] const Signal* find_signal(std::string_view signal_name) const;
   /// The top-level multiplexor switch (`M`), nullptr when the message is not multiplexed.
   [[nodiscard]] const Signal* multiplexor() const;
@@ -85,7 +89,7 @@ struct Database {
 
   /// nullptr when no message has that ID (`id` without flag bits).
   [[nodiscard]] const Message* find_message(std::uint32_t id, bool extended) const;
-  /// nullptr when no message has that name.
+  /// nullptr when no message has that name (or long name).
   [[nodiscard]] const Message* find_message(std::string_view message_name) const;
 };
 

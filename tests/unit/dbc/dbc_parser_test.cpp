@@ -208,6 +208,50 @@ TEST(DbcParser, ExtendedMultiplexingIsRecordedWithItsLine) {
       << ranged.messages.at(0).extended_mux_note;
 }
 
+TEST(DbcParser, LastSignalLineWithoutNewlineParses) {
+  for (const std::string receivers : {" ECU", " ECU,GW", "", " Vector__XXX"}) {
+    const Database db = parse_ok(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\"" + receivers);
+    ASSERT_EQ(db.messages.size(), 1U) << receivers;
+    ASSERT_EQ(db.messages[0].signals.size(), 1U) << receivers;
+    EXPECT_EQ(db.messages[0].signals[0].name, "a");
+  }
+  const Database db = parse_ok(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU,GW");
+  EXPECT_EQ(db.messages[0].signals[0].receivers, (std::vector<std::string>{"ECU", "GW"}));
+}
+
+TEST(DbcParser, LongNamesFromAttributesAreFoundBesideTheShortOnes) {
+  // As CANdb++ and cantools write names over 32 characters: a short name on the
+  // BO_/SG_ line, the full one in a BA_ (the attribute definitions come first).
+  const std::string long_signal = "ResolverSineEnvelopeDemodulatedCounts";     // 37 characters
+  const std::string long_message = "ResolverFeedbackSampleOfOneControlPeriod";  // 40 characters
+  const Database db = parse_ok(
+      "VERSION \"\"\n\nBO_ 291 ResolverFeedbackSampleOfOneCont: 8 ECU\n"
+      " SG_ ResolverSineEnvelopeDemodul_0000 : 0|16@1- (1,0) [0|0] \"\" ECU\n"
+      " SG_ other : 16|8@1+ (1,0) [0|0] \"\" ECU\n"
+      "BA_DEF_ SG_ \"SystemSignalLongSymbol\" STRING ;\n"
+      "BA_DEF_ BO_ \"SystemMessageLongSymbol\" STRING ;\n"
+      "BA_DEF_DEF_ \"SystemSignalLongSymbol\" \"\";\n"
+      "BA_ \"SystemMessageLongSymbol\" BO_ 291 \"" + long_message + "\";\n"
+      "BA_ \"SystemSignalLongSymbol\" SG_ 291 ResolverSineEnvelopeDemodul_0000 \"" + long_signal + "\";\n"
+      "BA_ \"GenSigStartValue\" SG_ 291 other 3;\n"
+      "VAL_ 291 ResolverSineEnvelopeDemodul_0000 0 \"zero\" ;\n");
+  EXPECT_TRUE(db.warnings.empty()) << db.warnings.front();
+  const Message* m = db.find_message(long_message);
+  ASSERT_NE(m, nullptr);
+  EXPECT_EQ(m, db.find_message("ResolverFeedbackSampleOfOneCont"));
+  const Signal* s = m->find_signal(long_signal);
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(s, m->find_signal("ResolverSineEnvelopeDemodul_0000"));
+  EXPECT_EQ(s->value_table.at(0), "zero");  // VAL_ after the BA_ still names the short one
+  EXPECT_EQ(m->find_signal("other")->long_name, "");
+  // A long name for a signal that does not exist is a warning with its line.
+  const Database dangling = parse_ok(kHeader + "BA_ \"SystemSignalLongSymbol\" SG_ 291 nope \"x\";\n");
+  ASSERT_EQ(dangling.warnings.size(), 1U);
+  EXPECT_NE(dangling.warnings[0].find("test.dbc:4: BA_ \"SystemSignalLongSymbol\" refers to unknown signal 291 nope"),
+            std::string::npos)
+      << dangling.warnings[0];
+}
+
 TEST(DbcParser, MultiplexedSignalWithoutMultiplexorIsAnError) {
   const DbcError e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ b m3 : 8|8@1+ (1,0) [0|0] \"\" ECU\n");
   EXPECT_EQ(e.line, 5U) << e.what();
