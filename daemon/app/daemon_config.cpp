@@ -499,6 +499,10 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     check_keys(*t, "layout",
                {"dbc", "counter_signal", "crc_signal", "crc", "bench_info_message", "max_counter_delta", "signals"}, s);
     read(*t, "dbc", c.dbc_path, s, "layout");
+    // A relative DBC path belongs with the config that names it, wherever resolverd is started from.
+    if (!c.dbc_path.empty() && std::filesystem::path(c.dbc_path).is_relative()) {
+      c.dbc_path = (std::filesystem::path(s).parent_path() / c.dbc_path).string();
+    }
     read(*t, "counter_signal", c.signal_map.counter_signal, s, "layout");
     read(*t, "crc_signal", c.signal_map.crc_signal, s, "layout");
     read(*t, "bench_info_message", c.signal_map.bench_info_message, s, "layout");

@@ -169,7 +169,9 @@ struct DaemonConfig {
   int ripple_revolutions = 8;
   BenchDefaults bench;
   CanOptions can;
-  std::string dbc_path;  ///< "" = proto/resolver_bench.dbc, compiled into the binary
+  /// "" = proto/resolver_bench.dbc, compiled into the binary. A relative [layout] dbc
+  /// is taken from the config file's folder (stored here already joined to it).
+  std::string dbc_path;
   SignalMap signal_map = SignalMap::bench_default();
   int max_counter_delta = 8;
   std::string estimator_method = "model";

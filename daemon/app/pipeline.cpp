@@ -85,6 +85,11 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
                                       : nullptr),
       signal_health_(health_config_for(config, stream_.intake().decoder()), config.bench.p_r, config.bench.sample_rate_hz,
                      diagnostics) {
+  // Once per load: the DBC's own findings ("file.dbc:40: ...": skipped keywords, comments on
+  // unknown signals), then the decoder's (overlaps among signals it does not read).
+  for (const std::string& w : stream_.intake().decoder().database().warnings) {
+    diagnostics << "resolverd: warning: " << w << "\n";
+  }
   for (const std::string& w : stream_.intake().decoder().warnings()) diagnostics << "resolverd: warning: " << w << "\n";
 }
 

@@ -380,7 +380,7 @@ def main():
     text_case("dbc_angle_unit_unknown", ".dbc", "dbc", grad,
               "role 'rd_angle' (RESOLVER_SAMPLE.rd_angle): unit \"grad\" is unknown")
     with open(os.path.join(CASES, "dbc_angle_unit_unknown.toml"), "w", encoding="ascii") as f:
-        f.write("[layout]\ndbc = \"cases/dbc_angle_unit_unknown.dbc\"\n")
+        f.write("[layout]\ndbc = \"dbc_angle_unit_unknown.dbc\"\n")
     cases[-1]["config"] = "cases/dbc_angle_unit_unknown.toml"
 
     # ---- configuration and DBC: resolverd must refuse to start, exit 2, say where and why
@@ -401,14 +401,14 @@ def main():
     text_case("dbc_syntax_error", ".dbc", "dbc", broken, "dbc_syntax_error.dbc:%d:" % broken_line,
               note="the bench DBC with the ':' after PHASE_CURRENTS removed; loaded through a config")
     with open(os.path.join(CASES, "dbc_syntax_error.toml"), "w", encoding="ascii") as f:
-        f.write("[layout]\ndbc = \"cases/dbc_syntax_error.dbc\"\n")
+        f.write("[layout]\ndbc = \"dbc_syntax_error.dbc\"\n")
     cases[-1]["config"] = "cases/dbc_syntax_error.toml"
     signal_past = bench_dbc.replace("SG_ crc : 56|8@1+", "SG_ crc : 60|8@1+", 1)
     assert signal_past != bench_dbc
     text_case("dbc_signal_past_dlc", ".dbc", "dbc", signal_past, "dbc_signal_past_dlc.dbc:",
               note="RESOLVER_SAMPLE.crc moved to bits 60..67 of an 8-byte message")
     with open(os.path.join(CASES, "dbc_signal_past_dlc.toml"), "w", encoding="ascii") as f:
-        f.write("[layout]\ndbc = \"cases/dbc_signal_past_dlc.dbc\"\n")
+        f.write("[layout]\ndbc = \"dbc_signal_past_dlc.dbc\"\n")
     cases[-1]["config"] = "cases/dbc_signal_past_dlc.toml"
 
     overlap = bench_dbc.replace("SG_ cos : 24|16@1-", "SG_ cos : 16|16@1-", 1)
@@ -417,7 +417,7 @@ def main():
               "message 'RESOLVER_SAMPLE': signals 'sin' (bits 8..23) and 'cos' (bits 16..31) overlap in bits 16..23",
               note="RESOLVER_SAMPLE.cos moved onto the upper byte of sin: two quantities from the same bits")
     with open(os.path.join(CASES, "dbc_overlapping_signals.toml"), "w", encoding="ascii") as f:
-        f.write("[layout]\ndbc = \"cases/dbc_overlapping_signals.dbc\"\n")
+        f.write("[layout]\ndbc = \"dbc_overlapping_signals.dbc\"\n")
     cases[-1]["config"] = "cases/dbc_overlapping_signals.toml"
 
     with open(os.path.join(HERE, "cases.json"), "w", encoding="ascii") as f:

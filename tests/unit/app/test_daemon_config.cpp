@@ -55,6 +55,15 @@ i_a = "CUR.Ia"
       << "a user map replaces the default one";
 }
 
+TEST(DaemonConfig, RelativeDbcPathIsTakenFromTheConfigsFolder) {
+  const std::string text = "[layout]\ndbc = \"layouts/my.dbc\"\n";
+  EXPECT_EQ(parse_daemon_config(text, "/etc/resolverd/bench.toml").dbc_path, "/etc/resolverd/layouts/my.dbc");
+  EXPECT_EQ(parse_daemon_config(text, "configs/bench.toml").dbc_path, "configs/layouts/my.dbc");
+  EXPECT_EQ(parse_daemon_config(text, "bench.toml").dbc_path, "layouts/my.dbc");
+  EXPECT_EQ(parse_daemon_config("[layout]\ndbc = \"/abs/my.dbc\"\n", "/etc/resolverd/bench.toml").dbc_path,
+            "/abs/my.dbc");
+}
+
 TEST(DaemonConfig, SyntaxErrorNamesFileAndLine) {
   const std::string e = error_of("[bench]\np_r = 3\np = = 4\n");
   EXPECT_NE(e.find("test.toml:3:"), std::string::npos) << e;

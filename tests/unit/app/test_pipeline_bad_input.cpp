@@ -3,7 +3,10 @@
 // them are all published, and nothing crashes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <vector>
 
@@ -204,6 +207,46 @@ TEST(PipelineHealth, AStepBackInTheLogKeepsHealthComing) {
   }
   EXPECT_EQ(sink.healths.size(), 4U);
   EXPECT_EQ(pipeline.intake().rejects().get("timestamp_step_back"), 1);
+}
+
+}  // namespace
+}  // namespace resolver
+
+namespace resolver {
+namespace {
+
+std::size_t occurrences(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+// A config in its own folder names its DBC relatively: found there, not in the
+// working directory; the DBC's findings are printed once each with file:line.
+TEST(PipelineDbcWarnings, RelativeDbcFromTheConfigFolderAndItsWarningsPrintedOnce) {
+  const std::string dir = std::string(RESOLVER_BINARY_DIR) + "/pipeline_dbc_warnings";
+  std::filesystem::create_directories(dir);
+  std::ifstream bench(std::string(RESOLVER_SOURCE_DIR) + "/proto/resolver_bench.dbc");
+  std::stringstream dbc;
+  dbc << bench.rdbuf();
+  const auto lines_before = static_cast<std::size_t>(std::count(std::istreambuf_iterator<char>(dbc),
+                                                                std::istreambuf_iterator<char>(), '\n'));
+  std::string text = dbc.str();
+  if (!text.empty() && text.back() != '\n') text += "\n";
+  text += "FOO_ 1 2 3\nCM_ SG_ 256 no_such_signal \"x\";\n";
+  std::ofstream(dir + "/with_warnings.dbc") << text;
+  std::ofstream(dir + "/bench.toml") << "[layout]\ndbc = \"with_warnings.dbc\"\n";
+
+  const DaemonConfig config = load_daemon_config(dir + "/bench.toml");
+  RecordingSink sink;
+  std::ostringstream diag;
+  Pipeline pipeline(config, sink, diag);
+  const std::string out = diag.str();
+  const std::string file = dir + "/with_warnings.dbc:";
+  const std::string unknown = file + std::to_string(lines_before + 1) + ": unknown keyword 'FOO_'";
+  const std::string comment = file + std::to_string(lines_before + 2) + ": CM_ SG_ refers to unknown signal 256 no_such_signal";
+  EXPECT_EQ(occurrences(out, unknown), 1U) << out;
+  EXPECT_EQ(occurrences(out, comment), 1U) << out;
 }
 
 }  // namespace
