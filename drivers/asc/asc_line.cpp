@@ -88,6 +88,10 @@ std::optional<std::int64_t> parse_seconds_us(std::string_view s) {
   return sec * kMicrosPerSecond + frac;
 }
 
+// [bytes] The largest CAN FD payload; the largest classic DLC code (9..15 mean 8 bytes).
+constexpr std::uint64_t kMaxFdBytes = 64;
+constexpr std::uint64_t kMaxClassicDlc = 15;
+
 bool is_valid_fd_len(std::uint64_t n) {
   return n <= 8 || n == 12 || n == 16 || n == 20 || n == 24 || n == 32 || n == 48 || n == 64;
 }
@@ -136,6 +140,14 @@ std::optional<AscLineParser::Result> read_data(const Tokens& t, std::size_t firs
   }
   frame.len = static_cast<std::uint8_t>(count);
   return std::nullopt;
+}
+
+/// Tokens first .. first + count - 1 exist and are data bytes.
+bool all_bytes(const Tokens& t, std::size_t first, std::size_t count, int base) {
+  for (std::size_t k = first; k < first + count; ++k) {
+    if (k >= t.size || !parse_uint(t.text(k), base, 0xFF)) return false;
+  }
+  return true;
 }
 
 void set_channel(CanFrame& frame, std::uint64_t channel) {
@@ -206,13 +218,26 @@ AscLineParser::Result parse_event(const Tokens& t, std::string_view line, int ba
                      "expected 'd' (data) or 'r' (remote) after the direction, found " +
                          (type.empty() ? std::string("end of line") : quoted(type)) + "; skipped");
     }
-    const auto dlc = parse_uint(t.text(type_at + 1), base, 15);
-    if (!dlc) {
+    const auto dlc = parse_uint(t.text(type_at + 1), base, kMaxFdBytes);
+    if (!dlc || (*dlc > kMaxClassicDlc && !is_valid_fd_len(*dlc))) {
       return problem("bad_dlc", type_at + 1 < t.size ? t.at[type_at + 1].column : end_column,
-                     "expected a DLC 0..F, found " + quoted(t.text(type_at + 1)));
+                     "expected a DLC 0..F (or, as python-can's ASCWriter writes a longer frame, its byte count "
+                     "10, 14, 18, 20, 30 or 40 in hex), found " + quoted(t.text(type_at + 1)));
     }
-    // Classic DLC 9..15 still means 8 data bytes.
-    if (auto bad = read_data(t, type_at + 2, *dlc > 8 ? 8 : *dlc, base, end_column, frame)) return *bad;
+    // python-can writes a 12-byte message not flagged FD as "d c" and its 12 bytes; a
+    // classic DLC code C (CANoe) has 8 bytes and then its trailing fields.
+    const bool twelve_bytes = *dlc == 12 && all_bytes(t, type_at + 2, 12, base);
+    if (*dlc <= kMaxClassicDlc && !twelve_bytes) {
+      // Classic DLC 9..15 still means 8 data bytes.
+      if (auto bad = read_data(t, type_at + 2, *dlc > 8 ? 8 : *dlc, base, end_column, frame)) return *bad;
+      return frame_ok();
+    }
+    // python-can's ASCWriter writes a message not flagged FD as "d <byte count in hex>"
+    // (`d 40` and 64 bytes): a frame classic CAN cannot carry, so an FD frame whose flag
+    // was lost. Its bytes are all on the line; read them. (python-can's own ASCReader
+    // keeps only the first 8 of them, which would hide the rest from the DBC's checks.)
+    if (auto bad = read_data(t, type_at + 2, *dlc, base, end_column, frame)) return *bad;
+    frame.fd = true;
     return frame_ok();
   }
 

@@ -10,7 +10,10 @@
 //      0.000000 Start of measurement
 //      0.001234 1  100             Rx   d 8 01 02 03 04 05 06 07 08  Length = 0 BitCount = 0 ID = 256
 //      0.001500 2  18FF0001x       Tx   d 2 0A 0B                  extended ID: 'x' suffix
-//      0.001600 1  100             Rx   r 8                        remote frame
+//      0.001600 1  100             Rx   r 8                        remote frame (DLC in hex)
+//      0.001700 1  100             Rx   d 40 00 01 ... 3F          python-can's ASCWriter for a message
+//                                                                  not flagged FD with 64 bytes: the byte
+//                                                                  count in hex; read as an FD frame
 //      0.002000 1  ErrorFrame                                      error frame
 //      0.003000 CANFD   1 Rx  100  [name]  1 0 8  8 01 02 ... <duration> <length> <flags> ...
 //                      channel dir id [symbolic name] BRS ESI DLC(hex) data-length(dec) data...;

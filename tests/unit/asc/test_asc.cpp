@@ -81,6 +81,56 @@ TEST(AscLine, WhatPythonCanWrites) {
   EXPECT_EQ(fd.timestamp_us, kStartUs + 3500);
 }
 
+// python-can 4.1 ASCWriter writes a message not flagged FD with more than 8 bytes as
+// "d <byte count in hex>" and all its bytes (`d 40`), and remote frames as "r <DLC hex>";
+// lines copied from its output (can.Message(..., is_fd=False), is_remote_frame=True).
+TEST(AscLine, PythonCanLongClassicLinesAndRemoteFrames) {
+  const auto out = parse_all({
+      " 0.000000 1  100             Rx   d 40 00 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F 10 11 12 13 14 15 16 17 18 19 1A 1B 1C 1D 1E 1F 20 21 22 23 24 25 26 27 28 29 2A 2B 2C 2D 2E 2F 30 31 32 33 34 35 36 37 38 39 3A 3B 3C 3D 3E 3F",
+      " 0.000000 1  100             Rx   d 14 00 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F 10 11 12 13",
+      " 0.000000 1  100             Rx   d c 00 01 02 03 04 05 06 07 08 09 0A 0B",
+      " 0.000000 1  100             Rx   d C 00 01 02 03 04 05 06 07  Length = 0 BitCount = 0 ID = 256",
+      " 0.001000 1  100             Rx   r 8 ",
+      " 0.002000 2  18FF0001x       Rx   r 0 ",
+      " 0.100000 1  100             Rx   r c ",
+      " 0.100000 1  100             Rx   r",
+      " 0.000000 1  100             Rx   d 11 00 01 02 03 04 05 06 07 08 09 0A 0B 0C 0D 0E 0F 10 11 12 13",
+      " 0.000000 1  100             Rx   d 40 00 01 02 03 04 05 06 07",
+  });
+  ASSERT_EQ(out[0].kind, AscLineParser::Kind::kFrame) << out[0].problem.message;
+  EXPECT_EQ(out[0].frame.len, 64);
+  EXPECT_TRUE(out[0].frame.fd);
+  EXPECT_FALSE(out[0].frame.rtr);
+  EXPECT_EQ(out[0].frame.data[63], 0x3F);
+  ASSERT_EQ(out[1].kind, AscLineParser::Kind::kFrame) << out[1].problem.message;
+  EXPECT_EQ(out[1].frame.len, 20);
+  EXPECT_EQ(out[1].frame.data[19], 0x13);
+  ASSERT_EQ(out[2].kind, AscLineParser::Kind::kFrame) << out[2].problem.message;
+  EXPECT_EQ(out[2].frame.len, 12);
+  EXPECT_TRUE(out[2].frame.fd);
+  ASSERT_EQ(out[3].kind, AscLineParser::Kind::kFrame) << out[3].problem.message;
+  EXPECT_EQ(out[3].frame.len, 8);  // CANoe's classic DLC code C: 8 bytes, then its trailing fields
+  EXPECT_FALSE(out[3].frame.fd);
+  for (std::size_t i : {4, 5, 6, 7}) {
+    ASSERT_EQ(out[i].kind, AscLineParser::Kind::kFrame) << i << out[i].problem.message;
+    EXPECT_TRUE(out[i].frame.rtr) << i;
+    EXPECT_FALSE(out[i].frame.fd) << i;
+  }
+  EXPECT_EQ(out[4].frame.len, 8);
+  EXPECT_EQ(out[5].frame.len, 0);
+  EXPECT_TRUE(out[5].frame.extended);
+  EXPECT_EQ(out[6].frame.len, 8);  // DLC C requests 8 bytes on classic CAN
+  EXPECT_EQ(out[7].frame.len, 0);
+  ASSERT_EQ(out[8].kind, AscLineParser::Kind::kProblem);  // 17 bytes: no CAN frame has that length
+  EXPECT_EQ(out[8].problem.reason, "bad_dlc");
+  EXPECT_EQ(out[8].problem.column, 37U);
+  EXPECT_NE(out[8].problem.message.find("found '11'"), std::string::npos) << out[8].problem.message;
+  ASSERT_EQ(out[9].kind, AscLineParser::Kind::kProblem);
+  EXPECT_EQ(out[9].problem.reason, "missing_data");
+  EXPECT_NE(out[9].problem.message.find("announces 64 data bytes, the line has 8"), std::string::npos)
+      << out[9].problem.message;
+}
+
 TEST(AscLine, CanoeStyleLinesDecimalBaseAndRelativeTimes) {
   const auto out = parse_all({
       "base dec  timestamps relative",
