@@ -11,6 +11,7 @@ PACKAGES=(
   libmuparser-dev  # [[model.custom]] effects: expressions users write (daemon/core/model/custom_effect.h)
   can-utils python3 python3-can
   python3-numpy  # tests/independent (benchgen)
+  python3-canmatrix  # tests/dbc_peer: an independent DBC reader judges resolverd's decoded values
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
   chromium  # headless: renders, zooms and screenshots the resolver-model HTML report (tests/model)
