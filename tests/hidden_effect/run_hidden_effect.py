@@ -204,7 +204,11 @@ def hidden_case(check, bin_dir, log, hidden, profile, config):
         # or a speed step can tell them apart); naming a twin is right only with the
         # hidden effect in its fits_as_well.
         named_refs = set(hidden.refs) | ({hidden.part[profile.name][0]} if profile.name in hidden.part else set())
-        ok = is_hidden or (name in twins and any(o in named_refs for o in others))
+        # Or the hidden effect is listed as not identifiable on this motion (issue 21: a
+        # delay or play at one speed in one direction is a constant: never proposed).
+        unidentifiable = any(n.startswith(f"{r}:") and "not identifiable here" in n
+                             for n in first["not_evaluated"] for r in hidden.refs)
+        ok = is_hidden or (name in twins and (any(o in named_refs for o in others) or unidentifiable))
         check("twins", ok, f"first candidate is {hidden.refs[0]}, or one of {', '.join(twins)} with "
                            f"{hidden.refs[0]} in fits_as_well (got {describe(best)})")
     for ref in hidden.apart.get(profile.name, ()):

@@ -41,7 +41,9 @@ struct DiscoveryOptions {
   /// a difference above 10 is "very strong" evidence).
   double proposal_bic_drop = 10.0;
   /// Harmonic orders 0..max_report_order of theta (and of theta_m, theta_e) in the breakdown.
-  int max_report_order = 8;
+  /// 20: the catalog's highest winding harmonic (k20), so a saturation pattern's
+  /// orders are all seen and proposed together (ranking's family candidate).
+  int max_report_order = 20;
   /// Speed bins of the residual breakdown (equal width over the signed speeds seen; empty bins dropped).
   int speed_bins = 6;
   /// Time windows of the breakdown (a residual that changes over time is outside the catalog).
@@ -202,6 +204,9 @@ struct Candidate {
   std::vector<ParamValue> params;
   double weighted_rss = 0.0;
   std::vector<std::string> fits_as_well;  ///< candidates this log cannot tell from it
+  /// A harmonic family (every significant order at once): named first only when no
+  /// smaller candidate reaches the floor (the simplest explanation first).
+  bool family = false;
 };
 
 enum class Verdict : std::uint8_t { kExplained, kMissingEffect, kUnexplained };

@@ -129,7 +129,11 @@ std::vector<std::string> describe_failure(const PreparedLog& log, const ModelFit
                                 num(f.mean), num(b.mean)));
     }
   }
-  if (fit.time_bins.size() > 1) {
+  // On one turn at one speed time and angle are the same axis (t is an affine function
+  // of theta_m): a drift term would be a mechanical harmonic in disguise. Two turns
+  // apart tell them apart.
+  const bool time_is_not_angle = log.motion.travelled >= 2.0 * kTwoPi;
+  if (fit.time_bins.size() > 1 && time_is_not_angle) {
     double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
     std::string ts;
     for (const TimeBinResidual& b : fit.time_bins) {
@@ -191,7 +195,11 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
       dict.push_back(by + "*" + harmonic_term("cos", k, "theta"));
     }
   };
-  if (fit.time_bins.size() > 1) {
+  // On one turn at one speed time and angle are the same axis (t is an affine function
+  // of theta_m): a drift term would be a mechanical harmonic in disguise. Two turns
+  // apart tell them apart.
+  const bool time_is_not_angle = log.motion.travelled >= 2.0 * kTwoPi;
+  if (fit.time_bins.size() > 1 && time_is_not_angle) {
     double lo = std::numeric_limits<double>::infinity(), hi = 0.0, mlo = lo, mhi = -lo;
     for (const TimeBinResidual& b : fit.time_bins) {
       lo = std::min(lo, b.rms);

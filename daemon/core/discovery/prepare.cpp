@@ -130,14 +130,16 @@ void check_turns_with_reference(const std::vector<const Sample*>& s, const std::
   // Half an electrical turn of net travel tells a direction; less is a note-free pass.
   if (!(std::abs(ref) > kPi)) return;
   const auto judge = [&](double travel, const char* what, const char* fix_reversed) {
+    // A dead or frozen channel turns ~0 times: a fault for signal health to report,
+    // not wiring. Only ratios a miswired or misconfigured bench gives are named.
     const double ratio = travel / ref;
-    if (ratio < -0.5) {
+    if (ratio < -0.5 && ratio > -5.0) {
       throw std::invalid_argument(fmt::format(
           "the {} turns the other way from the reference ({:.3g} electrical turns against the reference's {:.3g} "
           "x p_r = {}): {}",
           what, travel / kTwoPi, ref / kTwoPi, p_r, fix_reversed));
     }
-    if (std::abs(ratio - 1.0) > 0.05) {
+    if (std::abs(ratio - 1.0) > 0.05 && ratio > 0.2 && ratio < 5.0) {
       throw std::invalid_argument(fmt::format(
           "the {} turns {:.4g} times as far as the reference x p_r = {} ({:.3g} against {:.3g} electrical turns): "
           "the resolver's pole pairs are p_r = {:.4g}? set [bench] p_r (or the reference's ratio: [input.csv.columns] "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include <fmt/format.h>
 
@@ -21,7 +22,7 @@ namespace {
 constexpr int kOrdersTried = 3;
 constexpr double kSignificance = 4.0;
 /// Nonlinear candidates refitted to convergence (the best by their linearised score).
-constexpr int kNonlinearRefits = 2;
+constexpr int kNonlinearRefits = 3;
 /// Candidates within this BIC of each other, or whose residuals differ by less than
 /// this share of the smaller, are not told apart by the log (e.g. K_3 and a 6th mechanical
 /// harmonic with p_r = 3: the same 2 theta in the angle, and alpha takes up the
@@ -29,7 +30,12 @@ constexpr int kNonlinearRefits = 2;
 constexpr double kIndistinguishableBic = 10.0;
 constexpr double kIndistinguishableShare = 0.02;
 
-std::vector<int> significant_orders(const std::vector<HarmonicResidual>& h, double floor, std::int64_t n, int lowest) {
+/// A family candidate (every significant order at once) is tried from this many orders:
+/// a saturation pattern spreads over many, and one order at a time would take as many steps.
+constexpr int kFamilyFrom = 4;
+
+std::vector<int> significant_orders(const std::vector<HarmonicResidual>& h, double floor, std::int64_t n, int lowest,
+                                    int most = kOrdersTried) {
   std::vector<HarmonicResidual> v;
   const double se = floor * std::sqrt(2.0 / std::max<double>(1.0, static_cast<double>(n)));
   for (const HarmonicResidual& x : h) {
@@ -37,7 +43,7 @@ std::vector<int> significant_orders(const std::vector<HarmonicResidual>& h, doub
   }
   std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.amplitude > b.amplitude; });
   std::vector<int> out;
-  for (std::size_t i = 0; i < v.size() && static_cast<int>(i) < kOrdersTried; ++i) out.push_back(v[i].order);
+  for (std::size_t i = 0; i < v.size() && static_cast<int>(i) < most; ++i) out.push_back(v[i].order);
   return out;
 }
 
@@ -45,6 +51,51 @@ bool in_model(const ModelSpec& spec, const Effect& e, int param) {
   const ModelTerm* t = spec.find(e);
   return t != nullptr && std::find(t->params.begin(), t->params.end(), param) != t->params.end();
 }
+
+/// What the log's motion lacks for `e` to be identifiable, as advice ("" = nothing).
+/// One speed: the moving speeds span less than 10 % of the fastest (a bench's speed
+/// ripple is a few percent; a step or ramp is far more).
+std::string motion_missing(const Effect& e, const MotionSummary& m) {
+  const bool reversal = m.reversals > 0;
+  const double fastest = std::max(std::abs(m.omega_min), std::abs(m.omega_max));
+  const bool speed_change = m.omega_max - m.omega_min > 0.1 * fastest;
+  switch (e.identifiable_with()) {
+    case Effect::Needs::kNothing: return "";
+    case Effect::Needs::kSpeedChangeOrReversal:
+      return speed_change || reversal ? ""
+                                      : "at one speed in one direction it is a constant turn of the angle; record "
+                                        "a speed step, a ramp or an out-and-back";
+    case Effect::Needs::kSpeedChange:
+      return speed_change ? ""
+                          : "at one speed it only turns and scales each error harmonic by a constant; record a "
+                            "ramp or speed steps";
+    case Effect::Needs::kReversal:
+      return reversal ? "" : "in one direction a play is a constant; record an out-and-back (a reversal)";
+  }
+  return "";
+}
+
+/// The family of one effect over `orders` (parameter names per order), ascending, or
+/// empty when fewer than kFamilyFrom orders are left outside the model.
+ModelTerm family_term(const Effect& e, const ModelSpec& spec, const std::vector<int>& orders,
+                      const std::function<std::vector<std::string>(int)>& names) {
+  std::vector<int> params;
+  int count = 0;
+  for (int m : orders) {
+    bool any = false;
+    for (const std::string& name : names(m)) {
+      const int i = find_param(e, name);
+      if (i < 0 || in_model(spec, e, i)) continue;
+      params.push_back(i);
+      any = true;
+    }
+    count += any ? 1 : 0;
+  }
+  if (count < kFamilyFrom) return ModelTerm{&e, {}};
+  std::sort(params.begin(), params.end());
+  return ModelTerm{&e, params};
+}
+
 
 /// The candidate terms: defaults of every fittable effect not in the model, the
 /// harmonic families at the residual's orders, the config's custom effects.
@@ -64,6 +115,10 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
     }
     if (t.effect->current_side() && !log.currents) {
       not_evaluated.push_back(name + ": needs the phase currents (and the reference angle)");
+      return false;
+    }
+    if (const std::string missing = motion_missing(*t.effect, log.motion); !missing.empty()) {
+      not_evaluated.push_back(name + ": not identifiable here: " + missing);
       return false;
     }
     const CoverageCheck c = check_coverage(log.rows, needed_orders(t));
@@ -97,6 +152,12 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
           if (usable(with_phase)) out.push_back(with_phase);
         }
       }
+      // A smooth periodic error over many orders (a saturation pattern) as one step:
+      // every significant order of theta as K_{m+1} with its phase (issue 21).
+      const ModelTerm family =
+          family_term(*e, spec, significant_orders(fit.harmonics, fit.noise_floor_rad, n, 2, Harmonics::kMaxOrder - 1),
+                      [](int m) { return std::vector<std::string>{fmt::format("k{}", m + 1), fmt::format("k{}_q", m + 1)}; });
+      if (!family.params.empty() && usable(family)) out.push_back(family);
       continue;
     }
     if (name == "mechanical_harmonics") {
@@ -107,6 +168,10 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
         const ModelTerm t{e, {a, a + 1}};
         if (usable(t)) out.push_back(t);
       }
+      const ModelTerm family = family_term(
+          *e, spec, significant_orders(fit.harmonics_mech, fit.noise_floor_rad, n, 2, 16),
+          [](int m) { return std::vector<std::string>{fmt::format("a{}", m), fmt::format("b{}", m)}; });
+      if (!family.params.empty() && usable(family)) out.push_back(family);
       continue;
     }
     if (spec.find(*e) != nullptr) continue;
@@ -220,6 +285,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     }
     Candidate c;
     c.effect = terms[i].reference();
+    c.family = terms[i].params.size() >= 2 * static_cast<std::size_t>(kFamilyFrom);
     c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
     c.sincos_residual_after = rms(s.rss[1], s.n[1]);
     c.dq_residual_after = rms(s.rss[2], s.n[2]);
@@ -246,7 +312,9 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   for (Candidate& c : out.candidates) {
     if (refits >= kNonlinearRefits || !c.proposed) continue;
     const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
-    bool nonlinear = false;
+    // Envelope effects enter through atan2 too: at real magnitudes (a 15 % harmonic)
+    // one linearised step from zero leaves second-order terms far above the floor.
+    bool nonlinear = one.terms.front().effect->envelope_only() && !c.family;
     for (int p : one.terms.front().params) {
       nonlinear = nonlinear || one.terms.front().effect->params()[static_cast<std::size_t>(p)].nonlinear;
     }
@@ -308,6 +376,15 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
       const Candidate& b = out.candidates[j];
       if (a.proposed && b.proposed && alike(a, b) && simpler(b, a)) std::swap(out.candidates[i], out.candidates[j]);
     }
+  }
+  // A family first only when nothing smaller reaches the floor: one order that does
+  // is the plainer explanation (the family's extra orders may be a converter's
+  // quantization pattern at a speed commensurate with the sample rate).
+  if (!out.candidates.empty() && out.candidates.front().family) {
+    const auto smaller = std::find_if(out.candidates.begin() + 1, out.candidates.end(), [](const Candidate& c) {
+      return !c.family && c.proposed && c.reaches_floor;
+    });
+    if (smaller != out.candidates.end()) std::rotate(out.candidates.begin(), smaller, smaller + 1);
   }
   return out;
 }

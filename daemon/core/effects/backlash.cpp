@@ -32,6 +32,7 @@ class BacklashEffect final : public BasicEffect {
                     kParams, EffectStage::kMotion) {}
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool needs_speed_change() const override { return true; }
+  [[nodiscard]] Needs identifiable_with() const override { return Needs::kReversal; }
   [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double omega_m, MotionState& state,
                                        bool commit) const override {
     const double half = 0.5 * v[0];

@@ -24,6 +24,7 @@ class DelayEffect final : public BasicEffect {
                     kParams, EffectStage::kMotion) {}
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool needs_speed_change() const override { return true; }
+  [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChangeOrReversal; }
   [[nodiscard]] double resolver_time_shift(Values v) const override { return v[0]; }
   void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override { t.delay = v[0]; }
   [[nodiscard]] bool shapes_basis() const override { return true; }

@@ -172,6 +172,13 @@ class Effect {
   /// Only a log with changing speed or reversals separates it from the others
   /// (tracking loop, delay and backlash look like constants at one speed).
   [[nodiscard]] virtual bool needs_speed_change() const { return false; }
+  /// The motion without which the effect is not identifiable at all: at one speed in
+  /// one direction its signature is a constant or a turn of the other effects'
+  /// harmonics (delay: omega d; the loop: H(j k omega) per order), and in one
+  /// direction a play is a constant. Discovery lists it as "not identifiable here"
+  /// with what to record instead of proposing it (issue 21).
+  enum class Needs : std::uint8_t { kNothing, kSpeedChangeOrReversal, kSpeedChange, kReversal };
+  [[nodiscard]] virtual Needs identifiable_with() const { return Needs::kNothing; }
   /// The harmonic orders the columns of the fitted parameters `params` use.
   /// Default by stage: windings/channels/converter 2 theta, motion 0, currents 1 theta_e.
   [[nodiscard]] virtual HarmonicOrders orders(std::span<const int> params) const;

@@ -166,6 +166,23 @@ void Design::step(const Eigen::VectorXd& dz) {
   }
 }
 
+bool Design::pushed_past_bound(int col, double dz) const {
+  for (std::size_t i = 0; i < terms_.size(); ++i) {
+    const DesignTerm& t = terms_[i];
+    const int k = col - term_first_[i];
+    if (k < 0 || k >= static_cast<int>(t.params.size())) continue;
+    const auto p = static_cast<std::size_t>(t.params[static_cast<std::size_t>(k)]);
+    const ParamInfo& info = t.effect->params()[p];
+    if (info.polar != Polar::kNone) return false;
+    const double z = to_internal(info, t.values[p]);
+    const double lo = to_internal(info, info.min), hi = to_internal(info, info.max);
+    const double zmin = std::min(lo, hi), zmax = std::max(lo, hi);
+    const double tol = 1e-12 * std::max(1.0, zmax - zmin);
+    return (z <= zmin + tol && dz < 0.0) || (z >= zmax - tol && dz > 0.0);
+  }
+  return false;
+}
+
 std::vector<double> Design::values_with(std::size_t term, int column_in_term, double dz) const {
   const DesignTerm& t = terms_[term];
   std::vector<double> v = t.values;

@@ -95,6 +95,10 @@ class Design {
   /// Moves the model's parameters by dz (internal coordinates; nuisance and
   /// candidate entries ignored). Values are clamped to their ranges.
   void step(const Eigen::VectorXd& dz);
+  /// True when column `col`'s parameter sits at a bound of its range and `dz` would
+  /// push it past (a converter that is ideal: 1 / omega_n^2 = 0 asked to go below):
+  /// the fit then holds it at the bound instead of taking a step step() would clamp.
+  [[nodiscard]] bool pushed_past_bound(int col, double dz) const;
   /// Moves one column's coordinate only (numeric derivatives).
   [[nodiscard]] std::vector<double> values_with(std::size_t term, int column_in_term, double dz) const;
 

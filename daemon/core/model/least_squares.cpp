@@ -167,6 +167,17 @@ int frame_constant_column(const Design& d) {
   return rd;
 }
 
+/// True when design column `col` is a model term's nonlinear parameter.
+bool column_is_nonlinear(const Design& d, int col) {
+  for (std::size_t i = 0; i < d.terms().size(); ++i) {
+    const DesignTerm& t = d.terms()[i];
+    const int first = d.term_column(i);
+    if (col < first || col >= first + static_cast<int>(t.params.size())) continue;
+    return t.effect->params()[static_cast<std::size_t>(t.params[static_cast<std::size_t>(col - first)])].nonlinear;
+  }
+  return false;
+}
+
 /// True when every term's prediction is linear in its fitted parameters: one pass solves it.
 bool strictly_linear(const Design& d) {
   for (const DesignTerm& t : d.terms()) {
@@ -178,8 +189,10 @@ bool strictly_linear(const Design& d) {
 
 }  // namespace
 
-FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
-                     const std::function<void()>& progress) {
+namespace {
+
+FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
+                         const std::function<void()>& progress) {
   FitResult out;
   // Model columns only: candidates are evaluated at the model's solution later.
   std::vector<int> model_cols;
@@ -193,6 +206,15 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     }
   }
   const bool linear = strictly_linear(design);
+  // The first step holds the nonlinear parameters at their start: they act through
+  // the other effects' harmonics (a loop filters them, a delay turns them), whose
+  // columns are all zero at the neutral start, so a joint first step is a guess in
+  // an ill-conditioned direction (a loop once jumped to omega_n = 13 rad/s, filtered
+  // everything and stayed on that plateau at 364x the floor).
+  std::vector<int> warm_cols;
+  for (int c : model_cols) {
+    if (!column_is_nonlinear(design, c)) warm_cols.push_back(c);
+  }
   const int zero_col = linear ? -1 : frame_constant_column(design);
   if (zero_col >= 0) {
     // Start in the sensor's frame: the constant alone at the starting values (its
@@ -216,16 +238,35 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     // Rounding in sums over many rows moves the cost by ~1e-12 relative: a rise
     // smaller than the convergence tolerance is not a worse step.
     const double tolerance = 1e-9 * here + 1e-6;
-    if (here > cost + tolerance && lambda < 1e6) {
-      // The last step made it worse (nonlinear): go back, damp harder.
+    if (here > cost + tolerance) {
+      // The last step made it worse (nonlinear): go back, damp harder. Past the
+      // largest damping no step helps: the last good point is the answer, never an
+      // uphill one (a tracking loop once ended at omega_n = 14 rad/s, 364x the floor,
+      // from an ideal converter at 1x).
       design = last_good;
+      if (lambda >= 1e6) {
+        PassStatistics back(design.columns());
+        accumulate(design, rows, floors, back);
+        ++out.passes;
+        out.last = solve_step(back.all, floors, model_cols, 0.0);
+        out.stats = std::move(back);
+        out.cost = cost;
+        out.ok = out.last.ok;
+        return out;
+      }
       lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
       continue;
     }
     lambda = lambda / 10.0 < 1e-9 ? 0.0 : lambda / 10.0;
     cost = here;
     last_good = design;
-    StepSolution sol = solve_step(stats.all, floors, model_cols, lambda);
+    std::vector<int> cols = pass == 0 ? warm_cols : model_cols;
+    StepSolution sol = solve_step(stats.all, floors, cols, lambda);
+    // Parameters at a bound that the step pushes past are held there (their solution
+    // is the bound: an ideal converter, no play), and the rest solved without them.
+    if (sol.ok && std::erase_if(cols, [&](int c) { return design.pushed_past_bound(c, sol.dz[c]); }) > 0) {
+      sol = solve_step(stats.all, floors, cols, lambda);
+    }
     if (!sol.ok) {
       out.last = sol;
       out.stats = std::move(stats);
@@ -241,10 +282,11 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     const double shift = zero_col >= 0 ? design.frame_shift() - sol.dz[zero_col] : design.frame_shift();
     const bool shift_settled = std::abs(shift - design.frame_shift()) <= kShiftSettled;
     if (pass > 0 && shift_settled && here - sol.rss_w <= tolerance) {
-      const StepSolution free = lambda > 0.0 ? solve_step(stats.all, floors, model_cols, 0.0) : sol;
+      const StepSolution free = lambda > 0.0 ? solve_step(stats.all, floors, cols, 0.0) : sol;
       if (free.ok && here - free.rss_w <= tolerance) {
         out.last = free;
         out.stats = std::move(stats);
+        out.cost = here;
         out.ok = true;
         return out;
       }
@@ -255,12 +297,74 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
     design.set_frame_shift(shift);
     if (linear) {
       // One linearised step is exact; the statistics move with it (RSS(dz) above).
+      out.cost = sol.rss_w;
       out.ok = true;
       return out;
     }
   }
+  // Out of passes: the last step was never evaluated. Keep it only if it is not
+  // worse than the last point that was; the statistics and solution are the kept point's.
+  PassStatistics final_stats(design.columns());
+  accumulate(design, rows, floors, final_stats);
+  ++out.passes;
+  double final_cost = cost_at(final_stats, floors, nuisance_cols);
+  if (final_cost > cost + 1e-9 * cost + 1e-6) {
+    design = last_good;
+    final_stats = PassStatistics(design.columns());
+    accumulate(design, rows, floors, final_stats);
+    ++out.passes;
+    final_cost = cost;
+  }
+  out.last = solve_step(final_stats.all, floors, model_cols, 0.0);
+  out.stats = std::move(final_stats);
+  out.cost = final_cost;
   out.ok = out.last.ok;
   return out;
+}
+
+/// Other starting values of a model's nonlinear parameter, where its cost has more
+/// than one valley (the loop's |H| and the delay's phase wrap; the take-up of a play):
+/// a tracking loop at 30000, 3000 and 300 rad/s (z = 1 / omega_n^2), other parameters
+/// a thousandth of their range either side of the start.
+std::vector<double> other_starts(const ParamInfo& p, double start) {
+  if (p.scale == FitScale::kInverseSquare) return {3e4, 3e3, 3e2};
+  const double step = 1e-3 * (p.max - p.min);
+  std::vector<double> out;
+  for (double v : {start + step, start - step}) {
+    if (v >= p.min && v <= p.max) out.push_back(v);
+  }
+  return out;
+}
+
+}  // namespace
+
+FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
+                     const std::function<void()>& progress) {
+  const Design start = design;
+  FitResult best = fit_from_start(design, rows, floors, max_passes, progress);
+  // Several starts for the parameters whose cost is multimodal: keep the lowest cost
+  // among the fits that ended (issue 21: a single start diverged into a far valley).
+  for (std::size_t i = 0; i < start.terms().size(); ++i) {
+    const DesignTerm& t = start.terms()[i];
+    if (t.candidate) continue;
+    for (int p : t.params) {
+      const ParamInfo& info = t.effect->params()[static_cast<std::size_t>(p)];
+      if (!info.nonlinear || info.polar != Polar::kNone) continue;
+      for (double v : other_starts(info, t.values[static_cast<std::size_t>(p)])) {
+        Design trial = start;
+        trial.terms()[i].values[static_cast<std::size_t>(p)] = v;
+        FitResult r = fit_from_start(trial, rows, floors, max_passes, progress);
+        r.passes += best.passes;
+        if (r.ok && (!best.ok || r.cost < best.cost)) {
+          best = std::move(r);
+          design = trial;
+        } else {
+          best.passes = r.passes;
+        }
+      }
+    }
+  }
+  return best;
 }
 
 }  // namespace resolver

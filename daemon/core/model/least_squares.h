@@ -13,6 +13,7 @@
 #include <Eigen/Dense>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -69,6 +70,9 @@ struct FitResult {
   int passes = 0;
   StepSolution last;        ///< the final linearised solution (at the converged point)
   PassStatistics stats;     ///< the statistics of the final pass (at the converged point)
+  /// Weighted RSS at the final point with the nuisance constants solved (what the
+  /// starts of a multimodal fit are compared by).
+  double cost = std::numeric_limits<double>::infinity();
 };
 
 /// Fits the design's model parameters (candidates are not moved): Gauss-Newton,
