@@ -183,6 +183,11 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     }
     out << "\n";
   }
+  if (info.calibration.saved) {
+    out << fmt::format("  calibration saved to {}\n", info.calibration.path);
+  } else if (!info.calibration.path.empty()) {
+    out << fmt::format("  calibration not saved to {}: {}\n", info.calibration.path, info.calibration.reason);
+  }
   const LatencyHistogram& lat = p.latency_total();
   out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us ({} frames timed)\n",
                      lat.percentile(0.5), lat.percentile(0.99), lat.max(), lat.count());
@@ -256,6 +261,9 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
                      json_number(last.residual_rms_rad), json_number(last.noise_floor_rad),
                      json_string(last.candidate_effect.empty() ? std::string() : last.candidate_effect.front()));
   }
+  j += fmt::format(",\"calibration\":{{\"path\":{},\"saved\":{},\"reason\":{}}}", json_string(info.calibration.path),
+                   info.calibration.saved ? "true" : "false",
+                   info.calibration.saved ? "null" : json_string(info.calibration.reason));
   j += "}\n";
   return j;
 }
