@@ -48,35 +48,6 @@ std::optional<std::string> read_text(const std::string& path) {
 
 }  // namespace
 
-namespace {
-
-/// Every property of a signal that changes what a frame decodes to.
-std::string signal_key(const dbc::Signal* sig) {
-  if (sig == nullptr) return "-";
-  return fmt::format("{}@{}+{}{}{}*{:.17g}+{:.17g}:{}", sig->name, sig->start_bit, sig->length,
-                     sig->order == dbc::ByteOrder::kLittleEndian ? "le" : "be", sig->is_signed ? "s" : "u", sig->factor,
-                     sig->offset, static_cast<int>(sig->value_type));
-}
-
-}  // namespace
-
-LayoutIdentity layout_identity(const DaemonConfig& config) {
-  const auto decoder = make_frame_decoder(config);
-  // What decodes a frame into a sample, and nothing else (comments, receivers, value
-  // tables and the DBC's file name do not make another layout).
-  std::string canonical = decoder->has_counter() ? "counter" : "no counter";
-  for (const FrameDecoder::Slot& slot : decoder->slots()) {
-    canonical += fmt::format("\n{} {:x}{} dlc {} counter {} crc {}", slot.message->name, slot.message->id,
-                             slot.message->extended ? "x" : "", slot.message->dlc, signal_key(slot.counter),
-                             signal_key(slot.crc));
-    for (const FrameDecoder::RoleSignal& r : slot.roles) {
-      canonical += fmt::format("\n  {} = {} to_unit {:.17g}{}", role_name(r.role), signal_key(r.signal), r.to_role_unit,
-                               r.wrap ? " wrapped" : "");
-    }
-  }
-  return {hex8(crc32_ieee(canonical)), describe_layout(config, *decoder)};
-}
-
 std::string file_crc32(const std::string& path) {
   if (path.empty()) return "";
   const auto text = read_text(path);

@@ -11,7 +11,8 @@
 //     clipping, overspeed ...) covers the data the estimate was made from.
 // And it is applied only on the layout it was learned on: the file records the
 // layout's identity (layout_identity()) with the rest of its provenance, and a
-// file from another layout is refused and moved aside, not applied.
+// file from another layout is refused and moved aside, not applied
+// (layout_identity(), pipeline.h).
 #pragma once
 
 #include <string>
@@ -29,18 +30,6 @@ struct CalibrationJudgement {
 
 /// Whether the run's estimate may be saved. Cannot fail.
 [[nodiscard]] CalibrationJudgement judge_calibration(const Pipeline& pipeline);
-
-/// The layout a calibration belongs to: `id` is 8 hex digits of CRC-32 over what turns
-/// frames into samples: each mapped message's name, ID and DLC, and for each role, the
-/// counter and the CRC its signal's name, bits, byte order, sign, scale, offset and unit
-/// conversion. A renamed, moved or re-commented DBC is the same layout; a changed
-/// scaling, ID, bit position or mapping is not. `description` says it in words
-/// (describe_layout()). Throws ConfigError like make_frame_decoder().
-struct LayoutIdentity {
-  std::string id;
-  std::string description;
-};
-[[nodiscard]] LayoutIdentity layout_identity(const DaemonConfig& config);
 
 /// 8 hex digits of CRC-32 of the file's text, "" when `path` is empty or unreadable.
 [[nodiscard]] std::string file_crc32(const std::string& path);

@@ -57,7 +57,9 @@ RESOLVER_MODEL_FIT, RESOLVER_HEALTH. A file:///PATH?mode=w log is stamped with b
 On udpm, --fast publishes as fast as the CPU allows and listeners (lcm-logger, lcm-spy) drop
 what their socket buffers cannot hold: use --rate X, or write a file:// log.
 Signals: SIGTERM/SIGINT end it within a second on any input (the report is printed);
-SIGHUP reloads the config, live and in replay (a bad config keeps the old one).
+SIGHUP reloads the config, live and in replay (a bad config keeps the old one); the run keeps
+its record: counters, rejects, signal health, the sample index and, with the same model, the
+learned estimate; the report lists each reload.
 )";
 
 using resolver::Calibration;
@@ -298,18 +300,19 @@ static int run(int argc, char** argv) {
   if (!notifier.last_error().empty()) std::cerr << "resolverd: " << notifier.last_error() << "\n";
 
   RunInfo info;
-  // SIGHUP: a new config replaces the pipeline only if it is valid (live and replay).
+  // SIGHUP: a valid new config is swapped into the running pipeline, which keeps the run's
+  // record (counters, rejects, health, sample index, the learned estimate: Pipeline::reload).
   auto reload = [&]() {
     notifier.reloading();
     try {
       DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
       if (lcm_url) fresh.lcm_url = *lcm_url;
-      auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr, !can_iface.empty());
-      pipeline->finish();
-      pipeline = std::move(rebuilt);
+      const Pipeline::Reload& done = pipeline->reload(fresh);
       config = fresh;
       config_crc = file_crc32(config_path);
-      std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path) << "\n";
+      std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path)
+                << fmt::format(" at {:.3f} s into the input (sample {}): ", done.t_s, done.sample_index) << done.what
+                << "\n";
     } catch (const std::exception& e) {
       std::cerr << "resolverd: reload failed, keeping the running config: " << e.what() << "\n";
     }

@@ -11,7 +11,7 @@ message, each with a control where one makes sense.
   replay without --once (loop)              LoopingReplay
   --fast replay into file://                LcmLogsOtherToolsCanUse.test_file_log_*
   --fast replay on udpm with lcm-logger     LcmLogsOtherToolsCanUse.test_udpm_*
-  SIGHUP during --replay                    SighupInReplay
+  SIGHUP during --replay                    SighupInReplay (issue 25: it keeps the record)
   30000 r/min                               Overspeed
   exit codes                                ExitCodes
 
@@ -411,15 +411,15 @@ class LcmLogsOtherToolsCanUse(unittest.TestCase):
 
 
 class SighupInReplay(unittest.TestCase):
-    def replay_and_reload(self, name, before, after, lcm):
+    def replay_and_reload(self, name, before, after, lcm, *extra, log=None, after_s=1.0):
         """Paced replay of a 4 s log with config text `before`; 1 s in, the file becomes
         `after` and resolverd gets SIGHUP. Returns stderr once it ran to the end (exit 0)."""
-        log = sim_log("clean_4s.log", "--rpm", "200", "--duration", "4")
+        log = log or sim_log("clean_4s.log", "--rpm", "200", "--duration", "4")
         cfg = work(name + ".toml")
         with open(cfg, "w") as f:
             f.write(before)
-        proc = spawn(resolverd("--replay", log, "--once", "--config", cfg, "--quiet", "--lcm", lcm))
-        time.sleep(1.0)
+        proc = spawn(resolverd("--replay", log, "--once", "--config", cfg, "--quiet", "--lcm", lcm, *extra))
+        time.sleep(after_s)
         with open(cfg, "w") as f:
             f.write(after)
         proc.send_signal(signal.SIGHUP)
@@ -435,6 +435,68 @@ class SighupInReplay(unittest.TestCase):
         methods = [m["method"] for m in echo_messages(lcmlog, "--channel", "RESOLVER_ESTIMATE")]
         self.assertIn("hwang_integral", methods)
         self.assertEqual(methods[-1], "sincos_least_squares", "the reloaded config runs to the end")
+
+    def test_reload_keeps_the_record(self):
+        # Issue 25: one valid SIGHUP reset the run's counters, rejects, health, the learned
+        # estimate and angle_t's sample_index (7395 back to 228); the final report covered
+        # 6043 of 23992 frames. The reload changes a threshold and keeps the model.
+        log = sim_log("clean_4s.log", "--rpm", "200", "--duration", "4")
+        with open(log) as f:
+            frames = sum(1 for line in f if line.strip())
+        lcmlog, report = work("sighup_keep.lcmlog"), work("sighup_keep.report.json")
+        for f in (lcmlog, report):
+            if os.path.exists(f):
+                os.remove(f)
+        # Windows of 4 revolutions (0.4 s here): estimates come before the reload, 1.5 s in.
+        model = "[model]\nwindow_revolutions = 4\n"
+        err = self.replay_and_reload("sighup_keep", model + "[health]\noutlier_sigmas = 8.0\n",
+                                     model + "[health]\noutlier_sigmas = 9.0\n", f"file://{lcmlog}?mode=w",
+                                     "--report", report, after_s=1.5)
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertEqual(rep["frames_seen"], frames, "the final report covers the whole log")
+        self.assertEqual(rep["samples_complete"], 8000)
+        self.assertEqual(rep["signal_health"]["samples"], 8000, "health counts the whole log")
+        self.assertEqual(rep["reload_count"], 1)
+        reload = rep["reloads"][0]
+        self.assertGreater(reload["t_s"], 0.0)
+        self.assertLess(reload["t_s"], 4.0)
+        self.assertTrue(reload["estimate_kept"])
+        self.assertRegex(err, r"resolverd: config reloaded from \S+ at \d+\.\d{3} s into the input \(sample \d+\): "
+                              r"the learned estimate is kept")
+        msgs = echo_messages(lcmlog)
+        index = [m["sample_index"] for m in msgs if m["channel"] == "RESOLVER_ANGLE"]
+        self.assertEqual(len(index), 8000)
+        self.assertTrue(all(b > a for a, b in zip(index, index[1:])), "angle_t's sample_index never steps back")
+        health = [m for m in msgs if m["channel"] == "RESOLVER_HEALTH"]
+        seen = [h["frames_seen"] for h in health]
+        self.assertTrue(all(b >= a for a, b in zip(seen, seen[1:])), "health_t's frame count never steps back")
+        self.assertEqual(seen[-1], frames)
+        # The learned model carries on: the estimates after the reload build on the ones before.
+        est = [m for m in msgs if m["channel"] == "RESOLVER_ESTIMATE"]
+        after = [m for m in est if m["sample_index"] > reload["sample_index"]]
+        before = [m for m in est if m["sample_index"] <= reload["sample_index"]]
+        self.assertTrue(before and after, "estimates on both sides of the reload")
+        self.assertTrue(before[-1]["converged"])
+        self.assertTrue(after[0]["converged"], "no restart: still converged right after the reload")
+        self.assertGreaterEqual(after[0]["revolutions_used"], before[-1]["revolutions_used"])
+
+    def test_reload_of_a_clean_log_with_rejects_keeps_them(self):
+        # The rejects before a reload stay in the report: a log with a CRC error early on.
+        log = work("sighup_crc.log")
+        with open(sim_log("clean_4s.log", "--rpm", "200", "--duration", "4")) as src:
+            lines = src.read().splitlines()
+        head, payload = lines[30].rsplit("#", 1)
+        lines[30] = head + "#" + payload[:-2] + ("00" if payload[-2:] != "00" else "01")  # the CRC byte
+        with open(log, "w") as dst:
+            dst.write("\n".join(lines) + "\n")
+        report = work("sighup_crc.report.json")
+        self.replay_and_reload("sighup_crc", "[health]\noutlier_sigmas = 8.0\n", "[health]\noutlier_sigmas = 9.0\n",
+                               "memq://", "--report", report, log=log)
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertEqual(rep["rejects"].get("crc"), 1, rep["rejects"])
+        self.assertEqual(rep["frames_seen"], len(lines))
 
     def test_bad_config_on_reload_keeps_the_running_one(self):
         err = self.replay_and_reload("sighup_bad", "[bench]\np_r = 3\n", "[bench]\npole_pairs = 3\n", "memq://")
