@@ -21,6 +21,10 @@
 // (counter time where there is one, daemon/decode/sample_clock.h); health_t
 // runs on frame (or row) time; the caller passes the frame's arrival time only
 // for latency.
+//
+// A config reload (SIGHUP) is swapped into the same pipeline (reload()): what the
+// run has counted, its sample index and, with the same model, what it has learned
+// carry on, so one report covers the whole run.
 #pragma once
 
 #include <chrono>
