@@ -5,7 +5,8 @@
 //   0  done
 //   1  the input had no usable data (nothing decoded, a damaged log)
 //   2  usage or configuration error (bad option, bad config file or DBC)
-//   3  I/O error (a file missing or unreadable, a directory for a file, a write that failed)
+//   3  I/O error (a file missing or unreadable, a directory for a file, a write that failed,
+//      a --state-dir that is missing, unwritable or locked by another resolverd)
 //   70 internal error (an unexpected exception: a bug, please report it)
 //
 // CLI11's own codes (105 for a missing --config file, 106 for a missing

@@ -60,6 +60,12 @@ class LiveModelFit {
   /// window is fitted too when it covers at least two revolutions.
   void finish();
   [[nodiscard]] const Counters& counters() const { return counters_; }
+  /// A config reload replaced `previous` (finished) by this one: its window counts
+  /// and last message carry on, so the run report covers the whole run.
+  void continue_from(const LiveModelFit& previous) {
+    counters_ = previous.counters_;
+    last_ = previous.last_;
+  }
   /// The last published message (verdict empty before the first window).
   [[nodiscard]] const model_fit_t& last() const { return last_; }
 

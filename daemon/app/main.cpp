@@ -11,8 +11,10 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string_view>
 
+#include "daemon/app/calibration_gate.h"
 #include "daemon/app/daemon_config.h"
 #include "daemon/app/exit_codes.h"
 #include "daemon/app/lcm_output.h"
@@ -22,6 +24,7 @@
 #include "daemon/app/run_report.h"
 #include "daemon/app/stop_flag.h"
 #include "daemon/service/calibration_store.h"
+#include "daemon/service/state_dir_lock.h"
 #include "daemon/service/table_file.h"
 #include "daemon/service/sd_notify.h"
 #include "daemon/service/program_version.h"
@@ -54,7 +57,9 @@ RESOLVER_MODEL_FIT, RESOLVER_HEALTH. A file:///PATH?mode=w log is stamped with b
 On udpm, --fast publishes as fast as the CPU allows and listeners (lcm-logger, lcm-spy) drop
 what their socket buffers cannot hold: use --rate X, or write a file:// log.
 Signals: SIGTERM/SIGINT end it within a second on any input (the report is printed);
-SIGHUP reloads the config, live and in replay (a bad config keeps the old one).
+SIGHUP reloads the config, live and in replay (a bad config keeps the old one); the run keeps
+its record: counters, rejects, signal health, the sample index and, with the same model, the
+learned estimate; the report lists each reload.
 )";
 
 using resolver::Calibration;
@@ -157,8 +162,11 @@ static int run(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   std::string state_dir;
   app.add_option("--state-dir", state_dir,
-                 "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start, "
-                 "saved at exit when the estimate has converged");
+                 "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start unless it "
+                 "was learned on another layout (then moved aside), saved at exit only from a healthy run (estimate "
+                 "converged, model fit not unexplained, no lasting signal fault; else the reason is printed). "
+                 "Locked while resolverd runs: a second resolverd on the same directory exits 3 naming the first's pid; "
+                 "a save that fails exits 3");
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
   if (slice.to_s < slice.from_s) {
     std::cerr << "resolverd: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
@@ -188,6 +196,17 @@ static int run(int argc, char** argv) {
     return exit_code::kUsage;
   }
   if (lcm_url) config.lcm_url = *lcm_url;
+  std::string config_crc = file_crc32(config_path);  // provenance of a saved calibration
+  // Held for the whole run (see state_dir_lock.h); taken before anything is read from the directory.
+  std::optional<StateDirLock> state_lock;
+  if (!state_dir.empty()) {
+    std::string problem;
+    state_lock = StateDirLock::acquire(state_dir, problem);
+    if (!state_lock) {
+      std::cerr << "resolverd: " << problem << "\n";
+      return exit_code::kIo;
+    }
+  }
   if (!config.dbc_path.empty()) {
     if (auto problem = exit_code::unreadable("[layout] dbc", config.dbc_path)) {
       std::cerr << "resolverd: " << config_path << ": " << *problem << "\n";
@@ -228,7 +247,32 @@ static int run(int argc, char** argv) {
     }
   }
   if (!state_dir.empty()) {
-    const LoadResult loaded = load_calibration(state_dir);
+    LoadResult loaded = load_calibration(state_dir);
+    if (loaded.status == LoadResult::Status::kLoaded) {
+      const Calibration::Provenance& saved = loaded.calibration->provenance;
+      LayoutIdentity here;
+      try {
+        here = layout_identity(config);
+      } catch (const std::exception& e) {
+        std::cerr << "resolverd: " << e.what() << "\n";
+        return exit_code::kUsage;
+      }
+      if (saved.layout_id.empty()) {
+        std::cerr << "resolverd: " << calibration_path(state_dir)
+                  << " records no layout (written by an older resolverd); it is applied unchecked and the next save "
+                     "records this run's layout\n";
+      } else if (saved.layout_id != here.id) {
+        std::string moved_to;
+        const auto not_moved = set_calibration_aside(state_dir, "refused-" + utc_now(true), moved_to);
+        std::cerr << "resolverd: the saved calibration " << calibration_path(state_dir) << " was learned on another layout ("
+                  << saved.layout << ", layout id " << saved.layout_id << ", from " << saved.source << " at "
+                  << saved.saved_at << ") than this run's (" << here.description << ", layout id " << here.id
+                  << "); it is NOT applied, "
+                  << (not_moved ? "and could not be kept aside (" + *not_moved + ")" : "kept aside as " + moved_to)
+                  << "; learning from scratch\n";
+        loaded.status = LoadResult::Status::kMissing;
+      }
+    }
     if (loaded.status == LoadResult::Status::kLoaded) {
       const Calibration& cal = *loaded.calibration;
       if (config.method == EstimatorMethod::kModel && !cal.model.empty()) {
@@ -256,17 +300,19 @@ static int run(int argc, char** argv) {
   if (!notifier.last_error().empty()) std::cerr << "resolverd: " << notifier.last_error() << "\n";
 
   RunInfo info;
-  // SIGHUP: a new config replaces the pipeline only if it is valid (live and replay).
+  // SIGHUP: a valid new config is swapped into the running pipeline, which keeps the run's
+  // record (counters, rejects, health, sample index, the learned estimate: Pipeline::reload).
   auto reload = [&]() {
     notifier.reloading();
     try {
       DaemonConfig fresh = config_path.empty() ? DaemonConfig{} : load_daemon_config(config_path);
       if (lcm_url) fresh.lcm_url = *lcm_url;
-      auto rebuilt = std::make_unique<Pipeline>(fresh, *output, std::cerr, !can_iface.empty());
-      pipeline->finish();
-      pipeline = std::move(rebuilt);
+      const Pipeline::Reload& done = pipeline->reload(fresh);
       config = fresh;
-      std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path) << "\n";
+      config_crc = file_crc32(config_path);
+      std::cerr << "resolverd: config reloaded" << (config_path.empty() ? "" : " from " + config_path)
+                << fmt::format(" at {:.3f} s into the input (sample {}): ", done.t_s, done.sample_index) << done.what
+                << "\n";
     } catch (const std::exception& e) {
       std::cerr << "resolverd: reload failed, keeping the running config: " << e.what() << "\n";
     }
@@ -299,22 +345,50 @@ static int run(int argc, char** argv) {
     return exit_code::kIo;
   }
 
-  print_run_report(std::cout, *pipeline, info);
-  const ModelEstimate model = pipeline->processor().estimate();
-  if (!state_dir.empty() && model.converged) {
-    Calibration cal;
-    cal.p_r = pipeline->processor().config().p_r;
-    cal.p = pipeline->processor().config().p;
-    cal.method = model.method;
-    cal.samples = model.samples;
-    for (const ParamEstimate& prm : model.params) cal.params.push_back({prm.name, prm.value, prm.std_error});
-    if (pipeline->processor().config().method == EstimatorMethod::kModel) describe_model(pipeline->processor().model(), cal);
-    if (auto problem = save_calibration(state_dir, cal)) {
-      std::cerr << "resolverd: " << *problem << "\n";
+  // The calibration: judged, saved or not, before the report so the report says which.
+  bool save_failed = false;
+  if (!state_dir.empty()) {
+    info.calibration.path = calibration_path(state_dir);
+    const CalibrationJudgement judged = judge_calibration(*pipeline);
+    if (!judged.trusted) {
+      info.calibration.reason = judged.reason;
+      std::cerr << "resolverd: calibration not saved to " << info.calibration.path << ": " << judged.reason
+                << "; the file there, if any, is unchanged\n";
     } else {
-      std::cerr << "resolverd: calibration saved to " << calibration_path(state_dir) << "\n";
+      const ModelEstimate model = pipeline->processor().estimate();
+      Calibration cal;
+      cal.p_r = pipeline->processor().config().p_r;
+      cal.p = pipeline->processor().config().p;
+      cal.method = model.method;
+      cal.samples = model.samples;
+      for (const ParamEstimate& prm : model.params) cal.params.push_back({prm.name, prm.value, prm.std_error});
+      if (pipeline->processor().config().method == EstimatorMethod::kModel) describe_model(pipeline->processor().model(), cal);
+      Calibration::Provenance& pv = cal.provenance;
+      pv.config = config_path;
+      pv.config_crc32 = config_crc;
+      try {
+        const LayoutIdentity layout = layout_identity(config);
+        pv.layout_id = layout.id;
+        pv.layout = layout.description;
+      } catch (const std::exception& e) {  // the DBC vanished since the start: save without it
+        std::cerr << "resolverd: " << e.what() << "; the calibration is saved without its layout\n";
+      }
+      pv.source = info.source;
+      pv.saved_at = utc_now();
+      pv.program = version_line("resolverd");
+      if (auto problem = save_calibration(state_dir, cal)) {
+        info.calibration.reason = *problem;
+        save_failed = true;
+        std::cerr << "resolverd: " << *problem << " (exit code 3)\n";
+      } else {
+        info.calibration.saved = true;
+        std::cerr << "resolverd: calibration saved to " << info.calibration.path << "\n";
+      }
     }
+  } else {
+    info.calibration.reason = "no --state-dir given";
   }
+  print_run_report(std::cout, *pipeline, info);
   int code = exit_code::kDone;
   (void)output->flush();
   if (output->publish_failures() > 0) {
@@ -332,6 +406,7 @@ static int run(int argc, char** argv) {
       return exit_code::kIo;
     }
   }
+  if (save_failed) code = exit_code::kIo;
   if (code == exit_code::kDone && !replay_path.empty() && pipeline->samples() == 0) {
     std::cerr << "resolverd: " << replay_path << ": no sample decoded ("
               << pipeline->intake().stats().frames_seen << " frames seen); nothing was estimated or published "

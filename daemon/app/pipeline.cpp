@@ -9,6 +9,7 @@
 
 #include "daemon/app/embedded_dbc.h"
 #include "daemon/dbc/dbc_parser.h"
+#include "daemon/service/calibration_store.h"
 
 namespace resolver {
 
@@ -47,6 +48,36 @@ std::string describe_layout(const DaemonConfig& config, const FrameDecoder& deco
 
 namespace {
 
+/// Every property of a signal that changes what a frame decodes to.
+std::string signal_key(const dbc::Signal* sig) {
+  if (sig == nullptr) return "-";
+  return fmt::format("{}@{}+{}{}{}*{:.17g}+{:.17g}:{}", sig->name, sig->start_bit, sig->length,
+                     sig->order == dbc::ByteOrder::kLittleEndian ? "le" : "be", sig->is_signed ? "s" : "u", sig->factor,
+                     sig->offset, static_cast<int>(sig->value_type));
+}
+
+}  // namespace
+
+LayoutIdentity layout_identity(const DaemonConfig& config) { return layout_identity(config, *make_frame_decoder(config)); }
+
+LayoutIdentity layout_identity(const DaemonConfig& config, const FrameDecoder& decoder) {
+  // What decodes a frame into a sample, and nothing else (comments, receivers, value
+  // tables and the DBC's file name do not make another layout).
+  std::string canonical = decoder.has_counter() ? "counter" : "no counter";
+  for (const FrameDecoder::Slot& slot : decoder.slots()) {
+    canonical += fmt::format("\n{} {:x}{} dlc {} counter {} crc {}", slot.message->name, slot.message->id,
+                             slot.message->extended ? "x" : "", slot.message->dlc, signal_key(slot.counter),
+                             signal_key(slot.crc));
+    for (const FrameDecoder::RoleSignal& r : slot.roles) {
+      canonical += fmt::format("\n  {} = {} to_unit {:.17g}{}", role_name(r.role), signal_key(r.signal), r.to_role_unit,
+                               r.wrap ? " wrapped" : "");
+    }
+  }
+  return {fmt::format("{:08x}", crc32_ieee(canonical)), describe_layout(config, decoder)};
+}
+
+namespace {
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // DESIGN 5: health_t at 1 Hz
 
@@ -74,6 +105,8 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
                    const SampleSlice& slice)
     : config_(config),
       sink_(sink),
+      diagnostics_(diagnostics),
+      realtime_(realtime),
       problems_(diagnostics, "resolverd: "),
       stream_(make_frame_decoder(config), sample_stream_config(config, slice),
               SampleStream::Callbacks{
@@ -91,6 +124,113 @@ Pipeline::Pipeline(const DaemonConfig& config, OutputSink& sink, std::ostream& d
     diagnostics << "resolverd: warning: " << w << "\n";
   }
   for (const std::string& w : stream_.intake().decoder().warnings()) diagnostics << "resolverd: warning: " << w << "\n";
+}
+
+namespace {
+
+bool same_model_spec(const ModelFitOptions& a, const ModelFitOptions& b) {
+  if (a.effects != b.effects || a.custom.size() != b.custom.size()) return false;
+  for (std::size_t i = 0; i < a.custom.size(); ++i) {
+    const CustomEffectSpec& x = a.custom[i];
+    const CustomEffectSpec& y = b.custom[i];
+    if (x.name != y.name || x.signal != y.signal || x.terms != y.terms) return false;
+  }
+  return true;
+}
+
+bool same_fit_options(const ModelFitOptions& a, const ModelFitOptions& b) {
+  return a.enabled == b.enabled && same_model_spec(a, b) && a.window_revolutions == b.window_revolutions &&
+         a.candidates == b.candidates && a.reference_aligned == b.reference_aligned;
+}
+
+bool same_stream(const SampleStreamConfig& a, const SampleStreamConfig& b) {
+  return a.clock.counter_time == b.clock.counter_time && a.clock.sample_rate_hz == b.clock.sample_rate_hz &&
+         a.clock.max_counter_delta == b.clock.max_counter_delta && a.use_bench_info == b.use_bench_info &&
+         a.row_rate_hz == b.row_rate_hz;
+}
+
+}  // namespace
+
+const Pipeline::Reload& Pipeline::reload(const DaemonConfig& fresh) {
+  // Everything that can fail first: nothing below changes until these are built.
+  std::shared_ptr<const FrameDecoder> decoder = make_frame_decoder(fresh);
+  const bool same_layout = layout_identity(config_, stream_.intake().decoder()).id == layout_identity(fresh, *decoder).id;
+  const SampleStreamConfig stream_config = sample_stream_config(fresh, stream_.slice());
+  SignalHealthConfig health = health_config_for(fresh, *decoder);
+  const ProcessorConfig now = processor_.config();
+  ProcessorConfig next = processor_config(fresh);
+  if (bench_info_seen_ && fresh.bench.use_bench_info) {  // the bench said so; the config's are defaults
+    next.p_r = now.p_r;
+    next.p = now.p;
+  }
+  const bool same_model = next.method == now.method && next.p_r == now.p_r && next.p == now.p &&
+                          same_model_spec(config_.model, fresh.model);
+  const bool keep_processor = same_model && next == now;
+  std::optional<SampleProcessor> replacement;
+  if (!keep_processor) replacement.emplace(next);
+  const bool keep_fit = model_fit_ ? same_fit_options(config_.model, fresh.model) : !fresh.model.enabled;
+  std::unique_ptr<LiveModelFit> fit;
+  if (!keep_fit && fresh.model.enabled) fit = std::make_unique<LiveModelFit>(fresh.model, sink_, diagnostics_, realtime_);
+
+  // Nothing below throws.
+  std::vector<std::string> notes;
+  if (!same_layout) {
+    notes.push_back("new layout " + describe_layout(fresh, *decoder) + ": counters and joins restart");
+    for (const std::string& w : decoder->warnings()) diagnostics_ << "resolverd: warning: " << w << "\n";
+  }
+  if (!same_layout || !same_stream(stream_config, sample_stream_config(config_, stream_.slice()))) {
+    stream_.reconfigure(same_layout ? nullptr : decoder, stream_config);
+  }
+  if (rows_seen_ && !fresh.health_full_scale_set) {
+    health.full_scale = csv_sincos_full_scale(fresh.csv.map);
+    health.clip_margin = 0.0;
+  }
+  signal_health_.set_config(health);
+  signal_health_.set_pole_pairs(next.p_r);
+  if (!keep_fit) {
+    if (model_fit_) {
+      // Its last windows are fitted and published under the config they were read with.
+      model_fit_->finish();
+      if (auto fitted = model_fit_->take_model(); fitted && now.method == EstimatorMethod::kModel) {
+        processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+      }
+      if (fit) fit->continue_from(*model_fit_);
+    }
+    model_fit_ = std::move(fit);
+    notes.emplace_back(model_fit_ ? "the live model fit starts a new window" : "the live model fit is off");
+  }
+  bool estimate_kept = keep_processor;
+  if (!keep_processor) {
+    const ModelEstimate learned = processor_.estimate();
+    if (same_model && next.method == EstimatorMethod::kModel && !processor_.model().empty()) {
+      replacement->set_model(processor_.model(), learned.samples, learned.revolutions);
+      estimate_kept = true;
+    } else if (same_model && next.method == EstimatorMethod::kHwangIntegral && processor_.active_alpha() != 0.0) {
+      replacement->seed_alpha(processor_.active_alpha());  // compensation goes on while it learns again
+    }
+    if (table_) replacement->set_table(*table_);
+    std::string why = next.method != now.method     ? "the method changed (" + learned.method + " -> " +
+                                                           replacement->estimate().method + ")"
+                      : !same_model                 ? std::string("the model changed ([model] effects or custom "
+                                                                  "effects, or pole pairs)")
+                      : estimate_kept               ? std::string()
+                      : learned.params.empty()      ? std::string("nothing was learned yet")
+                                                    : std::string("the estimator's settings changed");
+    processor_ = std::move(*replacement);
+    notes.push_back(estimate_kept ? "the learned model is kept (the estimator's settings are new)"
+                                  : "estimation restarts: " + why);
+  } else {
+    notes.emplace_back("the learned estimate is kept");
+  }
+  config_ = fresh;
+  Reload r;
+  r.t_s = have_t_ ? last_t_ - first_t_ : 0.0;
+  r.sample_index = last_sample_index_;
+  r.utime = last_utime_;
+  r.estimate_kept = estimate_kept;
+  for (std::size_t i = 0; i < notes.size(); ++i) r.what += (i ? "; " : "") + notes[i];
+  reloads_.push_back(std::move(r));
+  return reloads_.back();
 }
 
 void Pipeline::count_problem(std::string_view reason, const std::string& message) {
@@ -206,6 +346,9 @@ void Pipeline::on_bench_info(const BenchInfo& info) {
 
 void Pipeline::on_sample(const Sample& sample, std::uint8_t counter) {
   ++samples_;
+  if (!have_t_) first_t_ = sample.t;
+  have_t_ = true;
+  last_t_ = sample.t;
   last_sample_index_ = sample.index;
   last_counter_ = counter;
   last_utime_ = sample.utime;

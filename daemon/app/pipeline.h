@@ -21,13 +21,19 @@
 // (counter time where there is one, daemon/decode/sample_clock.h); health_t
 // runs on frame (or row) time; the caller passes the frame's arrival time only
 // for latency.
+//
+// A config reload (SIGHUP) is swapped into the same pipeline (reload()): what the
+// run has counted, its sample index and, with the same model, what it has learned
+// carry on, so one report covers the whole run.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <ostream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -52,6 +58,20 @@ namespace resolver {
 /// How messages name the layout in use: "the default bench layout (proto/resolver_bench.dbc ...: RESOLVER_SAMPLE
 /// 0x100 (sin = sin, ...), ...)" or "the layout of my.dbc from cfg.toml (...)".
 [[nodiscard]] std::string describe_layout(const DaemonConfig& config, const FrameDecoder& decoder);
+
+/// The layout a calibration belongs to: `id` is 8 hex digits of CRC-32 over what turns
+/// frames into samples: each mapped message's name, ID and DLC, and for each role, the
+/// counter and the CRC its signal's name, bits, byte order, sign, scale, offset and unit
+/// conversion. A renamed, moved or re-commented DBC is the same layout; a changed
+/// scaling, ID, bit position or mapping is not. `description` says it in words
+/// (describe_layout()). Throws ConfigError like make_frame_decoder().
+struct LayoutIdentity {
+  std::string id;
+  std::string description;
+};
+[[nodiscard]] LayoutIdentity layout_identity(const DaemonConfig& config);
+/// The same for a decoder already made from `config`. Cannot fail.
+[[nodiscard]] LayoutIdentity layout_identity(const DaemonConfig& config, const FrameDecoder& decoder);
 
 class Pipeline {
  public:
@@ -86,8 +106,29 @@ class Pipeline {
   void seed_alpha(double alpha) { processor_.seed_alpha(alpha); }
   /// Compensate with a persisted or loaded model until the live fit has one.
   void seed_model(Model model) { processor_.set_model(std::move(model), 0, 0.0); }
-  /// Compensate with an exported table (resolverd --calibration).
-  void use_table(CalibrationTable table) { processor_.set_table(std::move(table)); }
+  /// Compensate with an exported table (resolverd --calibration); kept across reloads.
+  void use_table(CalibrationTable table) {
+    table_ = table;
+    processor_.set_table(std::move(table));
+  }
+
+  /// One config reload (SIGHUP), as the run report lists it.
+  struct Reload {
+    double t_s = 0.0;               ///< [s] sample time of the last sample before it, from the first sample
+    std::int64_t sample_index = 0;  ///< that sample's index
+    std::int64_t utime = 0;         ///< [us] that sample's utime (bench time)
+    bool estimate_kept = false;     ///< the learned estimate carried on
+    std::string what;               ///< what changed and what carried on, one line
+  };
+  /// Swaps in `fresh` between two frames and keeps the run's record: frame and sample
+  /// counts, rejects, signal-health counts, the sample clock and index, the report's
+  /// statistics and the live fit's window counts; and the learned estimate when the model
+  /// is unchanged (same method, [model] effects and custom effects, pole pairs). A new
+  /// layout restarts counters and joins (as a log loop does). Throws (ConfigError, or what
+  /// building the new parts throws) before anything changes when `fresh` cannot run.
+  const Reload& reload(const DaemonConfig& fresh);
+  /// Every reload so far, in order.
+  [[nodiscard]] const std::vector<Reload>& reloads() const { return reloads_; }
   /// Cumulative frames dropped by the kernel (SO_RXQ_OVFL), for health_t.
   void set_kernel_drops(std::int64_t drops) { kernel_drops_ = drops; }
 
@@ -125,6 +166,8 @@ class Pipeline {
 
   DaemonConfig config_;
   OutputSink& sink_;
+  std::ostream& diagnostics_;
+  bool realtime_;
   ProblemLog problems_;
   SampleStream stream_;
   SampleProcessor processor_;
@@ -146,6 +189,11 @@ class Pipeline {
   std::unique_ptr<LiveModelFit> model_fit_;
   SignalHealthLog signal_health_;
   std::function<void(const Sample&)> observer_;
+  std::optional<CalibrationTable> table_;  ///< --calibration, re-applied after a reload
+  bool have_t_ = false;
+  double first_t_ = 0.0;  ///< [s] sample time of the first sample
+  double last_t_ = 0.0;   ///< [s] and of the last
+  std::vector<Reload> reloads_;
 };
 
 }  // namespace resolver

@@ -183,6 +183,19 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     }
     out << "\n";
   }
+  if (!p.reloads().empty()) {
+    out << fmt::format("  reloads    {} (SIGHUP), the report covers the whole run:", p.reloads().size());
+    for (const Pipeline::Reload& r : p.reloads()) {
+      out << fmt::format(" {:.3f} s (sample {}, {})", r.t_s, r.sample_index,
+                         r.estimate_kept ? "estimate kept" : "estimation restarted");
+    }
+    out << "\n";
+  }
+  if (info.calibration.saved) {
+    out << fmt::format("  calibration saved to {}\n", info.calibration.path);
+  } else if (!info.calibration.path.empty()) {
+    out << fmt::format("  calibration not saved to {}: {}\n", info.calibration.path, info.calibration.reason);
+  }
   const LatencyHistogram& lat = p.latency_total();
   out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us ({} frames timed)\n",
                      lat.percentile(0.5), lat.percentile(0.99), lat.max(), lat.count());
@@ -256,6 +269,18 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
                      json_number(last.residual_rms_rad), json_number(last.noise_floor_rad),
                      json_string(last.candidate_effect.empty() ? std::string() : last.candidate_effect.front()));
   }
+  // Config reloads (SIGHUP): when each happened, in sample time from the first sample and bench time.
+  j += fmt::format(",\"reload_count\":{},\"reloads\":[", p.reloads().size());
+  for (std::size_t i = 0; i < p.reloads().size(); ++i) {
+    const Pipeline::Reload& rl = p.reloads()[i];
+    j += fmt::format("{}{{\"t_s\":{},\"sample_index\":{},\"utime\":{},\"estimate_kept\":{},\"what\":{}}}", i ? "," : "",
+                     json_number(rl.t_s), rl.sample_index, rl.utime, rl.estimate_kept ? "true" : "false",
+                     json_string(rl.what));
+  }
+  j += "]";
+  j += fmt::format(",\"calibration\":{{\"path\":{},\"saved\":{},\"reason\":{}}}", json_string(info.calibration.path),
+                   info.calibration.saved ? "true" : "false",
+                   info.calibration.saved ? "null" : json_string(info.calibration.reason));
   j += "}\n";
   return j;
 }

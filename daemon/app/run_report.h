@@ -10,9 +10,17 @@
 
 namespace resolver {
 
+/// What became of the run's calibration (calibration_gate.h).
+struct CalibrationOutcome {
+  std::string path;     ///< the calibration file ("" without --state-dir)
+  bool saved = false;
+  std::string reason;   ///< why it was not saved (empty when saved)
+};
+
 struct RunInfo {
   std::string source;        ///< log path or interface
   double wall_seconds = 0.0; ///< processing wall time [s]
+  CalibrationOutcome calibration;
 };
 
 void print_run_report(std::ostream& out, const Pipeline& pipeline, const RunInfo& info);

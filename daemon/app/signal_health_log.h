@@ -30,6 +30,8 @@ class SignalHealthLog {
   void set_pole_pairs(int p_r) { monitor_.set_pole_pairs(p_r); }
   void set_sample_rate(double hz) { monitor_.set_sample_rate(hz); }
   void set_full_scale(double full_scale, double clip_margin) { monitor_.set_full_scale(full_scale, clip_margin); }
+  /// New thresholds (config reload); everything counted so far stays.
+  void set_config(const SignalHealthConfig& config) { monitor_.set_config(config); }
   /// atan2 of this sample's sin/cos is noise (amplitude lost): publish NaN.
   [[nodiscard]] bool sincos_lost(const Sample& s) const { return monitor_.sincos_lost(s); }
   /// Amplitude since the last call and every fault, into health_t.

@@ -34,6 +34,15 @@ void FrameIntake::restart_sequence() {
   for (auto& c : counters_) c.reset();
 }
 
+void FrameIntake::change_decoder(std::shared_ptr<const FrameDecoder> decoder, int max_counter_delta) {
+  flush();
+  decoder_ = std::move(decoder);
+  max_counter_delta_ = max_counter_delta;
+  counters_.assign(decoder_->slots().size(), CounterCheck(max_counter_delta));
+  joiner_.reset();
+  order_joiner_.reset();
+}
+
 void FrameIntake::count_problem(std::string_view reason, const std::string& message) {
   rejects_.add(reason);
   if (callbacks_.on_problem) callbacks_.on_problem(reason, message);

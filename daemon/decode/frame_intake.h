@@ -65,10 +65,14 @@ class FrameIntake {
   }
   /// Forgets counters and open samples, keeps statistics (e.g. log loop).
   void restart_sequence();
+  /// A config reload: decodes with `decoder` from the next frame on. The open sample is
+  /// emitted, counters and joins restart (as at a log loop); statistics and rejects stay.
+  void change_decoder(std::shared_ptr<const FrameDecoder> decoder, int max_counter_delta);
 
   [[nodiscard]] const IntakeStats& stats() const { return stats_; }
   [[nodiscard]] const RejectCounters& rejects() const { return rejects_; }
   [[nodiscard]] const FrameDecoder& decoder() const { return *decoder_; }
+  [[nodiscard]] std::shared_ptr<const FrameDecoder> decoder_ptr() const { return decoder_; }
   /// Counter of the last frame decoded (valid once one was).
   [[nodiscard]] std::uint8_t last_frame_counter() const { return part_.counter; }
 

@@ -23,6 +23,13 @@ void SampleClock::set_sample_rate(double hz) {
   anchor(last_t_, last_index_, last_stamp_us_);
 }
 
+void SampleClock::reconfigure(const SampleClockConfig& config) {
+  const double rate = config.sample_rate_hz > 0.0 ? config.sample_rate_hz : config_.sample_rate_hz;
+  config_ = config;
+  config_.sample_rate_hz = rate;
+  anchor(last_t_, last_index_, last_stamp_us_);
+}
+
 void SampleClock::anchor(double t, std::int64_t index, std::int64_t stamp_us) {
   anchor_t_ = t;
   anchor_index_ = index;

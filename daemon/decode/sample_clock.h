@@ -89,6 +89,9 @@ class SampleClock {
   /// A new nominal rate (BENCH_INFO): time stays continuous, the new rate
   /// applies from the next sample on.
   void set_sample_rate(double hz);
+  /// A config reload: the new settings from the next sample on, time and index
+  /// continuous. A rate of 0 keeps the one in use (learned, or from BENCH_INFO).
+  void reconfigure(const SampleClockConfig& config);
   /// Log loop: the next sample continues one period after the last one, with
   /// the next index, whatever its stamp and counter say.
   void restart() { started_ = false; }

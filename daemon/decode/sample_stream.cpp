@@ -45,6 +45,16 @@ void SampleStream::restart_sequence() {
   clock_.restart();
 }
 
+void SampleStream::reconfigure(std::shared_ptr<const FrameDecoder> decoder, const SampleStreamConfig& config) {
+  const SampleSlice slice = config_.slice;
+  if (decoder || config.clock.max_counter_delta != config_.clock.max_counter_delta) {
+    intake_.change_decoder(decoder ? std::move(decoder) : intake_.decoder_ptr(), config.clock.max_counter_delta);
+  }
+  config_ = config;
+  config_.slice = slice;
+  clock_.reconfigure(config.clock);
+}
+
 void SampleStream::feed_row(const RowSample& row, std::uint64_t line) {
   line_ = line;
   BenchSample s;

@@ -65,6 +65,10 @@ class SampleStream {
   void flush() { intake_.flush(); }
   /// Log loop: counters and joins restart; time and index continue.
   void restart_sequence();
+  /// A config reload: `config` (its slice is ignored: the command line's stays) and,
+  /// when `decoder` is set, a new layout (FrameIntake::change_decoder). Time, sample
+  /// index, statistics and rejects continue. Cannot fail.
+  void reconfigure(std::shared_ptr<const FrameDecoder> decoder, const SampleStreamConfig& config);
 
   /// True once a sample was later than the slice's end: reading further is useless.
   [[nodiscard]] bool past_slice_end() const { return past_slice_end_; }

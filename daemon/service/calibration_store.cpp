@@ -74,6 +74,15 @@ std::pair<std::string_view, std::string_view> split_key(std::string_view line) {
   return {line.substr(0, space), line.substr(space + 1)};
 }
 
+/// `text` on one line: control characters (a line break in a path) become '?'.
+std::string one_line(std::string_view text) {
+  std::string out(text);
+  for (char& ch : out) {
+    if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = '?';
+  }
+  return out;
+}
+
 std::string errno_text(int err) { return std::strerror(err); }
 
 /// Writes all of `data` to `fd`, retrying short writes and EINTR. errno on failure.
@@ -160,6 +169,20 @@ std::optional<std::string> format_calibration(const Calibration& c, std::string&
   for (const auto& param : c.params) {
     body += "param " + param.name + " " + shortest(param.value) + " " + shortest(param.std_error) + "\n";
   }
+  const Calibration::Provenance& pv = c.provenance;
+  for (const auto& [key, value] : {std::pair<const char*, const std::string*>{"config", &pv.config},
+                                   {"config_crc32", &pv.config_crc32},
+                                   {"source", &pv.source},
+                                   {"saved_at", &pv.saved_at},
+                                   {"program", &pv.program}}) {
+    if (!value->empty()) body += std::string(key) + " " + one_line(*value) + "\n";
+  }
+  if (!pv.layout_id.empty()) {
+    if (pv.layout_id.find_first_of(" \t\r\n") != std::string::npos) {
+      return "cannot save the calibration: layout id '" + printable(pv.layout_id) + "' contains blanks";
+    }
+    body += "layout " + pv.layout_id + " " + one_line(pv.layout) + "\n";
+  }
   char crc[16];
   std::snprintf(crc, sizeof crc, "%08x", static_cast<unsigned>(crc32_ieee(body)));
   text = body + std::string(kChecksumKey) + crc + "\n";
@@ -201,10 +224,10 @@ std::optional<Calibration> parse_calibration(const std::string& text, const std:
       return fail("no 'format N' line after the identity line (found '" + printable(version_line) +
                   "'); the file is truncated or damaged and is ignored");
     }
-    if (version != kCalibrationFormatVersion && version != 1) {
-      return fail("calibration format version " + std::to_string(version) + ", but this resolverd reads only version " +
+    if (version < 1 || version > kCalibrationFormatVersion) {
+      return fail("calibration format version " + std::to_string(version) + ", but this resolverd reads only versions " +
                   std::to_string(kCalibrationFormatVersion) +
-                  " and 1; it was written by another resolverd release and is ignored (it is replaced at the next save)");
+                  ", 2 and 1; it was written by another resolverd release and is ignored (it is replaced at the next save)");
     }
   }
 
@@ -300,8 +323,22 @@ std::optional<Calibration> parse_calibration(const std::string& text, const std:
       }
       if (!names.insert(param.name).second) return fail(at + "parameter '" + param.name + "' appears twice; ignored");
       c.params.push_back(std::move(param));
+    } else if (key == "config" || key == "config_crc32" || key == "source" || key == "saved_at" ||
+               key == "program") {
+      Calibration::Provenance& pv = c.provenance;
+      std::string& field = key == "config"         ? pv.config
+                           : key == "config_crc32" ? pv.config_crc32
+                           : key == "source"       ? pv.source
+                           : key == "saved_at"     ? pv.saved_at
+                                                   : pv.program;
+      field = std::string(rest);
+    } else if (key == "layout") {
+      const auto [id, description] = split_key(rest);
+      if (id.empty()) return fail(at + "'layout' needs an id; ignored");
+      c.provenance.layout_id = std::string(id);
+      c.provenance.layout = std::string(description);
     } else {
-      return fail(at + "unknown key '" + printable(key) + "' in a version-1 file; ignored");
+      return fail(at + "unknown key '" + printable(key) + "'; ignored");
     }
   }
   if (!have_p_r || !have_p || !have_method || !have_samples) {
@@ -361,7 +398,9 @@ std::optional<std::string> save_calibration(const std::string& dir, const Calibr
 LoadResult load_calibration(const std::string& dir) {
   LoadResult result;
   const std::string path = calibration_path(dir);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer
+  // forever; fstat below then refuses anything that is not a regular file.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) {
     const int err = errno;
     if (err == ENOENT) {
@@ -378,7 +417,11 @@ LoadResult load_calibration(const std::string& dir) {
   std::string text;
   std::string problem;
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    problem = path + ": not a regular file; remove it; learning from scratch";
+    problem = path + ": not a regular file (" +
+              (S_ISFIFO(st.st_mode)  ? std::string("a FIFO")
+               : S_ISDIR(st.st_mode) ? std::string("a directory")
+                                     : std::string("a device or socket")) +
+              "); it is not read: remove it (the next save puts a file there); learning from scratch";
   } else if (static_cast<std::uint64_t>(st.st_size) > kMaxFileBytes) {
     problem = path + ": " + std::to_string(st.st_size) + " bytes is far larger than a calibration file (at most " +
               std::to_string(kMaxFileBytes) + "); not ours, ignored";
@@ -411,6 +454,16 @@ LoadResult load_calibration(const std::string& dir) {
     result.problem = problem;
   }
   return result;
+}
+
+std::optional<std::string> set_calibration_aside(const std::string& dir, const std::string& tag, std::string& moved_to) {
+  const std::string from = calibration_path(dir);
+  const std::string to = from + "." + tag;
+  if (::rename(from.c_str(), to.c_str()) != 0) {
+    return "cannot move " + from + " aside to " + to + ": " + errno_text(errno);
+  }
+  moved_to = to;
+  return std::nullopt;
 }
 
 }  // namespace resolver

@@ -4,8 +4,9 @@
 // their standard errors, for the bench identity p_r/p) in one small text file,
 // `<state dir>/calibration.txt` — under systemd the state dir is
 // /var/lib/resolverd (StateDirectory=resolverd, passed as --state-dir
-// ${STATE_DIRECTORY}). The file, format version 2 (version 1, without the model
-// and custom lines, is still read):
+// ${STATE_DIRECTORY}). The file, format version 3 (versions 1 and 2, without the
+// provenance lines, and version 1 also without the model and custom lines, are
+// still read):
 //
 //   resolverd-calibration                      magic/identity line (first line)
 //   format 2                                   format version
@@ -15,6 +16,14 @@
 //   p 4                                        motor pole pairs
 //   method hwang_integral                      estimator that produced it (may be empty)
 //   samples 123456                             samples the estimate used
+//   config /etc/resolverd/resolverd.toml       provenance (format 3, each line optional):
+//   config_crc32 5e1f00aa                        the config file and CRC-32 of its text
+//   layout 0badcafe the default bench layout ...  CRC-32 of the layout (DBC text + signal
+//                                                map) and its description; a run on
+//                                                another layout refuses the file
+//   source /var/log/bench/run7.log             the log replayed, or the CAN interface
+//   saved_at 2026-11-26T01:44:32Z              UTC
+//   program resolverd 0.1.0 (git 7d43eb5)      the --version line of the writer
 //   param amplitude_imbalance.alpha 0.0123 4.5e-05    name value std_error (nan: not identifiable)
 //   ...
 //   crc32 1a2b3c4d                             CRC-32 (IEEE 802.3) of every byte above
@@ -62,18 +71,31 @@ struct Calibration {
   };
   std::vector<Custom> custom;
   std::vector<CalibrationParam> params;
+  /// Where the calibration came from (format 3; all empty in a version-1 or -2 file).
+  /// Printable one-line texts: a line break written here is saved as '?'.
+  struct Provenance {
+    std::string config;        ///< config file path; "" = the built-in defaults
+    std::string config_crc32;  ///< 8 hex digits, CRC-32 of the config file's text; "" with no file
+    std::string layout_id;     ///< 8 hex digits identifying the layout (see calibration_gate.h)
+    std::string layout;        ///< the layout in words, for messages
+    std::string source;        ///< log path or CAN interface
+    std::string saved_at;      ///< UTC, ISO 8601 ("2026-11-26T01:44:32Z")
+    std::string program;       ///< the writer's --version line
+    bool operator==(const Provenance&) const = default;
+  };
+  Provenance provenance;
   bool operator==(const Calibration&) const = default;
 };
 
 /// File name inside the state directory.
 inline constexpr const char* kCalibrationFileName = "calibration.txt";
-/// Format version this code writes; it also reads version 1.
-inline constexpr int kCalibrationFormatVersion = 2;
+/// Format version this code writes; it also reads versions 1 and 2.
+inline constexpr int kCalibrationFormatVersion = 3;
 
 /// Full path of the calibration file in `dir`.
 std::string calibration_path(const std::string& dir);
 
-/// Serialises `calibration` in format version 2 (with its checksum line).
+/// Serialises `calibration` in format version 3 (with its checksum line).
 /// Returns an error text instead if a field cannot be written (bad name,
 /// non-finite value, p_r/p out of range, newline in method).
 std::optional<std::string> format_calibration(const Calibration& calibration, std::string& text);
@@ -99,8 +121,14 @@ struct LoadResult {
   std::string problem;  ///< empty when loaded
 };
 
-/// Reads calibration_path(dir). Never throws; see LoadResult.
+/// Reads calibration_path(dir). Never throws and never blocks: a FIFO, device or
+/// directory in its place is rejected as not a regular file. See LoadResult.
 LoadResult load_calibration(const std::string& dir);
+
+/// Renames calibration_path(dir) to `<that path>.<tag>` (e.g. tag "refused-20261126T014432Z"),
+/// so a refused file is kept for a person to look at and the next save does not
+/// overwrite it. Returns nullopt and sets `moved_to`, or an error text naming both paths.
+std::optional<std::string> set_calibration_aside(const std::string& dir, const std::string& tag, std::string& moved_to);
 
 /// CRC-32 (IEEE 802.3, reflected poly 0xEDB88320, init and final xor
 /// 0xFFFFFFFF); crc32("123456789") == 0xCBF43926.

@@ -56,6 +56,7 @@ struct AngleFourierConfig {
   int poly_order = 2;
   /// Fewest samples before a fit is returned.
   std::int64_t min_samples = 32;
+  bool operator==(const AngleFourierConfig&) const = default;
 };
 
 struct AngleErrorFit {

@@ -54,6 +54,7 @@ struct HwangIntegralConfig {
   /// longer step means lost samples. 2.5: at constant speed and a fixed rate the
   /// steps are 1 interval (2 at most next to a crossing); one lost sample makes 2.
   double max_gap_intervals = 2.5;
+  bool operator==(const HwangIntegralConfig&) const = default;
 };
 
 /// Result of one completed resolver electrical revolution.

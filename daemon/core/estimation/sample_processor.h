@@ -78,6 +78,7 @@ struct ProcessorConfig {
   bool compensate = true;
   /// Electrical revolutions coherently averaged for the ripple amplitudes.
   int ripple_revolutions = 8;
+  bool operator==(const ProcessorConfig&) const = default;
 };
 
 struct RippleSet {

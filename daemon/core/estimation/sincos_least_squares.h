@@ -83,6 +83,7 @@ struct SinCosLsConfig {
   double scale = 0.0;
   /// Fewest samples before solve() returns a fit (must be > number of parameters).
   std::int64_t min_samples = 16;
+  bool operator==(const SinCosLsConfig&) const = default;
 };
 
 enum class SinCosFitMethod : std::uint8_t { kReference, kConic };

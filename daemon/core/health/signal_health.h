@@ -188,6 +188,12 @@ class SignalHealthMonitor {
     config_.clip_margin = clip_margin;
   }
   void set_sample_rate(double hz) { sample_rate_hz_ = hz; }
+  /// New thresholds (a config reload) from the next sample on; counts, episodes and
+  /// the open block stay.
+  void set_config(const SignalHealthConfig& config) {
+    if (config.block_s != config_.block_s) have_grid_ = false;  // a new grid from the next sample
+    config_ = config;
+  }
 
   /// One sample. Cannot fail; samples without sin/cos or angles only move what they can.
   void add(const Sample& s);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -207,6 +208,85 @@ TEST(PipelineHealth, AStepBackInTheLogKeepsHealthComing) {
   }
   EXPECT_EQ(sink.healths.size(), 4U);
   EXPECT_EQ(pipeline.intake().rejects().get("timestamp_step_back"), 1);
+}
+
+
+// Issue 25: a config reload (SIGHUP) swaps the config between two frames and keeps the
+// run's record: frame and sample counts, rejects, health counts and the sample index.
+class PipelineReload : public ::testing::Test {
+ protected:
+  void feed_samples(Pipeline& p, int from, int to) {
+    for (int k = from; k < to; ++k) {
+      const auto c = static_cast<std::uint8_t>(k);
+      const std::int64_t t = 1'000'000 + 500LL * k;
+      const double theta = 0.02 * k;
+      p.feed_untimed(bench::encode_resolver_sample(t, c, static_cast<std::int16_t>(26000 * std::sin(theta)),
+                                                   static_cast<std::int16_t>(26000 * std::cos(theta)),
+                                                   static_cast<std::uint16_t>(theta / (2 * 3.141592653589793) * 65536)),
+                     0);
+      p.feed_untimed(bench::encode_phase_currents(t + 1, c, 100, -50, -50), 0);
+      if (k == 5) {
+        CanFrame bad = bench::encode_resolver_sample(t + 2, c, 1, 1, 1);
+        bad.data[7] ^= 0xFF;  // CRC broken
+        p.feed_untimed(bad, 0);
+      }
+    }
+  }
+  RecordingSink sink;
+  std::ostringstream diag;
+};
+
+TEST_F(PipelineReload, KeepsCountersRejectsHealthAndTheSampleIndex) {
+  Pipeline pipeline(DaemonConfig{}, sink, diag);
+  feed_samples(pipeline, 0, 100);
+  const std::int64_t seen = pipeline.intake().stats().frames_seen;
+  DaemonConfig fresh = parse_daemon_config("[health]\noutlier_sigmas = 9.0\n", "fresh.toml");
+  const Pipeline::Reload& r = pipeline.reload(fresh);
+  EXPECT_TRUE(r.estimate_kept);
+  // The last sample out before it: 99, or 98 while the 100th waits for its last frame.
+  EXPECT_GE(r.sample_index, 98);
+  EXPECT_LE(r.sample_index, 99);
+  EXPECT_NEAR(r.t_s, static_cast<double>(r.sample_index) * 0.0005, 1e-9);
+  EXPECT_EQ(pipeline.intake().stats().frames_seen, seen);
+  feed_samples(pipeline, 100, 200);
+  pipeline.finish();
+  EXPECT_EQ(pipeline.intake().stats().frames_seen, seen + 200);  // 2 frames a sample; the bad one came before
+  EXPECT_EQ(pipeline.intake().rejects().all().at("crc"), 1);
+  EXPECT_EQ(pipeline.signal_health().summary().samples, 200);
+  EXPECT_EQ(pipeline.signal_health().monitor().config().outlier_sigmas, 9.0);
+  ASSERT_EQ(sink.angles.size(), 200u);
+  for (std::size_t i = 1; i < sink.angles.size(); ++i) {
+    ASSERT_GT(sink.angles[i].sample_index, sink.angles[i - 1].sample_index) << i;
+  }
+  ASSERT_EQ(pipeline.reloads().size(), 1u);
+}
+
+TEST_F(PipelineReload, ANewLayoutDecodesFromTheNextFrameAndTheIndexGoesOn) {
+  Pipeline pipeline(DaemonConfig{}, sink, diag);
+  feed_samples(pipeline, 0, 50);
+  // The phase currents swapped: another layout, the same frames still decode.
+  const DaemonConfig fresh = parse_daemon_config(
+      "[layout.signals]\nsin = \"RESOLVER_SAMPLE.sin\"\ncos = \"RESOLVER_SAMPLE.cos\"\n"
+      "rd_angle = \"RESOLVER_SAMPLE.rd_angle\"\ni_a = \"PHASE_CURRENTS.i_b\"\ni_b = \"PHASE_CURRENTS.i_a\"\n"
+      "i_c = \"PHASE_CURRENTS.i_c\"\n",
+      "swapped.toml");
+  const Pipeline::Reload& r = pipeline.reload(fresh);
+  EXPECT_NE(r.what.find("new layout"), std::string::npos) << r.what;
+  feed_samples(pipeline, 50, 100);
+  pipeline.finish();
+  EXPECT_EQ(pipeline.intake().stats().samples_complete, 100);
+  ASSERT_EQ(sink.angles.size(), 100u);
+  EXPECT_EQ(sink.angles.back().sample_index, 99);
+}
+
+TEST_F(PipelineReload, AConfigThatCannotRunChangesNothing) {
+  Pipeline pipeline(DaemonConfig{}, sink, diag);
+  feed_samples(pipeline, 0, 20);
+  const DaemonConfig bad = parse_daemon_config("[layout.signals]\ni_a = \"PHASE_CURRENTS.i_a\"\n", "bad.toml");
+  EXPECT_THROW((void)pipeline.reload(bad), ConfigError);
+  EXPECT_TRUE(pipeline.reloads().empty());
+  feed_samples(pipeline, 20, 40);
+  EXPECT_GE(pipeline.intake().stats().samples_complete, 39);  // the 40th may still be open
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "daemon/service/calibration_store.h"
+#include "daemon/service/state_dir_lock.h"
 
 namespace resolver {
 namespace {
@@ -154,7 +155,7 @@ TEST(CalibrationStore, RandomizedRoundTrip) {
 TEST(CalibrationStore, FileLayout) {
   const std::string text = formatted(sample_calibration());
   EXPECT_EQ(text.substr(0, text.find('\n')), "resolverd-calibration");
-  EXPECT_NE(text.find("\nformat 2\n"), std::string::npos);
+  EXPECT_NE(text.find("\nformat 3\n"), std::string::npos);
   EXPECT_NE(text.find("\np_r 1\np 4\nmethod hwang_integral\nsamples 1234567\n"), std::string::npos) << text;
   EXPECT_NE(text.find("\nparam amplitude_imbalance.alpha 0.3333333333333333 2.5e-05\n"), std::string::npos) << text;
   const auto last = text.rfind("crc32 ");
@@ -277,20 +278,20 @@ TEST(CalibrationStore, ForeignFileRejected) {
 
 TEST(CalibrationStore, WrongVersionRejected) {
   TempDir dir;
-  // A self-consistent future file: right magic, valid checksum, version 3.
-  const std::string v3 = with_fresh_checksum(replace_once(formatted(sample_calibration()), "\nformat 2\n", "\nformat 3\n"));
-  const LoadResult r = load_text(dir, v3);
-  expect_rejected(r, "format version 3");
-  EXPECT_NE(r.problem.find("only version 2 and 1"), std::string::npos) << r.problem;
+  // A self-consistent future file: right magic, valid checksum, version 4.
+  const std::string v4 = with_fresh_checksum(replace_once(formatted(sample_calibration()), "\nformat 3\n", "\nformat 4\n"));
+  const LoadResult r = load_text(dir, v4);
+  expect_rejected(r, "format version 4");
+  EXPECT_NE(r.problem.find("only versions 3, 2 and 1"), std::string::npos) << r.problem;
   // Version is checked before the checksum, so the reason is the version.
-  expect_rejected(load_text(dir, replace_once(formatted(sample_calibration()), "\nformat 2\n", "\nformat 7\n")),
+  expect_rejected(load_text(dir, replace_once(formatted(sample_calibration()), "\nformat 3\n", "\nformat 7\n")),
                   "format version 7");
 }
 
 TEST(CalibrationStore, VersionOneFilesAreStillRead) {
   TempDir dir;
   // What the previous release wrote: no model line.
-  const std::string v1 = with_fresh_checksum(replace_once(formatted(sample_calibration()), "\nformat 2\n", "\nformat 1\n"));
+  const std::string v1 = with_fresh_checksum(replace_once(formatted(sample_calibration()), "\nformat 3\n", "\nformat 1\n"));
   const LoadResult r = load_text(dir, v1);
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
   EXPECT_EQ(*r.calibration, sample_calibration());
@@ -335,6 +336,73 @@ TEST(CalibrationStore, OversizedAndNonRegularFilesRejected) {
   fs::remove(calibration_path(dir.path()));
   fs::create_directory(calibration_path(dir.path()));
   expect_rejected(load_calibration(dir.path()), "not a regular file");
+}
+
+TEST(CalibrationStore, AFifoInPlaceOfTheFileDoesNotBlock) {
+  // Opening a FIFO for reading waits for a writer; the load must refuse it at once.
+  TempDir dir;
+  ASSERT_EQ(::mkfifo(calibration_path(dir.path()).c_str(), 0644), 0);
+  const LoadResult r = load_calibration(dir.path());
+  expect_rejected(r, "not a regular file (a FIFO)");
+  // The next save replaces it with a file.
+  ASSERT_FALSE(save_calibration(dir.path(), sample_calibration()));
+  EXPECT_EQ(load_calibration(dir.path()).status, Status::kLoaded);
+}
+
+TEST(CalibrationStore, ProvenanceRoundTripsOnOneLineEach) {
+  TempDir dir;
+  Calibration c = sample_calibration();
+  c.provenance = {"/etc/resolverd/bench 2.toml", "5e1f00aa", "0badcafe", "the default bench layout (x: y = z)",
+                  "/var/log/run.log", "2026-11-26T01:44:32Z", "resolverd 0.1.0 (git 7d43eb5)"};
+  ASSERT_FALSE(save_calibration(dir.path(), c));
+  const LoadResult r = load_calibration(dir.path());
+  ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
+  EXPECT_EQ(r.calibration->provenance, c.provenance);
+  // A line break in a path cannot split the record: it is saved as '?'.
+  c.provenance.source = "/tmp/odd\nname.log";
+  ASSERT_FALSE(save_calibration(dir.path(), c));
+  const LoadResult odd = load_calibration(dir.path());
+  ASSERT_EQ(odd.status, Status::kLoaded) << odd.problem;
+  EXPECT_EQ(odd.calibration->provenance.source, "/tmp/odd?name.log");
+}
+
+TEST(CalibrationStore, SetAsideKeepsTheFileUnderANewName) {
+  TempDir dir;
+  ASSERT_FALSE(save_calibration(dir.path(), sample_calibration()));
+  std::string moved;
+  ASSERT_FALSE(set_calibration_aside(dir.path(), "refused-x", moved));
+  EXPECT_EQ(moved, calibration_path(dir.path()) + ".refused-x");
+  EXPECT_TRUE(fs::exists(moved));
+  EXPECT_EQ(load_calibration(dir.path()).status, Status::kMissing);
+  const auto err = set_calibration_aside(dir.path(), "again", moved);
+  ASSERT_TRUE(err);
+  EXPECT_NE(err->find("No such file"), std::string::npos) << *err;
+}
+
+TEST(StateDirLock, SecondHolderIsRefusedNamingThePid) {
+  TempDir dir;
+  std::string problem;
+  auto first = StateDirLock::acquire(dir.path(), problem);
+  ASSERT_TRUE(first) << problem;
+  // flock locks belong to the open file description: a second open in this process
+  // conflicts just as another process would.
+  auto second = StateDirLock::acquire(dir.path(), problem);
+  EXPECT_FALSE(second);
+  EXPECT_NE(problem.find("in use by another resolverd, pid " + std::to_string(::getpid())), std::string::npos)
+      << problem;
+  EXPECT_NE(problem.find(dir.path() + "/resolverd.lock"), std::string::npos) << problem;
+  first.reset();  // released: the next one gets it
+  EXPECT_TRUE(StateDirLock::acquire(dir.path(), problem)) << problem;
+}
+
+TEST(StateDirLock, MissingDirectoryAndFifoAreRefusedWithoutBlocking) {
+  TempDir dir;
+  std::string problem;
+  EXPECT_FALSE(StateDirLock::acquire(dir.path() + "/nope", problem));
+  EXPECT_NE(problem.find("No such file or directory"), std::string::npos) << problem;
+  ASSERT_EQ(::mkfifo((dir.path() + "/resolverd.lock").c_str(), 0644), 0);
+  EXPECT_FALSE(StateDirLock::acquire(dir.path(), problem));
+  EXPECT_NE(problem.find("not a regular file"), std::string::npos) << problem;
 }
 
 TEST(CalibrationStore, MissingDirectoryErrorSaysWhatAndWhatToDo) {
