@@ -377,12 +377,15 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
       if (a.proposed && b.proposed && alike(a, b) && simpler(b, a)) std::swap(out.candidates[i], out.candidates[j]);
     }
   }
-  // A family first only when nothing smaller reaches the floor: one order that does
-  // is the plainer explanation (the family's extra orders may be a converter's
-  // quantization pattern at a speed commensurate with the sample rate).
+  // A family is the one step that reaches the floor where a smooth pattern spreads over
+  // many orders. First only when it does and nothing smaller does: one effect that
+  // reaches the floor is the plainer explanation (the family's extra orders may be a
+  // converter's quantization pattern at a speed commensurate with the sample rate), and
+  // a family that does not reach it is a curve fit, not a finding.
   if (!out.candidates.empty() && out.candidates.front().family) {
-    const auto smaller = std::find_if(out.candidates.begin() + 1, out.candidates.end(), [](const Candidate& c) {
-      return !c.family && c.proposed && c.reaches_floor;
+    const bool family_explains = out.candidates.front().reaches_floor;
+    const auto smaller = std::find_if(out.candidates.begin() + 1, out.candidates.end(), [&](const Candidate& c) {
+      return !c.family && c.proposed && (c.reaches_floor || !family_explains);
     });
     if (smaller != out.candidates.end()) std::rotate(out.candidates.begin(), smaller, smaller + 1);
   }
@@ -393,7 +396,8 @@ std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFi
                                            const std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
   std::vector<const Candidate*> top;
   for (const Candidate& c : candidates) {
-    if (c.proposed && top.size() < 3) top.push_back(&c);
+    // Effects, not families: a pair is two findings, a family already many orders.
+    if (c.proposed && !c.family && top.size() < 3) top.push_back(&c);
   }
   for (std::size_t i = 0; i < top.size(); ++i) {
     for (std::size_t j = i + 1; j < top.size(); ++j) {
