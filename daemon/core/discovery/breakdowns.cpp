@@ -213,12 +213,15 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
       for (Eigen::Index a = 0; a < sk; ++a) {
         const int c = score_columns[static_cast<std::size_t>(a)];
         double s = 0.0;
-        if (floors.rd > 0.0 && r.has(FitRow::kHasRd)) s += wr * jac.rd[c] * (r.y_rd - pred.rd);
+        // The residuals at the solution, nuisance constants included: a constant left in
+        // would enter every block's score and inflate their spread.
+        if (floors.rd > 0.0 && r.has(FitRow::kHasRd)) s += wr * jac.rd[c] * (r.y_rd - pred.rd - nuisance.rd);
         if (floors.sc > 0.0 && r.has(FitRow::kHasSc)) {
-          s += ws * (jac.sa[c] * (r.y_sa - pred.sa) + jac.sr[c] * (r.y_sr - pred.sr));
+          s += ws * (jac.sa[c] * (r.y_sa - pred.sa - sa_offset) +
+                     jac.sr[c] * (r.y_sr - pred.sr - sr_offset * (1.0 + pred.sr)));
         }
         if (floors.cur > 0.0 && r.has(FitRow::kHasCur)) {
-          s += wc * (jac.d[c] * (r.y_d - pred.d) + jac.q[c] * (r.y_q - pred.q));
+          s += wc * (jac.d[c] * (r.y_d - pred.d - d_offset) + jac.q[c] * (r.y_q - pred.q - q_offset));
         }
         g[a] += s;
       }
