@@ -184,6 +184,18 @@ class ExplainOnFaultySignals(unittest.TestCase):
         self.assertEqual(ex["verdict"], "unexplained")
         self.assertIn("overspeed", ex["summary"])
 
+    def test_garbage_on_many_samples_is_never_explained(self):
+        # Issue 25: impulsive garbage on a large share of the samples (here ~40 %, with a
+        # valid CRC) sets the noise floor itself; the fit then "explained" it at 0.82x.
+        # Outliers over a tenth of the samples now forbid "explained" and any proposal.
+        ex = self.explain(sim_log("garbage_half.log", "--seed", "2", "-e", "outliers:rate=1000,size=3000"))
+        self.assertEqual(ex["verdict"], "unexplained")
+        self.assertFalse([c for c in ex["candidates"] if c["proposed"]])
+        self.assertTrue([w for w in ex["where_it_fails"] if "signal health: outliers for" in w], ex["where_it_fails"])
+        # Control: a few spikes a second are the fit's own business (kept out of it).
+        few = self.explain(sim_log("spikes_5hz.log", "--seed", "2", "-e", "outliers:rate=5,size=3000"))
+        self.assertFalse([w for w in few["where_it_fails"] if "signal health: outliers for" in w])
+
     def test_control_clean_log_is_explained(self):
         ex = self.explain(sim_log("clean_200rpm.log", "--rpm", "200", "--duration", "2"))
         self.assertEqual(ex["verdict"], "explained")

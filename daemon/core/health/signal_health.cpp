@@ -50,7 +50,7 @@ std::vector<std::string> lasting_faults(const FaultCounts& counts, std::int64_t 
   if (total <= 0) return out;
   for (std::size_t i = 0; i < kSignalFaultCount; ++i) {
     const auto f = static_cast<SignalFault>(i);
-    if (f == SignalFault::kStopped || f == SignalFault::kOutliers || counts[i] == 0) continue;
+    if (f == SignalFault::kStopped || counts[i] == 0) continue;
     const double part = static_cast<double>(counts[i]) / static_cast<double>(total);
     if (part < share) continue;
     out.push_back(fmt::format("{} for {} of {} samples ({:.0f} %)", fault_name(f), counts[i], total, 100.0 * part));

@@ -60,9 +60,11 @@ inline constexpr double kUntrustedFaultShare = 0.1;
 using FaultCounts = std::array<std::int64_t, kSignalFaultCount>;
 
 /// The faults that held for at least `share` of `total` samples, worded for a note and
-/// a verdict ("loss_of_signal for 9000 of 10000 samples (90 %)"). stopped and outliers
-/// are never among them: a standstill is motion, and outliers are discovery's own
-/// (kept out of the fit and reported there).
+/// a verdict ("loss_of_signal for 9000 of 10000 samples (90 %)"). stopped is never among
+/// them (a standstill is motion). Outliers count sample by sample: a few impulses are
+/// discovery's own (kept out of the fit), but a tenth of the samples impulsive is garbage
+/// that sets the floor itself (every other sample's sin/cos garbage once read
+/// "explained" at 0.82x a floor estimated from the garbage: issue 25).
 [[nodiscard]] std::vector<std::string> lasting_faults(const FaultCounts& counts, std::int64_t total, double share);
 
 /// Thresholds. Defaults come from the physics of a 16-bit ADC bench; each says where from.
