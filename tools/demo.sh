@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job on the bundled default, no CAN bus needed:
-#   1. install packages, build
+#   1. install the packages the programs need, build the programs only (no tests,
+#      benchmarks or fuzzers: tools/run-tests.sh builds those into the same build/)
 #   2. simulate the bundled demo bench log (tools/demo/demo_bench.toml: Hwang's setup,
 #      alpha = 0.003, 200 r/min, 16-bit R/D, p_r = p = 3, plus one effect the seed
 #      model lacks) -> build/demo/demo.log (candump -l format)
@@ -10,8 +11,8 @@
 #      and the live model fit's verdict (README: "find the missing effect in 4 commands")
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/install-deps.sh
-bash tools/build.sh
+bash tools/install-deps.sh --programs
+bash tools/build.sh -DRESOLVER_BUILD_TESTS=OFF
 BIN=build/bin
 DEMO=build/demo
 mkdir -p "$DEMO"
