@@ -119,7 +119,7 @@ class ManPages(unittest.TestCase):
             self.assertIn(c, lines, f"{page}.1 EXAMPLES: '{c}' is not a line of its own")
 
     def test_examples_section_per_program(self):
-        for program in ["resolverd", "resolver-sim", "resolver-model", "resolver-accuracy"]:
+        for program in ["resolverd", "resolver-sim", "resolver-echo", "resolver-model", "resolver-accuracy"]:
             with self.subTest(program=program):
                 commands = example_commands(run_help(program), program)
                 self.assertTrue(commands, f"{program} --help has no examples")
