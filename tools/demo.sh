@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The main job on the bundled default, no CAN bus needed:
 #   1. install the packages the programs need, build the programs only (no tests,
-#      benchmarks or fuzzers: tools/run-tests.sh builds those into the same build/)
+#      benchmarks or fuzzers: tools/run-tests.sh builds those into the same build/,
+#      reconfigured) as Release: without debug info the build takes ~30 % less CPU
+#      and the links of the 100 MB RelWithDebInfo binaries shrink
 #   2. simulate the bundled demo bench log (tools/demo/demo_bench.toml: Hwang's setup,
 #      alpha = 0.003, 200 r/min, 16-bit R/D, p_r = p = 3, plus one effect the seed
 #      model lacks) -> build/demo/demo.log (candump -l format)
@@ -12,7 +14,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install-deps.sh --programs
-bash tools/build.sh -DRESOLVER_BUILD_TESTS=OFF
+bash tools/build.sh -DRESOLVER_BUILD_TESTS=OFF -DCMAKE_BUILD_TYPE=Release
 BIN=build/bin
 DEMO=build/demo
 mkdir -p "$DEMO"

@@ -7,7 +7,8 @@ cd "$(dirname "$0")/.."
 bash tools/install-deps.sh
 # Tests that talk to python-can must not skip where it was just installed.
 export RESOLVER_REQUIRE_PYCAN=${RESOLVER_REQUIRE_PYCAN:-1}
-# Tests ON explicitly: tools/demo.sh leaves build/ configured with them OFF.
+# Tests ON explicitly: tools/demo.sh leaves build/ configured with them OFF (and as
+# Release; tools/build.sh sets RelWithDebInfo again).
 bash tools/build.sh -DRESOLVER_WERROR=ON -DRESOLVER_BUILD_TESTS=ON
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 if [ "${RESOLVER_SANITIZE:-0}" = "1" ]; then
