@@ -3,18 +3,21 @@
 #   install-deps.sh              everything: programs + tests (tools/run-tests.sh, .ci/run)
 #   install-deps.sh --programs   only what building and running the programs needs
 #                                (tools/demo.sh; build with -DRESOLVER_BUILD_TESTS=OFF)
+#   --list                       print the packages of the set, one a line, install nothing
 # Idempotent: runs apt-get only when something is missing. Needs root or sudo.
 set -euo pipefail
 
-usage() { echo "usage: $0 [--programs]" >&2; exit 2; }
+usage() { echo "usage: $0 [--programs] [--list]" >&2; exit 2; }
 only_programs=0
-case "${1:-}" in
-  "") ;;
-  --programs) only_programs=1 ;;
-  -h|--help) sed -n '2,6p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-  *) usage ;;
-esac
-[ $# -le 1 ] || usage
+list=0
+for arg in "$@"; do
+  case "$arg" in
+    --programs) only_programs=1 ;;
+    --list) list=1 ;;
+    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) usage ;;
+  esac
+done
 
 # Building and running resolverd, resolver-sim, resolver-echo, resolver-model and
 # resolver-accuracy, their man pages and the Python package resolver_lcm.
@@ -45,6 +48,10 @@ TEST_PACKAGES=(
 
 PACKAGES=("${PROGRAM_PACKAGES[@]}")
 [ "$only_programs" = 1 ] || PACKAGES+=("${TEST_PACKAGES[@]}")
+if [ "$list" = 1 ]; then
+  printf '%s\n' "${PACKAGES[@]}"
+  exit 0
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
