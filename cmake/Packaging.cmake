@@ -87,6 +87,20 @@ if(RESOLVER_MAN_PAGES)
   add_custom_target(resolver_man_pages ALL DEPENDS ${resolver_man_pages})
   install(FILES ${resolver_man_pages} DESTINATION ${CMAKE_INSTALL_MANDIR}/man1)
 endif()
+# Every program's --help (usage names the program, examples per resolver-model
+# subcommand) and, when they are made, the man pages' EXAMPLES sections set one
+# command a line (tests/install/test_help.py). Registered here, where the
+# programs and RESOLVER_MAN_PAGES are known.
+if(RESOLVER_BUILD_TESTS)
+  set(help_test_man "")
+  if(RESOLVER_MAN_PAGES)
+    set(help_test_man --man ${RESOLVER_MAN_DIR})
+  endif()
+  add_test(NAME program_help
+    COMMAND ${RESOLVER_SYSTEM_PYTHON3} ${PROJECT_SOURCE_DIR}/tests/install/test_help.py
+            --bin ${CMAKE_RUNTIME_OUTPUT_DIRECTORY} ${help_test_man})
+  set_tests_properties(program_help PROPERTIES LABELS integration TIMEOUT 120)
+endif()
 # resolver-spy --version reads it (bin/../share/resolver-bench/VERSION).
 install(FILES ${RESOLVER_VERSION_FILE} DESTINATION ${RESOLVER_DATADIR})
 

@@ -1,27 +1,58 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages the build, the tools and the tests need.
+#   install-deps.sh              everything: programs + tests (tools/run-tests.sh, .ci/run)
+#   install-deps.sh --programs   only what building and running the programs needs
+#                                (tools/demo.sh; build with -DRESOLVER_BUILD_TESTS=OFF)
+#   --list                       print the packages of the set, one a line, install nothing
 # Idempotent: runs apt-get only when something is missing. Needs root or sudo.
 set -euo pipefail
 
-PACKAGES=(
+usage() { echo "usage: $0 [--programs] [--list]" >&2; exit 2; }
+only_programs=0
+list=0
+for arg in "$@"; do
+  case "$arg" in
+    --programs) only_programs=1 ;;
+    --list) list=1 ;;
+    -h|--help) sed -n '2,7p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) usage ;;
+  esac
+done
+
+# Building and running resolverd, resolver-sim, resolver-echo, resolver-model and
+# resolver-accuracy, their man pages and the Python package resolver_lcm.
+PROGRAM_PACKAGES=(
   build-essential cmake g++ pkg-config git
-  libgtest-dev libgmock-dev libbenchmark-dev
-  liblcm-dev liblcm-bin
-  libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev libsystemd-dev
+  liblcm-dev liblcm-bin  # liblcm-bin: lcm-gen, run at build time (proto/, tools/python)
+  libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev
   libmuparser-dev  # [[model.custom]] effects: expressions users write (daemon/core/model/custom_effect.h)
-  can-utils python3 python3-can
+  libmatio-dev  # resolver-model export-data --mat (tools/model/export_data.h)
+  python3  # the build finds Debian's interpreter for resolver_lcm (tools/python)
+  help2man  # man pages from --help (cmake/Packaging.cmake); without it the build makes none
+)
+# The tests, benchmarks and fuzzers (tests/), resolver-spy's Java types and packaging.
+TEST_PACKAGES=(
+  libgtest-dev libgmock-dev libbenchmark-dev libsystemd-dev
+  can-utils python3-can
   python3-numpy  # tests/independent (benchgen)
   python3-canmatrix  # tests/dbc_peer: an independent DBC reader judges resolverd's decoded values
   qemu-system-x86 iproute2 valgrind clang libclang-rt-14-dev
+  # resolver-spy: its types jar is built only where javac and lcm.jar are found (tools/spy)
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
   chromium  # headless: renders, zooms and screenshots the resolver-model HTML report (tests/model)
-  libmatio-dev  # resolver-model export-data --mat (tools/model/export_data.h)
   python3-scipy  # tests/model/test_export_data.py reads the .mat with scipy.io.loadmat
-  # packaging (cmake/Packaging.cmake, tests/install): man pages from --help, the
-  # .deb's shared-library dependencies (dpkg-shlibdeps), systemd-analyze for the
-  # installed units, /bin/kill their ExecReload= names; numpy for resolver_lcm's arrays
-  help2man dpkg-dev systemd procps
+  # packaging (cmake/Packaging.cmake, tests/install): the .deb's shared-library
+  # dependencies (dpkg-shlibdeps), systemd-analyze for the installed units, /bin/kill
+  # their ExecReload= names
+  dpkg-dev systemd procps
 )
+
+PACKAGES=("${PROGRAM_PACKAGES[@]}")
+[ "$only_programs" = 1 ] || PACKAGES+=("${TEST_PACKAGES[@]}")
+if [ "$list" = 1 ]; then
+  printf '%s\n' "${PACKAGES[@]}"
+  exit 0
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -32,10 +32,11 @@
 namespace {
 
 constexpr const char* kDescription = R"(resolverd: reads resolver sin/cos, R/D angle and phase currents from CAN,
-estimates the resolver's amplitude imbalance (Hwang et al. 2009 integral method),
-compensates the angle and publishes angle_t, dq_t, estimate_t and health_t (with the
-signal faults: loss of signal, degradation, loss of tracking, clipping, stop, overspeed,
-outliers) on LCM.
+fits the active effect model live ([model] effects, default amplitude_imbalance; by
+default the estimator too: [estimator] method = "model"; the seed's Hwang et al. 2009
+integral method is "hwang_integral"), compensates the angle by inverting the model and
+publishes angle_t, dq_t, estimate_t, model_fit_t and health_t (with the signal faults:
+loss of signal, degradation, loss of tracking, clipping, stop, overspeed, outliers) on LCM.
 
 Examples:
   # offline, as fast as possible, then print a report and exit

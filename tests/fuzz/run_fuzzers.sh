@@ -52,7 +52,7 @@ fi
 # the fuzz executables add -fsanitize=fuzzer themselves (tests/fuzz/CMakeLists.txt).
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 cmake_args=(-S "$repo" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
-            -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_C_FLAGS=$san" "-DCMAKE_CXX_FLAGS=$san")
+            -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRESOLVER_BUILD_TESTS=ON "-DCMAKE_C_FLAGS=$san" "-DCMAKE_CXX_FLAGS=$san")
 echo "== configuring $build (clang, ASan + UBSan + libFuzzer)"
 cmake "${cmake_args[@]}" >"$build.configure.log" 2>&1 || { cat "$build.configure.log" >&2; exit 2; }
 echo "== building ${targets[*]}"

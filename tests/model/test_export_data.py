@@ -14,7 +14,13 @@ is read back with independent readers, Python's csv module and scipy.io.loadmat
   - the model column is the physics: amplitude imbalance and quadrature move the
     sin/cos angle by (alpha/2) sin 2theta - (beta/2)(1 - cos 2theta) (Hanselman eq. 5
     and 7), plus the fitted constant
-  - the .mat holds the same columns, units, descriptions, parameters and info
+  - the raw signals beside them (sin_raw, cos_raw, theta_rd_rad, theta_ref_m_rad,
+    i_a_a, i_b_a, i_c_a): recomputing the fit's columns from them by the textbook
+    formulas gives the fit's columns (eps_rd = theta - theta_rd, eps_sc = theta -
+    atan2(sin, cos), the radius over its median, Clarke + Park at theta_e for i_d, i_q;
+    the reference angle is theta_m); the simulated currents are balanced
+  - the .mat holds the same columns, units, descriptions, parameters and info, the
+    info's numbers (p_r, p, residual and floor) as numbers
   - control: without --csv or --mat it refuses (exit 2); an unwritable path names it
 
   test_export_data.py --bin BUILD/bin --work DIR
@@ -144,6 +150,42 @@ class ExportData(unittest.TestCase):
         self.assertLess(worst, 2e-5)
         self.assertGreater(max(abs(e) for e in expected), 1e-3)  # the check has something to see
 
+    def test_raw_signals_give_the_fits_columns(self):
+        c = self.col
+        for name in ("sin_raw", "cos_raw", "theta_rd_rad", "theta_ref_m_rad", "i_a_a", "i_b_a", "i_c_a",
+                     "i_d_a", "i_q_a"):
+            self.assertIn(name, self.header)
+            self.assertFalse(any(math.isnan(v) for v in c[name]), f"{name}: every sample of this log has it")
+        two_pi = 2 * math.pi
+        # CSV: 12 significant digits of values up to 2 pi (angles) and ~26000 counts.
+        angle_tol = 1e-9
+        for i in range(len(self.rows)):
+            theta = c["theta_rad"][i]
+            self.assertAlmostEqual(math.remainder(theta - c["theta_rd_rad"][i] - c["eps_rd_rad"][i], two_pi), 0.0,
+                                   delta=angle_tol, msg=f"eps_rd row {i}")
+            seen = math.atan2(c["sin_raw"][i], c["cos_raw"][i])
+            self.assertAlmostEqual(math.remainder(theta - seen - c["eps_sc_rad"][i], two_pi), 0.0,
+                                   delta=angle_tol, msg=f"eps_sc row {i}")
+            self.assertAlmostEqual(math.remainder(c["theta_ref_m_rad"][i] - c["theta_m_rad"][i], two_pi), 0.0,
+                                   delta=angle_tol, msg=f"reference row {i}")
+        # radius_dev = radius / amplitude - 1 with one amplitude for the log (the median radius).
+        amplitudes = [math.hypot(a, b) / (1.0 + r) for a, b, r in zip(c["sin_raw"], c["cos_raw"], c["radius_dev"])]
+        self.assertLess((max(amplitudes) - min(amplitudes)) / amplitudes[0], 1e-9)
+        self.assertAlmostEqual(amplitudes[0], sorted(math.hypot(a, b) for a, b in zip(c["sin_raw"], c["cos_raw"]))[
+            len(amplitudes) // 2], delta=1.0)
+        # Clarke (amplitude invariant) and Park at the motor electrical angle.
+        worst = 0.0
+        for i in range(len(self.rows)):
+            ia, ib, ic = c["i_a_a"][i], c["i_b_a"][i], c["i_c_a"][i]
+            alpha, beta = ia, (ib - ic) / math.sqrt(3.0)
+            th = c["theta_e_rad"][i]
+            d = alpha * math.cos(th) + beta * math.sin(th)
+            q = -alpha * math.sin(th) + beta * math.cos(th)
+            worst = max(worst, abs(d - c["i_d_a"][i]), abs(q - c["i_q_a"][i]))
+            self.assertLess(abs(ia + ib + ic), 0.5, f"row {i}: the simulated phases are balanced up to noise")
+        self.assertLess(worst, 1e-8)
+        self.assertAlmostEqual(sum(c["i_q_a"]) / len(self.rows), 10.0, delta=0.1)  # resolver-sim's default i_q
+
     def test_mat_holds_the_same_table(self):
         try:
             import scipy.io
@@ -174,7 +216,13 @@ class ExportData(unittest.TestCase):
         self.assertEqual([str(c[0][0]) for c in params["unit"]], [p["unit"] for p in self.params])
         info = mat["info"][0, 0]
         self.assertEqual(str(info["model"][0]), EFFECTS)
-        self.assertEqual(str(info["p_r"][0]), "3")
+        for key, want in (("p_r", 3.0), ("p", 3.0), ("residual_rms_rad", self.fit["residual_rms_rad"])):
+            value = info[key]
+            self.assertEqual(value.dtype.kind, "f", f"info.{key} is a number, not {value.dtype}")
+            self.assertEqual(value.shape, (1, 1), key)
+            self.assertAlmostEqual(float(value[0, 0]) / want, 1.0, delta=1e-8, msg=key)
+        self.assertGreater(float(info["noise_floor_rad"][0, 0]), 0.0)
+        self.assertEqual(str(mat["units"][0, 0]["i_a_a"][0]), "A")
         self.assertEqual(str(info["log"][0]), self.log)
 
     def test_needs_an_output_and_names_an_unwritable_one(self):

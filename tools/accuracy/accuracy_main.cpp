@@ -23,9 +23,13 @@ constexpr double kRippleTargetDb = 40.0;  // ripple reduction >= 40 dB ... (issu
 constexpr double kFloorFactor = 1.5;    // ... or within 1.5 x the noise floor (mean over seeds)
 constexpr double kConvergedRevs = 1.0;  // signal-domain estimator within 1 % of alpha after 1 revolution
 
+// Comments above the commands: help2man splits "command   # comment" into a tagged
+// paragraph, the command apart from its comment.
 constexpr const char* kExamples = R"(Examples:
-  resolver-accuracy                 # 50 seeds, the full report (about a minute)
-  resolver-accuracy --quick         # 10 seeds, a smoke run
+  # 50 seeds, the full report (about a minute)
+  resolver-accuracy
+  # 10 seeds, a smoke run
+  resolver-accuracy --quick
   resolver-accuracy --seeds 200 > accuracy.md)";
 
 std::string sci(double v) {
@@ -115,7 +119,8 @@ void print_ripple(const std::vector<RippleStudy>& studies) {
 
 int main(int argc, char** argv) {
   CLI::App app{"resolver-accuracy: estimator bias and spread against the Cramer-Rao bound, convergence and 2x dq "
-               "ripple reduction on simulated data with known truth; prints a markdown report."};
+               "ripple reduction on simulated data with known truth; prints a markdown report.",
+               "resolver-accuracy"};  // the name in the usage line, not argv[0] (a build path)
   app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText);
   app.set_version_flag("--version", resolver::version_line("resolver-accuracy"));
   int seeds = 50;

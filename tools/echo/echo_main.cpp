@@ -9,8 +9,10 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "daemon/app/exit_codes.h"
+#include "tools/echo/csv_export.h"
 #include "tools/echo/echo_output.h"
 #include "tools/echo/lcm_eventlog_reader.h"
 #include "tools/echo/lcm_fingerprint.h"
@@ -28,9 +30,10 @@ constexpr const char* kDescription =
     "resolver-echo prints LCM messages as JSON lines, one object per message.\n"
     "It knows the project's types (proto/resolver/*.lcm, compiled in) and decodes\n"
     "any message whose 8-byte fingerprint matches one of them or a type added\n"
-    "with --types; there is nothing to regenerate when a type changes.";
+    "with --types; there is nothing to regenerate when a type changes.\n"
+    "With --csv DIR it writes a log's channels as tables instead, one CSV file per channel.";
 
-constexpr const char* kFooter = R"(OUTPUT
+constexpr const char* kFooter = R"(Output:
   One JSON object per line, members in declaration order:
     {"channel":"RESOLVER_ANGLE","type":"resolver.angle_t","utime":1700000000123456,
      "sample_index":42,"counter":42,"theta_rd":1.5707963267948966,...}
@@ -41,7 +44,15 @@ constexpr const char* kFooter = R"(OUTPUT
     {"channel":"X","type":null,"utime":null,"size":24,"error":"unknown fingerprint 0x..."}
   Errors about the input go to stderr.
 
-EXAMPLES
+  With --csv DIR: DIR/<channel>.csv per channel (characters other than letters, digits,
+  '_', '-', '.' in the name become '_'), one header line and one line per message:
+  utime_s (the utime member in seconds, to the microsecond; the log's receive time
+  when the type has none), then every numeric member in declaration order, nested
+  members joined with '_' and array elements numbered: value_0, value_1 ... (a
+  message with fewer elements leaves those fields empty). Booleans are 1/0, NaN and
+  infinities NaN/Inf/-Inf; strings are left out. One line per file on stdout.
+
+Examples:
   Everything in a log recorded with lcm-logger:
     resolver-echo --log lcmlog-2024-05-01.00
   Only the corrected angle, first 10 messages, one field with jq:
@@ -54,12 +65,16 @@ EXAMPLES
     resolver-echo --lcm udpm:// --timeout 2 --types ~/my_types
   Which types are known, with their fingerprints:
     resolver-echo --list-types
+  Every channel of a log as CSV tables (MATLAB readtable, pandas.read_csv):
+    resolver-echo --log build/demo/demo.lcmlog --csv build/demo/csv
+  Only the dq currents, as build/demo/csv/RESOLVER_DQ.csv:
+    resolver-echo --log build/demo/demo.lcmlog --channel RESOLVER_DQ --csv build/demo/csv
 
-EXIT STATUS
+Exit status:
   0 done; 1 the input had no usable data (a malformed or truncated log, --timeout expired
-  before --count messages arrived); 2 usage error (bad option, --type or --channel, a bad
-  .lcm file in --types); 3 I/O error (--log missing or unreadable, LCM cannot start,
-  stdout cannot be written); 70 internal error (a bug).)";
+  before --count messages arrived, --csv and no message matched); 2 usage error (bad
+  option, --type or --channel, a bad .lcm file in --types); 3 I/O error (--log missing or unreadable, LCM cannot start,
+  stdout or a --csv file cannot be written); 70 internal error (a bug).)";
 
 void print_line(const std::string& line) {
   std::fwrite(line.data(), 1, line.size(), stdout);
@@ -82,6 +97,7 @@ int main(int argc, char** argv) {
   std::optional<std::int64_t> limit;
   std::optional<std::int64_t> count;
   std::optional<double> timeout_s;
+  std::string csv_dir;
   bool list_types = false;
 
   auto* log_opt = app.add_option("--log", log_path, "read this LCM event log (lcm-logger output or file://)");
@@ -99,6 +115,9 @@ int main(int argc, char** argv) {
                         ->check(CLI::PositiveNumber)->needs(lcm_opt);
   app.add_option("--timeout", timeout_s, "--lcm: exit after SEC seconds (default: never)")
                           ->check(CLI::PositiveNumber)->needs(lcm_opt);
+  app.add_option("--csv", csv_dir, "--log: write each channel as DIR/<channel>.csv (numeric members, a utime_s "
+                                   "column) instead of JSON lines; DIR is created when missing")
+      ->needs(log_opt);
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
 
   if (!list_types && log_path.empty() && lcm_url.empty()) {
@@ -149,6 +168,32 @@ int main(int argc, char** argv) {
     }
     const resolver::LcmJsonDecoder decoder(registry);
 
+    if (!log_path.empty() && !csv_dir.empty()) {
+      resolver::CsvExportResult written;
+      try {
+        written = resolver::export_log_csv(log_path, decoder, filter, limit, csv_dir);
+      } catch (const resolver::EventLogError&) {
+        throw;
+      } catch (const std::runtime_error& e) {  // a file that cannot be written
+        std::cerr << "resolver-echo: --csv: " << e.what() << '\n';
+        return exit_code::kIo;
+      }
+      for (const auto& f : written.files) {
+        std::cout << fmt::format("wrote {}: {} rows x {} columns ({} on channel {})\n", f.path, f.rows, f.columns,
+                                 fmt::join(f.types, ", "), f.channel);
+      }
+      if (written.undecoded > 0) {
+        std::cerr << fmt::format("resolver-echo: --csv: {} message(s) could not be decoded and are not in a table "
+                                 "(the first: {}); resolver-echo --log shows them\n",
+                                 written.undecoded, written.first_undecoded_error);
+      }
+      if (written.files.empty()) {
+        std::cerr << "resolver-echo: --csv: no message " << (written.undecoded > 0 ? "could be decoded" : "matched")
+                  << "; nothing written\n";
+        return exit_code::kNoUsableData;
+      }
+      return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;
+    }
     if (!log_path.empty()) {
       resolver::echo_log_file(log_path, decoder, filter, limit, print_line);
       return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;

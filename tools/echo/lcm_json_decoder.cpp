@@ -1,7 +1,9 @@
 #include "tools/echo/lcm_json_decoder.h"
 
 #include <bit>
+#include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -33,8 +35,9 @@ void prepend_member(DecodeFailure& f, const std::string& name) {
 
 class Decoder {
  public:
-  Decoder(const LcmTypeRegistry& registry, std::span<const std::uint8_t> data, std::size_t start)
-      : registry_(registry), data_(data), pos_(start) {}
+  Decoder(const LcmTypeRegistry& registry, std::span<const std::uint8_t> data, std::size_t start,
+          std::vector<NumericField>* numbers)
+      : registry_(registry), data_(data), pos_(start), numbers_(numbers) {}
 
   // Writes the members of `s` as "name":value pairs. When `utime_out` is set
   // (top level), the member named utime goes there instead.
@@ -48,13 +51,21 @@ class Decoder {
     for (std::size_t i = 0; i < s.members.size(); ++i) {
       const LcmMember& m = s.members[i];
       std::string value;
+      const bool top_utime = utime_out != nullptr && m.name == "utime";
+      const std::size_t name_mark = number_name_.size();
+      if (!number_name_.empty()) number_name_.push_back('_');
+      number_name_ += m.name;
+      const std::size_t numbers_mark = numbers_ != nullptr ? numbers_->size() : 0;
       try {
         decode_dimension(s, m, integers, 0, value, integers[i], depth);
       } catch (DecodeFailure& f) {
         prepend_member(f, m.name);
         throw;
       }
-      if (utime_out != nullptr && m.name == "utime") {
+      number_name_.resize(name_mark);
+      if (top_utime) {
+        // The message's time: a table's time column, not one of its numbers.
+        if (numbers_ != nullptr) numbers_->resize(numbers_mark);
         *utime_out = std::move(value);
         continue;
       }
@@ -142,8 +153,11 @@ class Decoder {
     }
     out.push_back('[');
     std::int64_t ignored = 0;
+    const std::size_t name_mark = number_name_.size();
     for (std::int64_t i = 0; i < count; ++i) {
       if (i > 0) out.push_back(',');
+      number_name_.resize(name_mark);
+      number_name_ += fmt::format("_{}", i);
       try {
         decode_dimension(s, m, integers, dim + 1, out, ignored, depth);
       } catch (DecodeFailure& f) {
@@ -152,7 +166,23 @@ class Decoder {
         throw;
       }
     }
+    number_name_.resize(name_mark);
     out.push_back(']');
+  }
+
+  // A numeric leaf for the table (NumericField), when numbers are wanted.
+  template <typename T>
+  void number(T value) {
+    if (numbers_ == nullptr) return;
+    std::string text;
+    if constexpr (std::is_floating_point_v<T>) {
+      if (std::isnan(value)) text = "NaN";
+      else if (std::isinf(value)) text = value > 0 ? "Inf" : "-Inf";
+      else append_json_number(text, value);
+    } else {
+      append_json_number(text, static_cast<std::int64_t>(value));
+    }
+    numbers_->push_back({number_name_, std::move(text)});
   }
 
   void decode_scalar(const LcmMember& m, std::string& out, std::int64_t& integer_value, int depth) {
@@ -170,31 +200,47 @@ class Decoder {
       case LcmPrimitive::kInt8:
         integer_value = static_cast<std::int8_t>(read_be(1));
         append_json_number(out, integer_value);
+        number(integer_value);
         return;
       case LcmPrimitive::kInt16:
         integer_value = static_cast<std::int16_t>(read_be(2));
         append_json_number(out, integer_value);
+        number(integer_value);
         return;
       case LcmPrimitive::kInt32:
         integer_value = static_cast<std::int32_t>(read_be(4));
         append_json_number(out, integer_value);
+        number(integer_value);
         return;
       case LcmPrimitive::kInt64:
         integer_value = static_cast<std::int64_t>(read_be(8));
         append_json_number(out, integer_value);
+        number(integer_value);
         return;
-      case LcmPrimitive::kFloat:
-        append_json_number(out, std::bit_cast<float>(static_cast<std::uint32_t>(read_be(4))));
+      case LcmPrimitive::kFloat: {
+        const float v = std::bit_cast<float>(static_cast<std::uint32_t>(read_be(4)));
+        append_json_number(out, v);
+        number(v);
         return;
-      case LcmPrimitive::kDouble:
-        append_json_number(out, std::bit_cast<double>(read_be(8)));
+      }
+      case LcmPrimitive::kDouble: {
+        const double v = std::bit_cast<double>(read_be(8));
+        append_json_number(out, v);
+        number(v);
         return;
-      case LcmPrimitive::kBoolean:
-        out += read_be(1) != 0 ? "true" : "false";
+      }
+      case LcmPrimitive::kBoolean: {
+        const bool v = read_be(1) != 0;
+        out += v ? "true" : "false";
+        number(v ? 1 : 0);
         return;
-      case LcmPrimitive::kByte:
-        append_json_number(out, static_cast<std::int64_t>(read_be(1)));
+      }
+      case LcmPrimitive::kByte: {
+        const auto v = static_cast<std::int64_t>(read_be(1));
+        append_json_number(out, v);
+        number(v);
         return;
+      }
       case LcmPrimitive::kString: {
         const std::size_t at = pos_;
         const auto length = static_cast<std::int32_t>(read_be(4));
@@ -214,11 +260,13 @@ class Decoder {
   const LcmTypeRegistry& registry_;
   std::span<const std::uint8_t> data_;
   std::size_t pos_;
+  std::vector<NumericField>* numbers_;  ///< nullptr: JSON only
+  std::string number_name_;             ///< the leaf being decoded, as NumericField::name
 };
 
 }  // namespace
 
-DecodedMessage LcmJsonDecoder::decode(std::span<const std::uint8_t> data) const {
+DecodedMessage LcmJsonDecoder::decode(std::span<const std::uint8_t> data, bool with_numbers) const {
   DecodedMessage result;
   if (data.size() < 8) {
     result.error = fmt::format("message is {} byte(s), shorter than the 8-byte type fingerprint", data.size());
@@ -230,12 +278,13 @@ DecodedMessage LcmJsonDecoder::decode(std::span<const std::uint8_t> data) const 
     result.error = fmt::format("unknown fingerprint {}", hex64(result.fingerprint));
     return result;
   }
-  Decoder decoder(registry_, data, 8);
+  Decoder decoder(registry_, data, 8, with_numbers ? &result.numbers : nullptr);
   try {
     decoder.decode_struct_fields(*result.type, result.fields_json, &result.utime_json, 0);
   } catch (const DecodeFailure& f) {
     result.fields_json.clear();
     result.utime_json.reset();
+    result.numbers.clear();
     result.error = f.path.empty() ? f.reason
                                   : fmt::format("member '{}' of {}: {}", f.path, result.type->full_name(), f.reason);
   }

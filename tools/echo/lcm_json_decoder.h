@@ -14,10 +14,21 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "tools/echo/lcm_type_registry.h"
 
 namespace resolver {
+
+/// One numeric leaf of a message, for tables (resolver-echo --csv): members of
+/// nested structs joined with '_' ("pose_x"), array elements numbered from 0
+/// ("value_0", "value_1"; "m_1_2" in two dimensions).
+struct NumericField {
+  std::string name;
+  /// Integers exactly, floating point in the shortest text that reads back to the
+  /// same value, NaN / Inf / -Inf as MATLAB and pandas read them, booleans 1 / 0.
+  std::string text;
+};
 
 struct DecodedMessage {
   /// The matching type, or nullptr when the fingerprint is unknown (or the
@@ -32,6 +43,10 @@ struct DecodedMessage {
   std::string fields_json;
   /// Empty on success; otherwise what went wrong and where.
   std::string error;
+  /// With decode(data, true): every numeric member (integers, floats, booleans,
+  /// bytes) except the top-level utime, in declaration order. Strings are text,
+  /// not numbers, and are left out. Empty when `error` is set.
+  std::vector<NumericField> numbers;
 };
 
 class LcmJsonDecoder {
@@ -40,8 +55,9 @@ class LcmJsonDecoder {
   explicit LcmJsonDecoder(const LcmTypeRegistry& registry) : registry_(registry) {}
 
   /// Decodes one whole message (fingerprint included). Bytes after the last
-  /// member are ignored, as LCM's generated decoders do.
-  DecodedMessage decode(std::span<const std::uint8_t> data) const;
+  /// member are ignored, as LCM's generated decoders do. `with_numbers` also
+  /// fills DecodedMessage::numbers.
+  DecodedMessage decode(std::span<const std::uint8_t> data, bool with_numbers = false) const;
 
  private:
   const LcmTypeRegistry& registry_;

@@ -137,7 +137,8 @@ Var mat_struct(const char* name, std::vector<std::pair<std::string, Var>> fields
 
 }  // namespace
 
-ExportTable export_table(const PreparedLog& log, const ModelFit& fit, std::string_view log_path) {
+ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, const ModelFit& fit,
+                         std::string_view log_path) {
   ExportTable t;
   const std::size_t n = log.rows.size();
   const std::size_t time = add(t, "t_s", "s", "time from the log's first sample with an angle", n);
@@ -156,6 +157,32 @@ ExportTable export_table(const PreparedLog& log, const ModelFit& fit, std::strin
   const std::size_t excluded = add(t, "excluded", "0/1", "left out by --direction, or unusable without a reference", n);
   const std::size_t fitted = add(t, "fitted", "0/1", "in the fit: moving, not an outlier, not excluded", n);
   const std::size_t fold = add(t, "fold", "1/2", "held-back validation fold", n);
+  // The raw signals behind each row, as decoded (daemon/core/sample.h), a column per
+  // signal any row's sample carries.
+  const auto sample_of = [&](std::size_t i) -> const Sample& { return input.samples.at(log.sample_of_row.at(i)); };
+  bool any_rd = false, any_sc = false, any_ref = false, any_cur = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Sample& x = sample_of(i);
+    any_rd = any_rd || x.has_rd;
+    any_sc = any_sc || x.has_sincos;
+    any_ref = any_ref || x.has_ref;
+    any_cur = any_cur || x.has_currents;
+  }
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  const auto add_if = [&](bool present, const char* name, const char* unit, const char* description) {
+    return present ? add(t, name, unit, description, n) : kNone;
+  };
+  const std::size_t raw_sin = add_if(any_sc, "sin_raw", "counts",
+                                     "sin envelope as decoded (ADC counts; a scope export's own unit)");
+  const std::size_t raw_cos = add_if(any_sc, "cos_raw", "counts",
+                                     "cos envelope as decoded (ADC counts; a scope export's own unit)");
+  const std::size_t raw_rd = add_if(any_rd, "theta_rd_rad", "rad",
+                                    "R/D converter angle as decoded, resolver electrical, in [0, 2 pi)");
+  const std::size_t raw_ref = add_if(any_ref, "theta_ref_m_rad", "rad",
+                                     "reference encoder angle as decoded, mechanical, in [0, 2 pi)");
+  const std::size_t raw_ia = add_if(any_cur, "i_a_a", "A", "measured phase current a");
+  const std::size_t raw_ib = add_if(any_cur, "i_b_a", "A", "measured phase current b");
+  const std::size_t raw_ic = add_if(any_cur, "i_c_a", "A", "measured phase current c");
   SignalColumns rd, sa, sr, d, q;
   if (log.rd) rd = add_signal(t, "eps_rd", "rad", "rad", "position error theta - theta_rd of the R/D angle", n);
   if (log.sincos) {
@@ -166,7 +193,9 @@ ExportTable export_table(const PreparedLog& log, const ModelFit& fit, std::strin
     d = add_signal(t, "i_d", "a", "A", "i_d in the frame of the true theta_e", n);
     q = add_signal(t, "i_q", "a", "A", "i_q in the frame of the true theta_e", n);
   }
-  const auto set = [&t](std::size_t column, std::size_t i, double v) { t.columns[column].values[i] = v; };
+  const auto set = [&t](std::size_t column, std::size_t i, double v) {
+    if (column != kNone) t.columns[column].values[i] = v;
+  };
   const RowPredictor predict(log, fit.model);
   for (std::size_t i = 0; i < n; ++i) {
     const FitRow& r = log.rows[i];
@@ -183,6 +212,18 @@ ExportTable export_table(const PreparedLog& log, const ModelFit& fit, std::strin
     set(excluded, i, r.has(FitRow::kExcluded) ? 1.0 : 0.0);
     set(fitted, i, r.fitted() ? 1.0 : 0.0);
     set(fold, i, r.has(FitRow::kFoldB) ? 2.0 : 1.0);
+    const Sample& x = sample_of(i);
+    if (x.has_sincos) {
+      set(raw_sin, i, x.sin);
+      set(raw_cos, i, x.cos);
+    }
+    if (x.has_rd) set(raw_rd, i, x.theta_rd);
+    if (x.has_ref) set(raw_ref, i, x.theta_m_ref);
+    if (x.has_currents) {
+      set(raw_ia, i, x.i_a);
+      set(raw_ib, i, x.i_b);
+      set(raw_ic, i, x.i_c);
+    }
     const SignalValues p = predict(r);
     fill(t, rd, i, r.has(FitRow::kHasRd), r.y_rd, p.rd);
     fill(t, sa, i, r.has(FitRow::kHasSc), r.y_sa, p.sa);
@@ -195,11 +236,11 @@ ExportTable export_table(const PreparedLog& log, const ModelFit& fit, std::strin
   t.info = {
       {"log", std::string(log_path)},
       {"model", fit.effects.empty() ? std::string("(nuisance only)") : fmt::format("{}", fmt::join(fit.effects, ","))},
-      {"p_r", std::to_string(log.p_r)},
-      {"p", std::to_string(log.p)},
+      {"p_r", static_cast<double>(log.p_r)},
+      {"p", static_cast<double>(log.p)},
       {"angle_source", log.reference ? "reference encoder" : "self-calibrated ideal angle (no reference)"},
-      {"residual_rms_rad", fmt::format("{:.9g}", fit.residual_rms_rad)},
-      {"noise_floor_rad", fmt::format("{:.9g}", fit.noise_floor_rad)},
+      {"residual_rms_rad", fit.residual_rms_rad},
+      {"noise_floor_rad", fit.noise_floor_rad},
       {"fold_rule", log.fold_rule},
       {"standard_errors", fit.robust_errors ? "revolution-to-revolution spread" : "formal"},
       {"prediction", "the model's effects at the fitted values plus the constants fitted beside them (the dq "
@@ -267,7 +308,11 @@ void write_export_mat(const ExportTable& table, const std::string& path) {
   params.emplace_back("std_error", mat_column(errors));
   params.emplace_back("unit", mat_cells(param_units));
   std::vector<std::pair<std::string, Var>> info;
-  for (const auto& [key, value] : table.info) info.emplace_back(key, mat_text(value));
+  for (const auto& [key, value] : table.info) {
+    // Numbers as 1 x 1 doubles (info.p_r + 1 works in MATLAB), the rest as char rows.
+    if (const double* number = std::get_if<double>(&value)) info.emplace_back(key, mat_column({*number}));
+    else info.emplace_back(key, mat_text(std::get<std::string>(value)));
+  }
 
   std::vector<Var> vars;
   vars.push_back(mat_struct("samples", std::move(samples)));
@@ -288,9 +333,10 @@ std::string export_data(const DiscoveryInput& input, std::span<const std::string
                         const std::string& mat_path) {
   const PreparedLog log = prepare_log(input, options.prepare);
   const ModelFit fit = fit_prepared(log, effects, options);
-  const ExportTable table = export_table(log, fit, log_path);
+  const ExportTable table = export_table(input, log, fit, log_path);
   const std::string what = fmt::format("{} samples x {} columns, {} parameters of {}", table.rows(),
-                                       table.columns.size(), table.params.size(), table.info[1].second);
+                                       table.columns.size(), table.params.size(),
+                                       std::get<std::string>(table.info[1].second));
   std::string o;
   if (!csv_path.empty()) {
     write_export_csv(table, csv_path);

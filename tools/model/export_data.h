@@ -3,7 +3,9 @@
 // units, for MATLAB, Python or a spreadsheet.
 //
 //   rows     prepare_log (daemon/core/discovery/prepare.h): one per sample with an
-//            angle (and the reference when there is one), in time order
+//            angle (and the reference when there is one), in time order; beside the
+//            fit's columns, each row's raw signals as decoded (sin, cos, R/D angle,
+//            reference angle, phase currents; NaN where the sample lacks one)
 //   model    fit_prepared on the same rows; RowPredictor per row
 //   CSV      OUT: the samples, one header line of column names (units in the names:
 //            theta_rad, i_d_a), one line per row, NaN where a row lacks a signal.
@@ -14,7 +16,8 @@
 //            scipy.io.loadmat): structs samples (one N x 1 field per column), units
 //            and descriptions (the same fields, text), params (name, unit: P x 1
 //            cells; value, std_error: P x 1; struct2table(params) is the table),
-//            info (log, model, pole pairs, angle source, residual and floor).
+//            info (log, model, pole pairs, angle source, residual and floor; the
+//            numbers as 1 x 1 doubles, the rest as text).
 //
 // The prediction is the model's effects at the fitted values plus the constants
 // fitted beside them (row_prediction.h: the dq operating point, the envelopes' gain,
@@ -26,6 +29,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "daemon/core/discovery/model_discovery.h"
@@ -42,12 +46,14 @@ struct ExportColumn {
 struct ExportTable {
   std::vector<ExportColumn> columns;                       ///< the samples, every column the same length
   std::vector<ParamValue> params;                          ///< the fitted parameters
-  std::vector<std::pair<std::string, std::string>> info;   ///< key (an identifier), value as text
+  /// key (an identifier), value: a number (p_r, residual_rms_rad ...) or text (log, model ...)
+  std::vector<std::pair<std::string, std::variant<double, std::string>>> info;
   [[nodiscard]] std::size_t rows() const { return columns.empty() ? 0 : columns.front().values.size(); }
 };
 
-/// The table of `log` (prepared) and `fit` (fitted on it). `log_path` goes into info.
-[[nodiscard]] ExportTable export_table(const PreparedLog& log, const ModelFit& fit, std::string_view log_path);
+/// The table of `log` (prepared from `input`) and `fit` (fitted on it). `log_path` goes into info.
+[[nodiscard]] ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, const ModelFit& fit,
+                                       std::string_view log_path);
 
 /// Where the CSV export puts the parameters: "x.csv" -> "x.params.csv", "x" -> "x.params.csv".
 [[nodiscard]] std::string params_csv_path(const std::string& csv_path);

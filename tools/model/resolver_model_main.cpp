@@ -3,6 +3,7 @@
 //   resolver-model explain LOG [--effects a,b] [--json]
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
 //   resolver-model export-data LOG [--effects a,b] --csv OUT.csv | --mat OUT.mat
+//   resolver-model export LOG [--effects a,b] [--table-format csv|json|c-header] [--out FILE]
 // All take --config FILE: a resolverd config whose [layout] (DBC, signal map),
 // [input.csv] column map, [bench] pole pairs and [model] effects apply (logs of
 // a user's own layout, scope exports), --format candump|asc|csv and --from/--to [s].
@@ -139,15 +140,67 @@ int write_export(const resolver::LogSamples& samples, const std::string& log, co
   return 0;
 }
 
+// --help examples, one block per subcommand ("Examples:" after the options: help2man
+// makes it the man page's EXAMPLES section, cmake/MakeManPage.cmake sets it verbatim).
+constexpr const char* kExamples = R"(Examples:
+  # the demo log (tools/demo.sh): the seed model, then where it fails and what is missing
+  resolver-model fit build/demo/demo.log
+  resolver-model explain build/demo/demo.log
+  # the discovery as one HTML page; the samples for MATLAB or pandas
+  resolver-model report build/demo/demo.log --html demo.html
+  resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat
+  # a correction table for the drive firmware
+  resolver-model export build/demo/demo.log --effects amplitude_imbalance --table-format c-header --out table.h
+Each subcommand's --help has its options and examples: resolver-model fit --help)";
+
+constexpr const char* kFitExamples = R"(Examples:
+  # the default model (amplitude_imbalance, or the config's [model] effects)
+  resolver-model fit build/demo/demo.log
+  # two effects, as JSON; only seconds 1..4 of a Vector ASC log
+  resolver-model fit demo.log --effects amplitude_imbalance,dead_time --json
+  resolver-model fit bench.asc --from 1 --to 4
+  # a scope export mapped by [input.csv] in a resolverd config; forward motion only
+  resolver-model fit scope.csv --config scope.toml --direction forward)";
+
+constexpr const char* kExplainExamples = R"(Examples:
+  # where the seed model fails and the ranked missing effects
+  resolver-model explain build/demo/demo.log
+  # the same from a richer model, as JSON (suggested_custom: a [[model.custom]] block)
+  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json
+  # with the effects of a resolverd config (its [model] effects and [[model.custom]] blocks)
+  resolver-model explain demo.log --config tools/demo/model_with_dead_time.toml)";
+
+constexpr const char* kReportExamples = R"(Examples:
+  # the discovery loop to its verdict, as one self-contained page
+  resolver-model report build/demo/demo.log --html demo.html
+  # start from two effects, at most 3 steps
+  resolver-model report demo.log --effects amplitude_imbalance,dead_time --max-steps 3 --html demo.html)";
+
+constexpr const char* kExportDataExamples = R"(Examples:
+  # samples, prediction and residual per sample: CSV (+ demo.params.csv) and .mat
+  resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat
+  # the model with dead time, the first 2 s only, .mat alone
+  resolver-model export-data demo.log --effects amplitude_imbalance,dead_time --to 2 --mat demo.mat
+  # read back:  MATLAB  s = load('demo.mat'); T = readtable('demo.csv');
+  #             Python  scipy.io.loadmat('demo.mat', squeeze_me=True); pandas.read_csv('demo.csv'))";
+
+constexpr const char* kExportExamples = R"(Examples:
+  # a CSV table that resolverd --calibration compensates with
+  resolver-model export build/demo/demo.log --effects amplitude_imbalance,dead_time --out table.csv
+  resolverd --replay build/demo/demo.log --once --fast --calibration table.csv
+  # a C header for the drive firmware, 256 points per mechanical turn
+  resolver-model export demo.log --table-format c-header --points 256 --out resolver_table.h)";
+
+/// A subcommand's footer: its examples, then the exit codes every --help ends with.
+std::string sub_footer(const char* examples) {
+  return std::string(examples) + "\n\n" + resolver::exit_code::kHelpText;
+}
+
 int run(int argc, char** argv) {
-  CLI::App app{"resolver-model: compare the effect model with a log, see where it fails, name the missing effect.\n"
-               "Examples:\n"
-               "  resolver-model fit build/demo/demo.log\n"
-               "  resolver-model explain build/demo/demo.log\n"
-               "  resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json\n"
-               "  resolver-model report build/demo/demo.log --html demo.html\n"
-               "  resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat"};
-  app.footer(resolver::exit_code::kHelpText);
+  // The program's name, not argv[0] (a build path), in every usage line and man page.
+  CLI::App app{"resolver-model: compare the effect model with a log, see where it fails, name the missing effect.",
+               "resolver-model"};
+  app.footer(std::string(kExamples) + "\n\n" + resolver::exit_code::kHelpText);
   app.require_subcommand(1);
   app.set_version_flag("--version", resolver::version_line("resolver-model"));
   std::string log;
@@ -198,8 +251,11 @@ int run(int argc, char** argv) {
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
   add_common(fit);
   add_common(explain);
+  fit->footer(sub_footer(kFitExamples));
+  explain->footer(sub_footer(kExplainExamples));
   CLI::App* report = app.add_subcommand(
       "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
+  report->footer(sub_footer(kReportExamples));
   std::string html_out;
   int max_steps = 6;
   report->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
@@ -209,6 +265,7 @@ int run(int argc, char** argv) {
   CLI::App* export_data = app.add_subcommand(
       "export-data", "write the log's samples, the fitted model's prediction and residual per sample, and the "
                      "parameters with units: CSV (MATLAB readtable, pandas) and/or MATLAB .mat");
+  export_data->footer(sub_footer(kExportDataExamples));
   std::string csv_out, mat_out;
   export_data->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
   export_data->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
@@ -225,6 +282,7 @@ int run(int argc, char** argv) {
   CLI::App* exporter = app.add_subcommand(
       "export", "fit the model and write what a drive firmware loads: a correction table over one mechanical "
                 "revolution with its harmonic coefficients (resolverd --calibration reads the CSV)");
+  exporter->footer(sub_footer(kExportExamples));
   std::string export_format = "csv", export_out;
   int export_points = 1024;
   exporter->add_option("LOG", log, "the log to fit (as for fit)")->required();

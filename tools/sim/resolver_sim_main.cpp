@@ -212,7 +212,8 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
 int main(int argc, char** argv) {
   CLI::App app{
       "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
-      "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects."};
+      "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects.",
+      "resolver-sim"};  // the name in the usage line, not argv[0] (a build path)
   app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText + "\n\n" +
              resolver::format_effect_catalog());
   app.set_version_flag("--version", resolver::version_line("resolver-sim"));

@@ -318,6 +318,8 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   }
   // Rows.
   p.rows.resize(n);
+  p.sample_of_row.resize(n);
+  for (std::size_t i = 0; i < n; ++i) p.sample_of_row[i] = static_cast<std::size_t>(s[i] - in.samples.data());
   double i_d0 = 0.0, i_q0 = 0.0;
   std::int64_t n_cur = 0;
   for (std::size_t i = 0; i < n; ++i) {

@@ -14,6 +14,7 @@
 // (coverage.h), not here.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -54,6 +55,9 @@ struct PreparedLog {
   double amplitude = 0.0;      ///< [counts] median sin/cos radius
   double sample_period = 0.0;  ///< [s] median
   std::vector<FitRow> rows;
+  /// Of each row, its sample: rows[i] came from DiscoveryInput::samples[sample_of_row[i]]
+  /// (the raw signals behind a row, e.g. for resolver-model export-data).
+  std::vector<std::size_t> sample_of_row;
   MotionSummary motion;        ///< of the mechanical angle (true, or self-calibrated / p_r)
   FloorReport floors;
   ChannelQuanta quanta;

@@ -188,7 +188,7 @@ TEST_F(EchoLog, BinaryPrintsTheSameLinesAsTheLibrary) {
 TEST_F(EchoLog, BinaryHelpAndUsageErrors) {
   const auto help = run(kEchoBinary + " --help");
   EXPECT_EQ(help.exit_code, 0);
-  EXPECT_NE(help.out.find("EXAMPLES"), std::string::npos);
+  EXPECT_NE(help.out.find("\nExamples:\n"), std::string::npos);
   EXPECT_NE(help.out.find("unknown fingerprint"), std::string::npos);
   EXPECT_EQ(run(kEchoBinary + " 2>&1").exit_code, 2);
   EXPECT_EQ(run(kEchoBinary + " --log " + log_ + " --lcm memq:// 2>&1").exit_code, 2);
