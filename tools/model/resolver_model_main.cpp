@@ -337,6 +337,7 @@ int run(int argc, char** argv) {
       samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config, read_options);
     }
     resolver::DiscoveryOptions options;
+    options.max_report_order = resolver::kOfflineReportOrder;
     options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
     options.prepare.direction = direction == "forward"    ? resolver::DirectionFilter::kForward
                                 : direction == "backward" ? resolver::DirectionFilter::kBackward

@@ -34,6 +34,10 @@ namespace resolver {
 
 class CustomEffects;
 
+/// The highest harmonic order an offline analysis breaks the residual into: the
+/// catalog's highest winding harmonic (k20).
+inline constexpr int kOfflineReportOrder = 20;
+
 struct DiscoveryOptions {
   /// A signal is explained when its residual rms <= explained_ratio x its noise floor (issue 4: 1.5).
   double explained_ratio = 1.5;
@@ -41,9 +45,11 @@ struct DiscoveryOptions {
   /// a difference above 10 is "very strong" evidence).
   double proposal_bic_drop = 10.0;
   /// Harmonic orders 0..max_report_order of theta (and of theta_m, theta_e) in the breakdown.
-  /// 20: the catalog's highest winding harmonic (k20), so a saturation pattern's
-  /// orders are all seen and proposed together (ranking's family candidate).
-  int max_report_order = 20;
+  /// 8 by default: resolverd's live windows pay (2N + 1)^2 per row and accumulator, and
+  /// on a busy core a slower fit starves the socket. resolver-model sets
+  /// kOfflineReportOrder: a saturation pattern's orders are then all seen and proposed
+  /// together (ranking's family candidate).
+  int max_report_order = 8;
   /// Speed bins of the residual breakdown (equal width over the signed speeds seen; empty bins dropped).
   int speed_bins = 6;
   /// Time windows of the breakdown (a residual that changes over time is outside the catalog).

@@ -314,7 +314,9 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
     // Envelope effects enter through atan2 too: at real magnitudes (a 15 % harmonic)
     // one linearised step from zero leaves second-order terms far above the floor.
-    bool nonlinear = one.terms.front().effect->envelope_only() && !c.family;
+    // Where that step already reaches the floor (small magnitudes) a refit would only
+    // cost the live daemon its time.
+    bool nonlinear = one.terms.front().effect->envelope_only() && !c.family && !c.reaches_floor;
     for (int p : one.terms.front().params) {
       nonlinear = nonlinear || one.terms.front().effect->params()[static_cast<std::size_t>(p)].nonlinear;
     }

@@ -62,19 +62,13 @@ void Model::take_values(const Design& design) {
   scratch_valid_ = false;
 }
 
-SignalValues Model::predict(const SignatureRow& row) const {
-  if (!scratch_valid_) {
-    scratch_ = design({});
-    scratch_valid_ = true;
-  }
-  AngleBasis basis;
-  FitRow r;
-  r.sig = row;
-  scratch_.set_frame_shift(0.0);
-  return scratch_.predict(r, basis);
-}
+SignalValues Model::predict(const SignatureRow& row) const { return predict_with_shift(row, 0.0); }
 
 SignalValues Model::predict_in_log_frame(const SignatureRow& row) const {
+  return predict_with_shift(row, frame_shift_);
+}
+
+SignalValues Model::predict_with_shift(const SignatureRow& row, double shift) const {
   if (!scratch_valid_) {
     scratch_ = design({});
     scratch_valid_ = true;
@@ -82,7 +76,7 @@ SignalValues Model::predict_in_log_frame(const SignatureRow& row) const {
   AngleBasis basis;
   FitRow r;
   r.sig = row;
-  scratch_.set_frame_shift(frame_shift_);
+  scratch_.set_frame_shift(shift);
   return scratch_.predict(r, basis);
 }
 

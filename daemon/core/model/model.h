@@ -65,6 +65,8 @@ class Model {
   void keep(std::shared_ptr<const CustomEffects> customs) { customs_ = std::move(customs); }
 
  private:
+  [[nodiscard]] SignalValues predict_with_shift(const SignatureRow& row, double shift) const;
+
   ModelSpec spec_;
   int p_r_ = 1, p_ = 1;
   std::vector<std::vector<double>> values_;
