@@ -338,6 +338,7 @@ int run(int argc, char** argv) {
     }
     resolver::DiscoveryOptions options;
     options.max_report_order = resolver::kOfflineReportOrder;
+    options.harmonic_families = true;
     options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
     options.prepare.direction = direction == "forward"    ? resolver::DirectionFilter::kForward
                                 : direction == "backward" ? resolver::DirectionFilter::kBackward

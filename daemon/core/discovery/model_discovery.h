@@ -50,6 +50,10 @@ struct DiscoveryOptions {
   /// kOfflineReportOrder: a saturation pattern's orders are then all seen and proposed
   /// together (ranking's family candidate).
   int max_report_order = 8;
+  /// Propose harmonic families (every significant order at once) besides single orders:
+  /// offline (resolver-model). Off for resolverd's live windows, where their many
+  /// columns would slow every window that misses an effect.
+  bool harmonic_families = false;
   /// Speed bins of the residual breakdown (equal width over the signed speeds seen; empty bins dropped).
   int speed_bins = 6;
   /// Time windows of the breakdown (a residual that changes over time is outside the catalog).

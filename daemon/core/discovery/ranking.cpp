@@ -157,7 +157,7 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
       const ModelTerm family =
           family_term(*e, spec, significant_orders(fit.harmonics, fit.noise_floor_rad, n, 2, Harmonics::kMaxOrder - 1),
                       [](int m) { return std::vector<std::string>{fmt::format("k{}", m + 1), fmt::format("k{}_q", m + 1)}; });
-      if (!family.params.empty() && usable(family)) out.push_back(family);
+      if (opt.harmonic_families && !family.params.empty() && usable(family)) out.push_back(family);
       continue;
     }
     if (name == "mechanical_harmonics") {
@@ -171,7 +171,7 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
       const ModelTerm family = family_term(
           *e, spec, significant_orders(fit.harmonics_mech, fit.noise_floor_rad, n, 2, 16),
           [](int m) { return std::vector<std::string>{fmt::format("a{}", m), fmt::format("b{}", m)}; });
-      if (!family.params.empty() && usable(family)) out.push_back(family);
+      if (opt.harmonic_families && !family.params.empty() && usable(family)) out.push_back(family);
       continue;
     }
     if (spec.find(*e) != nullptr) continue;
