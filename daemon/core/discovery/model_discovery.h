@@ -50,9 +50,10 @@ struct DiscoveryOptions {
   /// kOfflineReportOrder: a saturation pattern's orders are then all seen and proposed
   /// together (ranking's family candidate).
   int max_report_order = 8;
-  /// Propose harmonic families (every significant order at once) besides single orders:
-  /// offline (resolver-model). Off for resolverd's live windows, where their many
-  /// columns would slow every window that misses an effect.
+  /// Propose harmonic families (every significant order at once) and each order with
+  /// its quadrature part besides single in-phase orders: offline (resolver-model). Off
+  /// for resolverd's live windows, where their columns slowed every window that misses
+  /// an effect (and, on one emulated CPU, the socket reader beside it).
   bool harmonic_families = false;
   /// Speed bins of the residual breakdown (equal width over the signed speeds seen; empty bins dropped).
   int speed_bins = 6;

@@ -146,7 +146,8 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
           if (i < 0 || in_model(spec, *e, i)) continue;
           const ModelTerm t{e, {i}};
           if (usable(t)) out.push_back(t);
-          const int q = p == "k0" ? -1 : find_param(*e, p + "_q");
+          // The phased pair offline (harmonic_families): live windows keep one column per order.
+          const int q = p == "k0" || !opt.harmonic_families ? -1 : find_param(*e, p + "_q");
           if (q < 0 || in_model(spec, *e, q)) continue;
           const ModelTerm with_phase{e, {i, q}};
           if (usable(with_phase)) out.push_back(with_phase);

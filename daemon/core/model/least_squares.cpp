@@ -151,9 +151,9 @@ double cost_at(const PassStatistics& s, const GroupFloors& floors, std::span<con
   return c;
 }
 
-/// [rad] a change of the frame shift that no longer matters: its effect on a
-/// harmonic error of 0.1 rad is 1e-11 rad, far below any floor.
-constexpr double kShiftSettled = 1e-10;
+/// [rad] a change of the frame shift that no longer matters: it turns a harmonic error
+/// of 0.1 rad by 1e-8 rad, far below any floor (a 24-bit converter's LSB is 3.7e-7).
+constexpr double kShiftSettled = 1e-7;
 
 /// The column of the position-error constant the frame shift follows: the sin/cos
 /// angle's where the log has it (the windings' own frame), else the R/D angle's; -1
