@@ -7,6 +7,7 @@
 
 #include "daemon/app/wake_planner.h"
 #include "daemon/service/sd_notify.h"
+#include "drivers/socketcan/link_monitor.h"
 #include "drivers/socketcan/split_wake_source.h"
 
 namespace resolver {
@@ -36,6 +37,24 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
   auto backoff = std::chrono::milliseconds(250);
   constexpr auto kMaxBackoff = std::chrono::milliseconds(5000);
   bool reported_down = false;
+  // Link outages are counted from link events where rtnetlink is available:
+  // a socket whose queue is never empty reports ENETDOWN late, and two flaps
+  // in that time as one (drivers/socketcan/link_monitor.h).
+  std::optional<LinkMonitor> link = LinkMonitor::open(options.iface);
+  auto poll_link = [&](Pipeline& p) {
+    if (!link) return;
+    for (int n = link->poll_downs(); n > 0; --n) {
+      p.count_problem("network_down", options.iface + " went down (link event); waiting for it to come back up");
+    }
+  };
+  // ENETDOWN from the socket: counted only without link events, once per outage.
+  auto note_network_down = [&](Pipeline& p) {
+    poll_link(p);
+    if (!link && !reported_down) {
+      p.count_problem("network_down", options.iface + " is down (ENETDOWN); waiting for it to come back up");
+    }
+    reported_down = true;
+  };
   std::uint64_t drops_reported = 0;
   CanFrame frame;
   SdNotifier* notify = options.notifier;
@@ -151,15 +170,14 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
         pipeline.count_problem("truncated_read", options.iface + ": short read from the CAN socket, frame dropped");
         break;
       case ReadStatus::kNetworkDown:
-        // The socket stays bound; frames resume when the link comes back up.
-        if (!reported_down) {
-          pipeline.count_problem("network_down", options.iface + " is down (ENETDOWN); waiting for it to come back up");
-          reported_down = true;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        // The socket stays bound; frames resume when the link comes back up
+        // (no pause when link events say it already has: the queue is behind).
+        note_network_down(pipeline);
+        if (!link || link->down()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
         break;
       case ReadStatus::kDeviceGone:
         pipeline.count_problem("device_gone", options.iface + " disappeared (ENODEV); re-opening with backoff");
+        source->refresh_kernel_drops();  // drops after the last frame it queued, before the socket closes
         drops_before += source->stats().kernel_drops;
         source.reset();
         silences_seen = 0;
@@ -170,6 +188,7 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
       if (status == ReadStatus::kTimeout || ++reads_since_refresh >= kReadsPerDropRefresh) {
         // Drops after the last frame a socket queued show only this way.
         source->refresh_kernel_drops();
+        poll_link(pipeline);
         reads_since_refresh = 0;
       }
       const std::uint64_t drops = drops_before + source->stats().kernel_drops;
@@ -188,12 +207,25 @@ void run_live(const LiveOptions& options, const std::function<Pipeline&()>& curr
   if (source) {
     source->set_read_timeout(std::chrono::milliseconds(0));
     Pipeline& pipeline = current();
-    for (int i = 0; i < 1'000'000 && source->read(frame) == ReadStatus::kFrame; ++i) {
-      pipeline.feed(frame, 0, Clock::now());
+    // Only an empty queue ends it: a link that went down while the reader was
+    // behind reports that ahead of the frames still queued after it.
+    for (int i = 0; i < 1'000'000; ++i) {
+      const ReadStatus status = source->read(frame);
+      if (status == ReadStatus::kFrame) {
+        pipeline.feed(frame, 0, Clock::now());
+        reported_down = false;
+      } else if (status == ReadStatus::kNetworkDown) {
+        note_network_down(pipeline);
+      } else if (status == ReadStatus::kTruncated) {
+        pipeline.count_problem("truncated_read", options.iface + ": short read from the CAN socket, frame dropped");
+      } else if (status != ReadStatus::kInterrupted) {
+        break;  // kTimeout: empty; kDeviceGone: nothing more to read
+      }
     }
     source->refresh_kernel_drops();
     pipeline.set_kernel_drops(static_cast<std::int64_t>(drops_before + source->stats().kernel_drops));
   }
+  poll_link(current());
   current().finish();
 }
 

@@ -1,12 +1,19 @@
 #include "drivers/socketcan/split_wake_source.h"
 
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <stdexcept>
 #include <utility>
 
 namespace resolver {
 namespace {
+
+/// [ns] CLOCK_REALTIME, the clock of the kernel's receive stamps.
+std::int64_t realtime_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 
 /// Adds a quiet socket's counts (timeouts and network_down stay the waking
 /// socket's: the quiet one is never waited on).
@@ -97,12 +104,18 @@ void SplitWakeSource::pull_quiet() {
       continue;
     }
     if (s == ReadStatus::kTimeout && quiet_retiring_) {
+      // Drops after the last frame it queued show only through SO_MEMINFO;
+      // a full queue retired under a saturated bus hides thousands there.
+      quiet_->refresh_kernel_drops();
       add_quiet_counts(closed_quiet_, quiet_->stats());
       quiet_.reset();
       quiet_retiring_ = false;
     }
-    // kTimeout: empty. kNetworkDown/kDeviceGone reach the waking socket too,
-    // which reports them; kInterrupted: the next call reads on.
+    // The waking socket gets the same ENETDOWN and reports it; on this one
+    // the error came ahead of the frames still queued, so read on.
+    if (s == ReadStatus::kNetworkDown) continue;
+    // kTimeout: empty. kDeviceGone reaches the waking socket too, which
+    // reports it; kInterrupted: the next call reads on.
     return;
   }
 }
@@ -129,6 +142,28 @@ ReadStatus SplitWakeSource::read(CanFrame& frame) {
       --truncated_pending_;
       return ReadStatus::kTruncated;
     }
+    if (deferred_) {
+      // The caller may drop this source after the status: first what both
+      // sockets had queued when it came. Only that: under a saturated bus the
+      // quiet socket refills as fast as it is read, and waiting for it to be
+      // empty held the status back for good while the waking socket overflowed.
+      if (!held_ && read_waking(false) == ReadStatus::kTruncated) {
+        ++truncated_pending_;
+        continue;
+      }
+      pull_quiet();
+      if (held_ && quiet_next_ && same_frame(*quiet_next_, *held_)) {
+        ++duplicates_skipped_;
+        quiet_next_.reset();
+        continue;
+      }
+      std::optional<Stamped>& first =
+          held_ && (!quiet_next_ || held_->stamp_ns < quiet_next_->stamp_ns) ? held_ : quiet_next_;
+      if (first && first->stamp_ns <= deferred_at_ns_) return hand_out(first, frame);
+      const ReadStatus s = *deferred_;
+      deferred_.reset();
+      return s;
+    }
     if (held_) {
       // Quiet frames that arrived before the waking frame go first. Equal
       // stamps: the same frame through both sockets while the split changed,
@@ -141,14 +176,6 @@ ReadStatus SplitWakeSource::read(CanFrame& frame) {
       }
       if (quiet_next_ && quiet_next_->stamp_ns <= held_->stamp_ns) return hand_out(quiet_next_, frame);
       return hand_out(held_, frame);
-    }
-    if (deferred_) {
-      // The caller may drop this source after the status: first what is queued.
-      pull_quiet();
-      if (quiet_next_) return hand_out(quiet_next_, frame);
-      const ReadStatus s = *deferred_;
-      deferred_.reset();
-      return s;
     }
     ReadStatus s = ReadStatus::kTimeout;
     if (quiet_flowing_) {
@@ -179,6 +206,7 @@ ReadStatus SplitWakeSource::read(CanFrame& frame) {
       case ReadStatus::kNetworkDown:
       case ReadStatus::kDeviceGone:
         deferred_ = s;
+        deferred_at_ns_ = realtime_now_ns();
         continue;
       case ReadStatus::kInterrupted:
       case ReadStatus::kTruncated:

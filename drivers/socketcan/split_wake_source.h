@@ -16,8 +16,9 @@
 // socket would): quiet frames stamped at or before a waking frame come before
 // it; quiet frames after the last waking frame wait for the next one, or for
 // read_timeout, after which they are handed out as they come. Nothing is
-// dropped: queued quiet frames are handed out before a kNetworkDown or
-// kDeviceGone is reported. Kernel drop and other counts are the sums of both
+// dropped: the frames both sockets had queued when a kNetworkDown or
+// kDeviceGone came are handed out before it is reported (frames stamped later
+// after it, so a saturated bus cannot hold the status back). Kernel drop and other counts are the sums of both
 // sockets. One quiet frame at most is held in user space.
 //
 // set_wake() changes the split on the live sockets: the waking socket's
@@ -114,7 +115,8 @@ class SplitWakeSource {
   std::chrono::milliseconds read_timeout_;
   std::optional<Stamped> held_;          ///< waking frame, until the quiet frames before it are out
   std::optional<Stamped> quiet_next_;    ///< the oldest quiet frame not handed out
-  std::optional<ReadStatus> deferred_;   ///< waking socket's status, after the queued quiet frames
+  std::optional<ReadStatus> deferred_;   ///< waking socket's status, after the frames queued before it
+  std::int64_t deferred_at_ns_ = 0;      ///< [ns] when deferred_ was read: frames stamped later come after it
   bool quiet_flowing_ = false;           ///< no waking frame for read_timeout: quiet frames as they come
   bool quiet_retiring_ = false;          ///< back to one socket: the quiet one is read until empty
   std::uint64_t truncated_pending_ = 0;  ///< quiet kTruncated results not reported yet

@@ -137,6 +137,23 @@ TEST(SplitWakeSource, DrainedFramesComeBeforeTheDeviceIsReportedGone) {
   EXPECT_EQ(bus.source.read(f), ReadStatus::kDeviceGone);
 }
 
+TEST(SplitWakeSource, FramesArrivingAfterTheDeviceWentAreNotAheadOfTheReport) {
+  // Under a saturated bus the quiet socket refills as fast as it is read: the
+  // status must come after what was queued when it came, not after an empty
+  // queue (which may never be), or the waking socket overflows meanwhile.
+  SplitBus bus(SOCK_SEQPACKET);
+  bus.send(0x100, 1);
+  bus.send(0x101, 1);
+  ::close(bus.waking_peer);
+  bus.waking_peer = -1;
+  EXPECT_EQ(read_frame(bus.source).id, 0x100U);  // the status is read here and deferred
+  bus.send(0x100, 2);                             // arrives after it
+  EXPECT_EQ(read_frame(bus.source).id, 0x101U);
+  CanFrame f;
+  EXPECT_EQ(bus.source.read(f), ReadStatus::kDeviceGone);
+  EXPECT_EQ(read_frame(bus.source).tag, 2) << "the later frame is still handed out, after the status";
+}
+
 TEST(SplitWakeSource, TruncatedQuietReadIsReportedAndCounted) {
   SplitBus bus;
   const std::array<std::uint8_t, 3> stub{1, 2, 3};
