@@ -2,13 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 
 #include <fmt/format.h>
 
 #include "daemon/core/discovery/coverage.h"
 #include "daemon/core/discovery/fit_support.h"
-#include "daemon/core/effects/harmonics.h"
+#include "daemon/core/effects/effect.h"
 #include "daemon/core/effects/registry.h"
 #include "daemon/core/model/custom_effect.h"
 #include "daemon/core/model/least_squares.h"
@@ -75,15 +74,14 @@ std::string motion_missing(const Effect& e, const MotionSummary& m) {
   return "";
 }
 
-/// The family of one effect over `orders` (parameter names per order), ascending, or
-/// empty when fewer than kFamilyFrom orders are left outside the model.
-ModelTerm family_term(const Effect& e, const ModelSpec& spec, const std::vector<int>& orders,
-                      const std::function<std::vector<std::string>(int)>& names) {
+/// A family (CandidateParams::family) of one effect: every group's parameters not
+/// yet in the model, ascending, or empty when fewer than kFamilyFrom groups are left.
+ModelTerm family_term(const Effect& e, const ModelSpec& spec, const std::vector<std::vector<std::string>>& groups) {
   std::vector<int> params;
   int count = 0;
-  for (int m : orders) {
+  for (const std::vector<std::string>& names : groups) {
     bool any = false;
-    for (const std::string& name : names(m)) {
+    for (const std::string& name : names) {
       const int i = find_param(e, name);
       if (i < 0 || in_model(spec, e, i)) continue;
       params.push_back(i);
@@ -96,6 +94,33 @@ ModelTerm family_term(const Effect& e, const ModelSpec& spec, const std::vector<
   return ModelTerm{&e, params};
 }
 
+/// A listed candidate: its parameters, or empty when one is unknown or already in the model.
+ModelTerm listed_term(const Effect& e, const ModelSpec& spec, const std::vector<std::string>& names) {
+  std::vector<int> params;
+  for (const std::string& name : names) {
+    const int i = find_param(e, name);
+    if (i < 0 || in_model(spec, e, i)) return ModelTerm{&e, {}};
+    params.push_back(i);
+  }
+  return ModelTerm{&e, params};
+}
+
+/// The fit's residual spectra as the effects ask for them (Effect::residual_candidates).
+class FitResidualSpectrum final : public ResidualSpectrum {
+ public:
+  FitResidualSpectrum(const ModelFit& fit, std::int64_t n) : fit_(fit), n_(n) {}
+  [[nodiscard]] std::vector<int> significant(Angle angle, int lowest, int most) const override {
+    return significant_orders(angle == Angle::kResolver ? fit_.harmonics : fit_.harmonics_mech, fit_.noise_floor_rad,
+                              n_, lowest, most);
+  }
+  [[nodiscard]] std::vector<int> strongest(Angle angle, int lowest) const override {
+    return significant(angle, lowest, kOrdersTried);
+  }
+
+ private:
+  const ModelFit& fit_;
+  std::int64_t n_;
+};
 
 /// The candidate terms: defaults of every fittable effect not in the model, the
 /// harmonic families at the residual's orders, the config's custom effects.
@@ -128,51 +153,14 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
     }
     return true;
   };
-  const std::int64_t n = fit.account.fitted;
+  const FitResidualSpectrum residual(fit, fit.account.fitted);
   for (const Effect* e : effect_registry()) {
     if (!e->fittable()) continue;
-    const std::string_view name = e->name();
-    if (name == "harmonics") {
-      // Residual at order m of theta: K_{m+1} (same sign) or K_{m-1} opposite (m >= 3), K_0 / K_2 at m = 1.
-      // Each order alone (in phase with the fundamental, as Hanselman's K_n) and with
-      // its quadrature part (a harmonic with its own phase, as measured): the BIC
-      // and the simpler-first rule name the pair only where the phase is in the data.
-      for (int m : significant_orders(fit.harmonics, fit.noise_floor_rad, n, 1)) {
-        std::vector<std::string> params;
-        if (m == 1) params = {"k2", "k0"};
-        else params = {fmt::format("k{}", m + 1), m - 1 >= 2 ? fmt::format("k{}_opp", m - 1) : ""};
-        for (const std::string& p : params) {
-          const int i = p.empty() ? -1 : find_param(*e, p);
-          if (i < 0 || in_model(spec, *e, i)) continue;
-          const ModelTerm t{e, {i}};
-          if (usable(t)) out.push_back(t);
-          // The phased pair offline (harmonic_families): live windows keep one column per order.
-          const int q = p == "k0" || !opt.harmonic_families ? -1 : find_param(*e, p + "_q");
-          if (q < 0 || in_model(spec, *e, q)) continue;
-          const ModelTerm with_phase{e, {i, q}};
-          if (usable(with_phase)) out.push_back(with_phase);
-        }
+    if (const auto sets = e->residual_candidates(residual, opt.harmonic_families)) {
+      for (const CandidateParams& set : *sets) {
+        const ModelTerm t = set.family ? family_term(*e, spec, set.groups) : listed_term(*e, spec, set.groups.front());
+        if (!t.params.empty() && usable(t)) out.push_back(t);
       }
-      // A smooth periodic error over many orders (a saturation pattern) as one step:
-      // every significant order of theta as K_{m+1} with its phase (issue 21).
-      const ModelTerm family =
-          family_term(*e, spec, significant_orders(fit.harmonics, fit.noise_floor_rad, n, 2, Harmonics::kMaxOrder - 1),
-                      [](int m) { return std::vector<std::string>{fmt::format("k{}", m + 1), fmt::format("k{}_q", m + 1)}; });
-      if (opt.harmonic_families && !family.params.empty() && usable(family)) out.push_back(family);
-      continue;
-    }
-    if (name == "mechanical_harmonics") {
-      // Order 1 is eccentricity's (a candidate of its own).
-      for (int m : significant_orders(fit.harmonics_mech, fit.noise_floor_rad, n, 2)) {
-        const int a = find_param(*e, fmt::format("a{}", m));
-        if (a < 0 || in_model(spec, *e, a)) continue;
-        const ModelTerm t{e, {a, a + 1}};
-        if (usable(t)) out.push_back(t);
-      }
-      const ModelTerm family = family_term(
-          *e, spec, significant_orders(fit.harmonics_mech, fit.noise_floor_rad, n, 2, 16),
-          [](int m) { return std::vector<std::string>{fmt::format("a{}", m), fmt::format("b{}", m)}; });
-      if (opt.harmonic_families && !family.params.empty() && usable(family)) out.push_back(family);
       continue;
     }
     if (spec.find(*e) != nullptr) continue;
@@ -191,10 +179,10 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
   return out;
 }
 
-std::string reason_of(const ModelTerm& t, const std::vector<ParamValue>& params) {
+std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params) {
   std::string vals;
   const std::string prefix = std::string(t.effect->name()) + ".";
-  for (const ParamValue& p : params) {
+  for (const ModelParameter& p : params) {
     vals += (vals.empty() ? "" : ", ") + p.name.substr(prefix.size()) + " = " + num(p.value) + " +- " +
             num(p.std_error, "%.2g");
   }
@@ -213,12 +201,12 @@ double value_std_error(const ParamInfo& info, const StepSolution& s, int col, do
 /// The parameters of `design`'s term in value coordinates with standard errors from `s`.
 /// `step` moves the term by the solution first (a linearised candidate taken from its
 /// neutral point); without it the design is already at the solution (a converged refit).
-std::vector<ParamValue> term_params(const Design& design, std::size_t term, const StepSolution& s, bool step) {
+std::vector<ModelParameter> term_params(const Design& design, std::size_t term, const StepSolution& s, bool step) {
   Design moved = design;
   DesignTerm& dt = moved.terms()[term];
   dt.candidate = false;  // let step() move it
   if (step) moved.step(s.dz);
-  std::vector<ParamValue> out;
+  std::vector<ModelParameter> out;
   for (std::size_t k = 0; k < dt.params.size(); ++k) {
     const auto p = static_cast<std::size_t>(dt.params[k]);
     const ParamInfo& info = dt.effect->params()[p];
@@ -297,7 +285,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     c.proposed = c.bic_drop > options.proposal_bic_drop;
     c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
     c.params = term_params(d, term, s, true);
-    std::erase_if(c.params, [&](const ParamValue& pv) {
+    std::erase_if(c.params, [&](const ModelParameter& pv) {
       for (int p : terms[i].params) {
         if (pv.name == terms[i].param_name(static_cast<std::size_t>(&p - terms[i].params.data()))) return false;
       }

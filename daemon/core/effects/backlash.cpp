@@ -46,6 +46,11 @@ class BacklashEffect final : public BasicEffect {
     }
     return seen;
   }
+  // Once the play is taken up: eps = p_r (h/2) sign(omega), a direction term.
+  [[nodiscard]] bool has_motion_terms() const override { return true; }
+  [[nodiscard]] MotionTerms motion_terms(Values v, int p_r) const override {
+    return {.per_direction_rad = 0.5 * static_cast<double>(p_r) * v[0]};
+  }
   // Steady motion: eps = p_r (h/2) direction. During the take-up after a reversal
   // (travel D < h from the turning point) the resolver stands still: eps_m runs
   // from +h/2 to -h/2 of the new direction, eps = p_r direction (D - h/2).

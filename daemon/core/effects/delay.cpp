@@ -26,6 +26,9 @@ class DelayEffect final : public BasicEffect {
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChangeOrReversal; }
   [[nodiscard]] double resolver_time_shift(Values v) const override { return v[0]; }
+  // eps = omega d at steady speed (delay.h).
+  [[nodiscard]] bool has_motion_terms() const override { return true; }
+  [[nodiscard]] MotionTerms motion_terms(Values v, int /*p_r*/) const override { return {.per_speed_s = v[0]}; }
   void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override { t.delay = v[0]; }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }

@@ -34,8 +34,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "daemon/core/effects/phase_currents.h"
 #include "daemon/core/effects/sin_cos.h"
@@ -135,6 +138,37 @@ struct HarmonicOrders {
 /// The parameter values of one effect, in the order of its params().
 using Values = std::span<const double>;
 
+/// What discovery's residual shows, for effects whose candidates follow it.
+class ResidualSpectrum {
+ public:
+  enum class Angle : std::uint8_t { kResolver, kMechanical };
+  virtual ~ResidualSpectrum() = default;
+  /// The residual's harmonic orders of `angle` that stand above its noise, from
+  /// `lowest`, largest first, at most `most`.
+  [[nodiscard]] virtual std::vector<int> significant(Angle angle, int lowest, int most) const = 0;
+  /// The same, only the few largest that discovery tries one order at a time.
+  [[nodiscard]] virtual std::vector<int> strongest(Angle angle, int lowest) const = 0;
+};
+
+/// A candidate term discovery tries for an effect: its parameters by name, grouped
+/// by harmonic order. One group: the term as listed (skipped when a name is
+/// unknown or already in the model). A family: every group's parameters not yet in
+/// the model, tried as one step when enough orders are left (ranking.cpp).
+struct CandidateParams {
+  std::vector<std::vector<std::string>> groups;
+  bool family = false;
+};
+
+/// The part of an effect's angle error that depends on speed or direction and
+/// not on the angle: [rad, resolver electrical] per_speed_s * omega +
+/// per_direction_rad * sign(omega), omega the resolver electrical speed [rad/s].
+/// A calibration table keeps these as scalars beside its static correction
+/// (daemon/core/model/calibration_table.h).
+struct MotionTerms {
+  double per_speed_s = 0.0;
+  double per_direction_rad = 0.0;
+};
+
 /// State a motion hook may keep between samples (backlash's play).
 struct MotionState {
   bool started = false;
@@ -179,6 +213,14 @@ class Effect {
   /// with what to record instead of proposing it (issue 21).
   enum class Needs : std::uint8_t { kNothing, kSpeedChangeOrReversal, kSpeedChange, kReversal };
   [[nodiscard]] virtual Needs identifiable_with() const { return Needs::kNothing; }
+  /// The candidate terms discovery tries for this effect, from the residual's
+  /// spectrum (a harmonic at the orders the residual shows, with its phase, and as a
+  /// family when `families`: offline only). nullopt: its default parameters, once,
+  /// when the model lacks the effect.
+  [[nodiscard]] virtual std::optional<std::vector<CandidateParams>> residual_candidates(
+      const ResidualSpectrum& /*residual*/, bool /*families*/) const {
+    return std::nullopt;
+  }
   /// The harmonic orders the columns of the fitted parameters `params` use.
   /// Default by stage: windings/channels/converter 2 theta, motion 0, currents 1 theta_e.
   [[nodiscard]] virtual HarmonicOrders orders(std::span<const int> params) const;
@@ -189,6 +231,12 @@ class Effect {
   /// True when the values change the chain from ideal. Default: a parameter is
   /// away from its neutral value.
   [[nodiscard]] virtual bool active(Values v) const;
+  /// True when the effect's whole angle error is speed- or direction-dependent
+  /// (motion_terms()): a table over the angle leaves it out and keeps the terms.
+  [[nodiscard]] virtual bool has_motion_terms() const { return false; }
+  /// The speed and direction terms of the error at values `v` (resolver pole
+  /// pairs p_r); only for effects with has_motion_terms().
+  [[nodiscard]] virtual MotionTerms motion_terms(Values /*v*/, int /*p_r*/) const { return {}; }
 
   // ---- forward hooks (forward_chain.h calls them; defaults do nothing) -------
   /// [s] the resolver's signals are those of time t - shift (delay).

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
@@ -136,6 +138,35 @@ class HarmonicsEffect final : public BasicEffect {
       top = std::max(top, group % 2 == 0 ? n : n + 1);
     }
     return {.theta = top};
+  }
+  // A residual at order m of theta is K_{m+1} (same sign) or K_{m-1} opposite
+  // (m >= 3), K_0 / K_2 at m = 1 (Hanselman eq. 8-9). Each order alone (in phase
+  // with the fundamental, as Hanselman's K_n) and with its quadrature part (a
+  // harmonic with its own phase, as measured): the BIC and the simpler-first rule
+  // name the pair only where the phase is in the data. A smooth periodic error
+  // over many orders (a saturation pattern) as one family (issue 21).
+  [[nodiscard]] std::optional<std::vector<CandidateParams>> residual_candidates(const ResidualSpectrum& residual,
+                                                                                bool families) const override {
+    using Angle = ResidualSpectrum::Angle;
+    std::vector<CandidateParams> out;
+    for (int m : residual.strongest(Angle::kResolver, 1)) {
+      std::vector<std::string> names;
+      if (m == 1) names = {"k2", "k0"};
+      else names = {fmt::format("k{}", m + 1), m - 1 >= 2 ? fmt::format("k{}_opp", m - 1) : ""};
+      for (const std::string& k : names) {
+        if (k.empty()) continue;
+        out.push_back({.groups = {{k}}});
+        if (families && k != "k0") out.push_back({.groups = {{k, k + "_q"}}});
+      }
+    }
+    if (families) {
+      CandidateParams family{.groups = {}, .family = true};
+      for (int m : residual.significant(Angle::kResolver, 2, Harmonics::kMaxOrder - 1)) {
+        family.groups.push_back({fmt::format("k{}", m + 1), fmt::format("k{}_q", m + 1)});
+      }
+      out.push_back(std::move(family));
+    }
+    return out;
   }
   [[nodiscard]] bool envelope_only() const override { return true; }
   void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string_view>
 
+#include <fmt/format.h>
+
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
@@ -56,6 +58,25 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
     return {.theta_m = top};
   }
   [[nodiscard]] bool needs_reference() const override { return true; }
+  // An order's (a_n, b_n) pair at the orders the residual shows over the mechanical
+  // turn, from 2 (order 1 is eccentricity's, a candidate of its own); offline also
+  // every significant order as one family.
+  [[nodiscard]] std::optional<std::vector<CandidateParams>> residual_candidates(const ResidualSpectrum& residual,
+                                                                                bool families) const override {
+    using Angle = ResidualSpectrum::Angle;
+    std::vector<CandidateParams> out;
+    for (int m : residual.strongest(Angle::kMechanical, 2)) {
+      out.push_back({.groups = {{fmt::format("a{}", m), fmt::format("b{}", m)}}});
+    }
+    if (families) {
+      CandidateParams family{.groups = {}, .family = true};
+      for (int m : residual.significant(Angle::kMechanical, 2, kMaxMechanicalOrder)) {
+        family.groups.push_back({fmt::format("a{}", m), fmt::format("b{}", m)});
+      }
+      out.push_back(std::move(family));
+    }
+    return out;
+  }
   void validate(Values v) const override {
     double sum = 0.0;
     for (std::size_t i = 0; i < v.size(); ++i) sum += static_cast<double>(i / 2 + 1) * std::abs(v[i]);

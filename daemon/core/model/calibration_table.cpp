@@ -28,11 +28,23 @@ double static_correction(const Model& m, double x) {
   return eps;
 }
 
-double parameter(const Model& m, std::string_view name) {
-  for (const ModelParameter& p : m.parameters()) {
-    if (p.name == name) return p.value;
+/// The model without the effects whose error is a speed or direction term
+/// (their parameters at neutral), and those terms summed.
+Model statics_of(const Model& model, MotionTerms& terms) {
+  Model statics = model;
+  const ModelSpec& spec = model.spec();
+  for (std::size_t i = 0; i < spec.terms.size(); ++i) {
+    const ModelTerm& term = spec.terms[i];
+    if (!term.effect->has_motion_terms()) continue;
+    const MotionTerms m = term.effect->motion_terms(model.values()[i], model.p_r());
+    terms.per_speed_s += m.per_speed_s;
+    terms.per_direction_rad += m.per_direction_rad;
+    for (std::size_t j = 0; j < term.params.size(); ++j) {
+      const ParamInfo& info = term.effect->params()[static_cast<std::size_t>(term.params[j])];
+      statics.set(term.param_name(j), info.neutral);
+    }
   }
-  return 0.0;
+  return statics;
 }
 
 }  // namespace
@@ -54,12 +66,10 @@ CalibrationTable tabulate(const Model& model, int points, int fourier_orders) {
   t.model = model.spec().references();
   t.parameters = model.parameters();
   // Speed and direction terms stay scalars; the table is the model without them.
-  Model statics = model;
-  for (const ModelParameter& p : model.parameters()) {
-    if (p.name == "delay.d" || p.name == "backlash.h") statics.set(p.name, 0.0, p.std_error);
-  }
-  t.delay = parameter(model, "delay.d");
-  t.backlash = parameter(model, "backlash.h");
+  MotionTerms terms;
+  const Model statics = statics_of(model, terms);
+  t.delay = terms.per_speed_s;
+  t.backlash = 2.0 * terms.per_direction_rad / model.p_r();  // the file's h: p_r (h/2) sign(omega)
   const auto n = static_cast<std::size_t>(points);
   t.correction.resize(n);
   for (std::size_t i = 0; i < n; ++i) t.correction[i] = static_correction(statics, kTwoPi * static_cast<double>(i) / points);
