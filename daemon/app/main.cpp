@@ -362,7 +362,7 @@ static int run(int argc, char** argv) {
       cal.p = pipeline->processor().config().p;
       cal.method = model.method;
       cal.samples = model.samples;
-      for (const ParamEstimate& prm : model.params) cal.params.push_back({prm.name, prm.value, prm.std_error});
+      cal.params = model.params;
       if (pipeline->processor().config().method == EstimatorMethod::kModel) describe_model(pipeline->processor().model(), cal);
       Calibration::Provenance& pv = cal.provenance;
       pv.config = config_path;

@@ -420,7 +420,7 @@ void Pipeline::publish_estimate(const Sample& sample, std::uint8_t counter) {
   e.sample_index = sample.index;
   e.counter = counter;
   e.method = est.method;
-  for (const ParamEstimate& p : est.params) {
+  for (const ModelParameter& p : est.params) {
     e.param_name.push_back(p.name);
     e.value.push_back(p.value);
     e.std_error.push_back(p.std_error);

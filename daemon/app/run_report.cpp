@@ -128,7 +128,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     out << fmt::format("  estimate   {}: {} over {:.0f} revolutions{}\n", model.method,
                        model.converged ? "converged" : "NOT converged", model.revolutions,
                        model.params.empty() ? " (no fit: missing signals? sincos needs sin/cos, fourier a reference)" : "");
-    for (const ParamEstimate& prm : model.params) {
+    for (const ModelParameter& prm : model.params) {
       out << fmt::format("             {:<28} = {:+.6e} +- {:.2e}\n", prm.name, prm.value, prm.std_error);
     }
   }
@@ -220,7 +220,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   j += fmt::format("\"p_r\":{},\"p\":{},", p.processor().config().p_r, p.processor().config().p);
   const ModelEstimate model = p.processor().estimate();
   double alpha = est.alpha(), alpha_se = est.alpha_stderr();
-  for (const ParamEstimate& prm : model.params) {
+  for (const ModelParameter& prm : model.params) {
     if (prm.name == "amplitude_imbalance.alpha") {
       alpha = prm.value;
       alpha_se = prm.std_error;

@@ -315,7 +315,7 @@ std::optional<Calibration> parse_calibration(const std::string& text, const std:
     } else if (key == "param") {
       const auto [name, values] = split_key(rest);
       const auto [value_text, error_text] = split_key(values);
-      CalibrationParam param;
+      ModelParameter param;
       param.name = std::string(name);
       if (!valid_name(name) || !parse_number(value_text, param.value) || !parse_number(error_text, param.std_error) ||
           !std::isfinite(param.value) || std::isinf(param.std_error) || param.std_error < 0.0) {

@@ -46,15 +46,11 @@
 #include <string>
 #include <vector>
 
+#include "daemon/core/model/parameter.h"
+
 namespace resolver {
 
 /// One learned parameter, named as in estimate_t (e.g. "amplitude_imbalance.alpha").
-struct CalibrationParam {
-  std::string name;        ///< [A-Za-z0-9_.:-]+, unique within a calibration
-  double value = 0.0;      ///< in the parameter's own unit (see the effect catalog)
-  double std_error = 0.0;  ///< one standard error, same unit; >= 0, or NaN (not identifiable)
-  bool operator==(const CalibrationParam&) const = default;
-};
 
 struct Calibration {
   int p_r = 1;  ///< resolver pole pairs (theta = p_r * theta_m), 1..255 as in BENCH_INFO
@@ -70,7 +66,9 @@ struct Calibration {
     bool operator==(const Custom&) const = default;
   };
   std::vector<Custom> custom;
-  std::vector<CalibrationParam> params;
+  /// Names [A-Za-z0-9_.:-]+, unique; std_error >= 0 or NaN. The file keeps name,
+  /// value and standard error (the unit is the registry's: read back empty).
+  std::vector<ModelParameter> params;
   /// Where the calibration came from (format 3; all empty in a version-1 or -2 file).
   /// Printable one-line texts: a line break written here is saved as '?'.
   struct Provenance {

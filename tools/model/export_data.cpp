@@ -232,7 +232,7 @@ ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, co
     fill(t, q, i, r.has(FitRow::kHasCur), r.y_q, p.q);
   }
   t.params = fit.params;
-  for (ParamValue& p : t.params) p.unit = report::bare_unit(p.unit);
+  for (ModelParameter& p : t.params) p.unit = report::bare_unit(p.unit);
   t.info = {
       {"log", std::string(log_path)},
       {"model", fit.effects.empty() ? std::string("(nuisance only)") : fmt::format("{}", fmt::join(fit.effects, ","))},

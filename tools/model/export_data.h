@@ -45,7 +45,7 @@ struct ExportColumn {
 
 struct ExportTable {
   std::vector<ExportColumn> columns;                       ///< the samples, every column the same length
-  std::vector<ParamValue> params;                          ///< the fitted parameters
+  std::vector<ModelParameter> params;                          ///< the fitted parameters
   /// key (an identifier), value: a number (p_r, residual_rms_rad ...) or text (log, model ...)
   std::vector<std::pair<std::string, std::variant<double, std::string>>> info;
   [[nodiscard]] std::size_t rows() const { return columns.empty() ? 0 : columns.front().values.size(); }

@@ -75,13 +75,6 @@ struct DiscoveryOptions {
 };
 
 /// A value with its standard error (NaN: not identifiable / not computed).
-struct ParamValue {
-  std::string name;  ///< "effect.param", e.g. "amplitude_imbalance.alpha"
-  double value = 0.0;
-  double std_error = 0.0;
-  std::string unit;
-};
-
 struct SignalResidual {
   std::string signal;        ///< "position_error" [rad], "sin_cos" [fraction of amplitude ~ rad] or "i_dq" [A]
   double rms = 0.0;          ///< residual rms after the fit, over the fitted samples
@@ -168,8 +161,8 @@ struct SampleAccount {
 
 struct ModelFit {
   std::vector<std::string> effects;          ///< the model's effect references
-  std::vector<ParamValue> params;            ///< fitted parameters (no nuisance)
-  std::vector<ParamValue> nuisance;          ///< the nuisance constants (operating point, amplitude, offsets)
+  std::vector<ModelParameter> params;            ///< fitted parameters (no nuisance)
+  std::vector<ModelParameter> nuisance;          ///< the nuisance constants (operating point, amplitude, offsets)
   Model model;                               ///< the fitted model (values, standard errors)
   std::vector<SignalResidual> signals;
   double residual_rms_rad = 0.0;             ///< position-error residual [rad]
@@ -212,7 +205,7 @@ struct Candidate {
   bool proposed = false;            ///< bic_drop > proposal_bic_drop
   bool reaches_floor = false;       ///< every signal <= ratio x floor with it added
   std::string reason;               ///< one sentence of physics + the fitted values
-  std::vector<ParamValue> params;
+  std::vector<ModelParameter> params;
   double weighted_rss = 0.0;
   std::vector<std::string> fits_as_well;  ///< candidates this log cannot tell from it
   /// A harmonic family (every significant order at once): named first only when no

@@ -2,14 +2,46 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
+#include <string_view>
 
+#include "daemon/core/effects/amplitude_imbalance.h"
+#include "daemon/core/effects/harmonics.h"
+#include "daemon/core/effects/offsets.h"
+#include "daemon/core/effects/quadrature.h"
+#include "daemon/core/effects/registry.h"
 #include "daemon/core/estimation/dq_transform.h"
 
 namespace resolver {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// An older estimator's value of a registry effect's parameter: named and united
+/// by the effect (a name the effect lacks is a programming error).
+ModelParameter param_of(const Effect& effect, std::string_view param, double value, double std_error) {
+  const int i = find_param(effect, param);
+  if (i < 0) throw std::logic_error(std::string(effect.name()) + " has no parameter " + std::string(param));
+  return ModelParameter{.name = std::string(effect.name()) + "." + std::string(param), .value = value,
+                        .std_error = std_error,
+                        .unit = std::string(effect.params()[static_cast<std::size_t>(i)].unit)};
 }
+
+/// The sin/cos fits' envelope parameters (alpha, beta, o_s, o_c), as the registry's effects.
+template <typename Fit>
+std::vector<ModelParameter> envelope_params(const Fit& f) {
+  return {param_of(amplitude_imbalance_effect(), "alpha", f.alpha.value, f.alpha.std_error),
+          param_of(quadrature_effect(), "beta", f.beta.value, f.beta.std_error),
+          param_of(offsets_effect(), "o_s", f.o_s.value, f.o_s.std_error),
+          param_of(offsets_effect(), "o_c", f.o_c.value, f.o_c.std_error)};
+}
+
+/// A value no registry effect has (the signal's amplitude, the Fourier reference's series).
+ModelParameter extra_param(std::string name, double value, double std_error, std::string unit) {
+  return ModelParameter{.name = std::move(name), .value = value, .std_error = std_error, .unit = std::move(unit)};
+}
+}  // namespace
 
 std::optional<EstimatorMethod> estimator_from_name(std::string_view name) {
   if (name == "model") return EstimatorMethod::kModel;
@@ -246,15 +278,13 @@ ModelEstimate SampleProcessor::estimate() const {
   e.revolutions = static_cast<double>(revolutions_);
   switch (config_.method) {
     case EstimatorMethod::kModel:
-      for (const ModelParameter& p : compensator_.model().parameters()) {
-        e.params.push_back({p.name, p.value, p.std_error});
-      }
+      e.params = compensator_.model().parameters();
       e.samples = model_samples_;
       e.revolutions = model_revolutions_;
       e.converged = model_set_;
       break;
     case EstimatorMethod::kHwangIntegral:
-      e.params = {{"amplitude_imbalance.alpha", estimator_.alpha(), estimator_.alpha_stderr()}};
+      e.params = {param_of(amplitude_imbalance_effect(), "alpha", estimator_.alpha(), estimator_.alpha_stderr())};
       e.samples = estimator_.samples_used();
       e.revolutions = static_cast<double>(estimator_.revolutions());
       e.converged = estimator_.converged();
@@ -262,13 +292,11 @@ ModelEstimate SampleProcessor::estimate() const {
     case EstimatorMethod::kSinCosLeastSquares:
       if (sincos_fit_) {
         const SinCosFit& f = *sincos_fit_;
-        e.params = {{"amplitude_imbalance.alpha", f.alpha.value, f.alpha.std_error},
-                    {"quadrature.beta", f.beta.value, f.beta.std_error},
-                    {"offsets.o_s", f.o_s.value, f.o_s.std_error},
-                    {"offsets.o_c", f.o_c.value, f.o_c.std_error},
-                    {"signal.amplitude", f.amplitude.value, f.amplitude.std_error}};
+        e.params = envelope_params(f);
+        e.params.push_back(extra_param("signal.amplitude", f.amplitude.value, f.amplitude.std_error, "[signal units]"));
         for (std::size_t i = 0; i < f.k.size() && i < f.harmonic_orders.size(); ++i) {
-          e.params.push_back({"harmonics.k" + std::to_string(f.harmonic_orders[i]), f.k[i].value, f.k[i].std_error});
+          e.params.push_back(param_of(harmonics_effect(), "k" + std::to_string(f.harmonic_orders[i]), f.k[i].value,
+                                      f.k[i].std_error));
         }
         e.samples = f.samples_seen;
         e.converged = revolutions_ >= 1;
@@ -277,15 +305,12 @@ ModelEstimate SampleProcessor::estimate() const {
     case EstimatorMethod::kFourierReference:
       if (fourier_fit_) {
         const AngleErrorFit& f = *fourier_fit_;
-        e.params = {{"amplitude_imbalance.alpha", f.alpha.value, f.alpha.std_error},
-                    {"quadrature.beta", f.beta.value, f.beta.std_error},
-                    {"offsets.o_s", f.o_s.value, f.o_s.std_error},
-                    {"offsets.o_c", f.o_c.value, f.o_c.std_error}};
+        e.params = envelope_params(f);
         for (int n = 1; n <= f.max_order && static_cast<std::size_t>(n) < f.a.size(); ++n) {
-          e.params.push_back({"fourier.a" + std::to_string(n), f.a[static_cast<std::size_t>(n)].value,
-                              f.a[static_cast<std::size_t>(n)].std_error});
-          e.params.push_back({"fourier.b" + std::to_string(n), f.b[static_cast<std::size_t>(n)].value,
-                              f.b[static_cast<std::size_t>(n)].std_error});
+          const auto& a = f.a[static_cast<std::size_t>(n)];
+          const auto& b = f.b[static_cast<std::size_t>(n)];
+          e.params.push_back(extra_param("fourier.a" + std::to_string(n), a.value, a.std_error, "[rad]"));
+          e.params.push_back(extra_param("fourier.b" + std::to_string(n), b.value, b.std_error, "[rad]"));
         }
         e.samples = static_cast<std::int64_t>(f.samples);
         e.converged = revolutions_ >= 1;

@@ -53,15 +53,10 @@ enum class CompensationDomain : std::uint8_t {
 [[nodiscard]] std::string_view estimator_name(EstimatorMethod method);
 
 /// One parameter of the active model, named "effect.param" as in the catalog.
-struct ParamEstimate {
-  std::string name;
-  double value = 0.0;
-  double std_error = 0.0;
-};
 /// Everything estimate_t publishes.
 struct ModelEstimate {
   std::string method;
-  std::vector<ParamEstimate> params;
+  std::vector<ModelParameter> params;
   std::int64_t samples = 0;
   double revolutions = 0.0;
   bool converged = false;

@@ -16,15 +16,9 @@
 #include "daemon/core/model/custom_effect.h"
 #include "daemon/core/model/design.h"
 #include "daemon/core/model/model_spec.h"
+#include "daemon/core/model/parameter.h"
 
 namespace resolver {
-
-struct ModelParameter {
-  std::string name;       ///< "effect.param"
-  double value = 0.0;
-  double std_error = 0.0; ///< NaN: not identifiable
-  std::string unit;
-};
 
 class Model {
  public:

@@ -57,6 +57,11 @@ void write_file(const std::string& path, const std::string& text) {
   ASSERT_TRUE(out.good()) << path;
 }
 
+/// A persisted parameter: the file keeps name, value and standard error.
+ModelParameter param(std::string name, double value, double std_error) {
+  return ModelParameter{.name = std::move(name), .value = value, .std_error = std_error, .unit = ""};
+}
+
 Calibration sample_calibration() {
   Calibration c;
   c.p_r = 1;
@@ -64,10 +69,10 @@ Calibration sample_calibration() {
   c.method = "hwang_integral";
   c.samples = 1'234'567;
   // Values whose decimal form is not short: the round trip must be bit-exact.
-  c.params = {{"amplitude_imbalance.alpha", 1.0 / 3.0, 2.5e-5},
-              {"quadrature.beta", -0.0123456789012345678, 1e-300},
-              {"offsets.o_s", 5e-324, 0.0},
-              {"offsets.o_c", -std::numeric_limits<double>::max(), std::numeric_limits<double>::max()}};
+  c.params = {param("amplitude_imbalance.alpha", 1.0 / 3.0, 2.5e-5),
+              param("quadrature.beta", -0.0123456789012345678, 1e-300),
+              param("offsets.o_s", 5e-324, 0.0),
+              param("offsets.o_c", -std::numeric_limits<double>::max(), std::numeric_limits<double>::max())};
   return c;
 }
 
@@ -142,8 +147,8 @@ TEST(CalibrationStore, RandomizedRoundTrip) {
     c.samples = static_cast<std::int64_t>(rng() >> 2);
     const int n = count(rng);
     for (int i = 0; i < n; ++i) {
-      c.params.push_back({"effect_" + std::to_string(i) + ".k", std::ldexp(mantissa(rng), exponent(rng)),
-                          std::fabs(std::ldexp(mantissa(rng), exponent(rng)))});
+      c.params.push_back(param("effect_" + std::to_string(i) + ".k", std::ldexp(mantissa(rng), exponent(rng)),
+                               std::fabs(std::ldexp(mantissa(rng), exponent(rng)))));
     }
     ASSERT_FALSE(save_calibration(dir.path(), c));
     const LoadResult r = load_calibration(dir.path());
@@ -303,7 +308,7 @@ TEST(CalibrationStore, TheWholeModelRoundTrips) {
   c.method = "model";
   c.model = {"amplitude_imbalance", "harmonics(k5,k3_opp)", "drift"};
   c.custom = {{"drift", "position_error", {"t", "t*sin(2*theta)"}}};
-  c.params.push_back({"harmonics.k5", 1e-4, std::nan("")});  // not identifiable: kept as nan
+  c.params.push_back(param("harmonics.k5", 1e-4, std::nan("")));  // not identifiable: kept as nan
   ASSERT_FALSE(save_calibration(dir.path(), c));
   const LoadResult r = load_calibration(dir.path());
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
