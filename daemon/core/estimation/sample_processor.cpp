@@ -128,7 +128,7 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   }
   const double omega = speed_.update(in.t, theta_meas);
   out.speed_mech = omega / p_r;
-  // Compensation (DESIGN 3 sign): theta_c = theta_rd + eps_hat.
+  // Compensation (docs/ARCHITECTURE.md §3 sign): theta_c = theta_rd + eps_hat.
   if (table_ && config_.compensate) {
     out.theta_comp = table_->correct(theta_meas, omega, in.has_ref ? wrap_2pi(in.theta_m_ref) : kNaN);
     out.eps_hat = wrap_pi(out.theta_comp - theta_meas);

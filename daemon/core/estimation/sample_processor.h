@@ -33,7 +33,7 @@ namespace resolver {
 /// The processor's input is the shared sample (daemon/core/sample.h).
 using SampleInput = Sample;
 
-/// Which estimator runs (DESIGN 6 "Estimators to provide and compare").
+/// Which estimator runs (docs/ARCHITECTURE.md §5).
 enum class EstimatorMethod : std::uint8_t {
   /// The active model ([model] effects) fitted by the live model fit on the
   /// signals present (sin/cos and R/D angle against the reference when there is
