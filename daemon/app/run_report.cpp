@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
+#include "drivers/text/json_string.h"
 
 namespace resolver {
 
@@ -20,20 +21,7 @@ std::string json_number(double v) {
   return fmt::format("{:.17g}", v);  // round-trips a double
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (char ch : text) {
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(ch)));
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
+using text::json_string;  // drivers/text/json_string.h: the one JSON string writer
 
 /// "completed by 0x102 (100.0 %)": the frame a live reader must wake up for.
 void print_completing_frames(std::ostream& out, const CompletingFrames& c) {
