@@ -1,5 +1,6 @@
 #include "daemon/core/estimation/sample_processor.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -11,12 +12,26 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
+namespace {
+/// Every method, the default first: what the config accepts and what messages list.
+constexpr std::array kEstimatorMethods{EstimatorMethod::kModel, EstimatorMethod::kHwangIntegral,
+                                       EstimatorMethod::kSinCosLeastSquares, EstimatorMethod::kFourierReference};
+}  // namespace
+
 std::optional<EstimatorMethod> estimator_from_name(std::string_view name) {
-  if (name == "model") return EstimatorMethod::kModel;
-  if (name == "hwang_integral") return EstimatorMethod::kHwangIntegral;
-  if (name == "sincos_least_squares") return EstimatorMethod::kSinCosLeastSquares;
-  if (name == "fourier_reference") return EstimatorMethod::kFourierReference;
+  for (const EstimatorMethod m : kEstimatorMethods) {
+    if (estimator_name(m) == name) return m;
+  }
   return std::nullopt;
+}
+
+std::string estimator_names() {
+  std::string out;
+  for (const EstimatorMethod m : kEstimatorMethods) {
+    if (!out.empty()) out += ", ";
+    out += estimator_name(m);
+  }
+  return out;
 }
 
 std::string_view estimator_name(EstimatorMethod method) {

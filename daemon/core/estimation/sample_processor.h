@@ -49,8 +49,12 @@ enum class CompensationDomain : std::uint8_t {
   kAngle,   ///< theta_c = theta_rd + eps_hat(theta_rd)   (Hwang Fig. 5)
   kSignal,  ///< correct sin/cos, then atan2               (sin/cos least squares only)
 };
+/// The method named as in the config ([estimator] method), or nullopt for an unknown name.
 [[nodiscard]] std::optional<EstimatorMethod> estimator_from_name(std::string_view name);
 [[nodiscard]] std::string_view estimator_name(EstimatorMethod method);
+/// "model, hwang_integral, ...": every name estimator_from_name() accepts, the default first
+/// (for messages and help, so no hand-kept list drifts from the code). Cannot fail.
+[[nodiscard]] std::string estimator_names();
 
 /// One parameter of the active model, named "effect.param" as in the catalog.
 struct ParamEstimate {
