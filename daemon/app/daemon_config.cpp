@@ -572,7 +572,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     const auto method = estimator_from_name(c.estimator_method);
     if (!method) {
       throw ConfigError(s + ": [estimator] method \"" + c.estimator_method +
-                        "\" is not available; available: hwang_integral, sincos_least_squares, fourier_reference");
+                        "\" is not available; available: " + estimator_names());
     }
     c.method = *method;
     require_positive(c.hwang.min_revolutions, "[estimator] min_revolutions", s);

@@ -140,7 +140,7 @@ struct BenchDefaults {
   bool time_from_counter = true;
 };
 
-/// Live model discovery (DESIGN 7): the active effect list and its window.
+/// Live model discovery (docs/ARCHITECTURE.md §8): the active effect list and its window.
 struct ModelFitOptions {
   bool enabled = true;
   /// The active model: effect references (daemon/core/model/model_spec.h), catalog

@@ -1,4 +1,4 @@
-// Live model discovery in resolverd (issue 4 "Live", DESIGN 7): every window of
+// Live model discovery in resolverd (issue 4 "Live", docs/ARCHITECTURE.md §8): every window of
 // `[model] window_revolutions` resolver revolutions the active model
 // (`[model] effects`) is fitted to the window's samples and a model_fit_t is
 // published, so an engineer watching the residual adds an effect (edit the

@@ -79,7 +79,7 @@ LayoutIdentity layout_identity(const DaemonConfig& config, const FrameDecoder& d
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // DESIGN 5: health_t at 1 Hz
+constexpr std::int64_t kHealthPeriodUs = 1'000'000;  // docs/ARCHITECTURE.md §4: health_t at 1 Hz
 
 ProcessorConfig processor_config(const DaemonConfig& c) {
   ProcessorConfig p;

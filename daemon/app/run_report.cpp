@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
+#include "drivers/text/json_string.h"
 
 namespace resolver {
 
@@ -20,20 +21,7 @@ std::string json_number(double v) {
   return fmt::format("{:.17g}", v);  // round-trips a double
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (char ch : text) {
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(ch)));
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
+using text::json_string;  // drivers/text/json_string.h: the one JSON string writer
 
 /// "completed by 0x102 (100.0 %)": the frame a live reader must wake up for.
 void print_completing_frames(std::ostream& out, const CompletingFrames& c) {
@@ -81,9 +69,9 @@ std::string signal_health_json(const SignalHealthSummary& h, const SignalHealthC
   for (std::size_t i = 0; i < h.faults.size(); ++i) {
     const auto& f = h.faults[i];
     // first_s / last_s: seconds after the first sample (null: never held).
-    j += fmt::format("{}\"{}\":{{\"samples\":{},\"share\":{},\"episodes\":{},\"first_s\":{},\"last_s\":{},"
+    j += fmt::format("{}{}:{{\"samples\":{},\"share\":{},\"episodes\":{},\"first_s\":{},\"last_s\":{},"
                      "\"active_at_end\":{}}}",
-                     i ? "," : "", fault_name(f.fault), f.samples, json_number(f.share), f.episodes,
+                     i ? "," : "", json_string(fault_name(f.fault)), f.samples, json_number(f.share), f.episodes,
                      json_number(f.first_t - h.t_first), json_number(f.last_t - h.t_first),
                      f.active_at_end ? "true" : "false");
   }
@@ -213,7 +201,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   j += "\"rejects\":{";
   bool first = true;
   for (const auto& [reason, n] : p.intake().rejects().all()) {
-    j += fmt::format("{}\"{}\":{}", first ? "" : ",", reason, n);
+    j += fmt::format("{}{}:{}", first ? "" : ",", json_string(reason), n);
     first = false;
   }
   j += "},";

@@ -1,4 +1,4 @@
-// Angle conventions of the whole project (DESIGN section 3), written down once.
+// Angle conventions of the whole project (docs/ARCHITECTURE.md §3), written down once.
 //
 //   theta_m   mechanical rotor angle [rad]
 //   theta     resolver electrical angle = p_r * theta_m [rad]  (p_r: resolver pole pairs)

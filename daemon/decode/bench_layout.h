@@ -1,4 +1,4 @@
-// The default bench CAN layout (DESIGN section 4), as constants and an encoder.
+// The default bench CAN layout (docs/ARCHITECTURE.md §4), as constants and an encoder.
 //
 // The daemon decodes frames through proto/resolver_bench.dbc (so a user's own
 // layout is only a different DBC + signal map). This header is the second,

@@ -1,4 +1,4 @@
-// CRC-8 SAE J1850 as used by the bench layout (DESIGN 4): polynomial 0x1D,
+// CRC-8 SAE J1850 as used by the bench layout (docs/ARCHITECTURE.md §4): polynomial 0x1D,
 // initial value 0xFF, final XOR 0xFF, no reflection. Check value for the
 // ASCII bytes "123456789" is 0x4B (AUTOSAR CRC library spec, Crc_CalculateCRC8).
 #pragma once
@@ -44,7 +44,7 @@ inline constexpr std::uint8_t kCrc8J1850Init = 0xFF;
 }
 
 /// The bench layout's frame CRC: over data bytes 0..6 followed by the low byte
-/// of the CAN ID (DESIGN 4). `data` must hold at least 7 bytes.
+/// of the CAN ID (docs/ARCHITECTURE.md §4). `data` must hold at least 7 bytes.
 [[nodiscard]] constexpr std::uint8_t bench_frame_crc(const std::uint8_t* data, std::uint32_t can_id) {
   std::uint8_t crc = kCrc8J1850Init;
   for (std::size_t i = 0; i < 7; ++i) crc = crc8_j1850_update(crc, data[i]);

@@ -30,7 +30,7 @@ inline constexpr std::size_t kRoleCount = 7;
 
 enum class CrcAlgorithm : std::uint8_t {
   kNone,
-  /// CRC-8 SAE J1850 over bytes 0..6 then the low byte of the CAN ID (DESIGN 4).
+  /// CRC-8 SAE J1850 over bytes 0..6 then the low byte of the CAN ID (docs/ARCHITECTURE.md §4).
   kBenchJ1850,
 };
 
@@ -49,7 +49,7 @@ struct SignalMap {
   /// Message carrying p_r, p, rd_bits, sample_rate_hz, layout_version ("" = none).
   std::string bench_info_message = "BENCH_INFO";
 
-  /// The default bench layout of DESIGN 4 / proto/resolver_bench.dbc.
+  /// The default bench layout of docs/ARCHITECTURE.md §4 / proto/resolver_bench.dbc.
   static SignalMap bench_default();
 };
 

@@ -11,6 +11,7 @@
 #include <fmt/ranges.h>
 
 #include "daemon/core/angles.h"
+#include "drivers/text/json_string.h"
 
 namespace resolver {
 
@@ -18,15 +19,7 @@ namespace {
 
 constexpr const char* kMagic = "# resolver-bench calibration table, format 1";
 
-std::string json_str(std::string_view s) {
-  std::string o = "\"";
-  for (char ch : s) {
-    if (ch == '"' || ch == '\\') o += '\\';
-    if (static_cast<unsigned char>(ch) < 0x20) continue;
-    o += ch;
-  }
-  return o + "\"";
-}
+std::string json_str(std::string_view s) { return text::json_string(s); }
 
 std::string header_lines(const CalibrationTable& t, const TableOrigin& o, const char* c) {
   std::string h;

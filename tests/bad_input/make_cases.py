@@ -2,7 +2,7 @@
 """Writes the bad-input cases of tests/bad_input/cases/ (run once; the output is checked in).
 
 Every log case starts from the same clean log of the default bench layout
-(DESIGN 4, proto/resolver_bench.dbc): one BENCH_INFO frame, then N_SAMPLES
+(docs/ARCHITECTURE.md §4, proto/resolver_bench.dbc): one BENCH_INFO frame, then N_SAMPLES
 control periods of RESOLVER_SAMPLE (0x100), PHASE_CURRENTS (0x101) and
 REFERENCE_ANGLE (0x102), 500 us apart (2 kHz). Each case then makes exactly one
 kind of damage, and where possible *adds* the bad line/frame rather than

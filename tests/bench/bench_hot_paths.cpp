@@ -1,7 +1,7 @@
 // Micro-benchmarks of resolverd's per-frame and per-sample hot paths.
 //
 // Each benchmark runs one stage of the chain in pipeline.h over a synthetic
-// but realistic stream of the default bench (DESIGN 4): 2 kHz control rate,
+// but realistic stream of the default bench (docs/ARCHITECTURE.md §4): 2 kHz control rate,
 // 200 r/min, p_r = p = 3, 16-bit R/D angle, amplitude imbalance alpha = 0.003,
 // 10 A of i_q, a reference encoder, and BENCH_INFO at 10 Hz. So one control
 // period is three frames (0x100, 0x101, 0x102) and one resolver electrical
@@ -14,7 +14,7 @@
 //   BM_FrameIntake          decode + counters + join into samples    [frames/s]
 //   BM_HwangUpdate          HwangIntegralEstimator::update           [samples/s]
 //   BM_SinCosLsReference    SinCosLeastSquares::add with reference   [samples/s]
-//                           (alpha, beta, offsets, K_3; DESIGN 6)
+//                           (alpha, beta, offsets, K_3; docs/ARCHITECTURE.md §7)
 //   BM_SinCosLsConic        SinCosLeastSquares::add, conic only      [samples/s]
 //   BM_AngleFourierUpdate   AngleErrorFourier::add, orders 1..4      [samples/s]
 //   BM_CompensateAngle      eps_hat(theta_rd) from a Fourier fit     [samples/s]

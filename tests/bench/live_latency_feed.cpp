@@ -17,7 +17,7 @@
 namespace resolver::bench_live {
 namespace {
 
-constexpr double kBenchInfoHz = 10.0;     // BENCH_INFO rate (DESIGN 4)
+constexpr double kBenchInfoHz = 10.0;     // BENCH_INFO rate (docs/ARCHITECTURE.md §4)
 constexpr double kFramesPerSample = 3.0;  // sample + currents + reference
 constexpr std::int64_t kNsPerS = 1'000'000'000;
 

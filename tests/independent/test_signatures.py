@@ -8,7 +8,7 @@ Bounds are derived, not tuned:
     w = e^{-j theta} (dc + j ds) the envelope perturbation, |w| <= m. The signature is the
     first-order term Im(w); the rest of the series Im(log(1 + w)) is bounded by
     sum_{k>=2} m^k / k <= m^2 / (2 (1 - m))                                        (B1)
-    Where the brief's signature also linearises the parameter itself (quadrature:
+    Where the catalog's signature also linearises the parameter itself (quadrature:
     cos(theta + beta) - cos(theta) = -beta sin(theta) - (1 - cos beta) cos(theta) - ...),
     that remainder is added: (1 - cos beta)/2 + |beta - sin beta| <= beta^2/2 + |beta|^3/6.
   * Mechanical effects, mounting offset and delay at constant speed are exact: bound F.
@@ -152,7 +152,7 @@ class SpeedDependentTest(SignatureCase):
         self.assertTrue(np.all(np.diff(means) > 0), f"eps must grow with speed: {means}")
 
     def test_delay_shifts_other_errors(self):
-        # eps = omega d + every other error at theta - omega d (brief).
+        # eps = omega d + every other error at theta - omega d (docs/ARCHITECTURE.md §7).
         d, alpha, rpm = 2e-3, 0.01, 200
         log, _, _ = run([f"delay:d={d}", f"amplitude_imbalance:alpha={alpha}"], profile=f"{rpm}:3")
         lag = P_R * rpm * RPM * d

@@ -175,7 +175,7 @@ ref_angle = {{ column = "Encoder", unit = "deg" }}
 
 
 def write_scope_csv(frames, path, bad_rows=()):
-    """RESOLVER_SAMPLE's rd_angle and REFERENCE_ANGLE's ref_angle (DESIGN 4 payloads, decoded with struct)
+    """RESOLVER_SAMPLE's rd_angle and REFERENCE_ANGLE's ref_angle (docs/ARCHITECTURE.md §4 payloads, decoded with struct)
     as a scope export: 5 header lines, a name line, one row per sample (a sample starts with its
     RESOLVER_SAMPLE frame; the resolver-sim log holds no gaps). Returns the number of rows."""
     rows = []  # [t_us, rd_deg, ref_deg]

@@ -22,8 +22,8 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kRefCountsPerTurn = 4294967296.0;  // DESIGN 4: 2^32 counts per mechanical turn
-constexpr double kAmpsPerCurrentBit = 1e-3;         // DESIGN 4: PHASE_CURRENTS at 1 mA/bit
+constexpr double kRefCountsPerTurn = 4294967296.0;  // docs/ARCHITECTURE.md §4: 2^32 counts per mechanical turn
+constexpr double kAmpsPerCurrentBit = 1e-3;         // docs/ARCHITECTURE.md §4: PHASE_CURRENTS at 1 mA/bit
 constexpr double kConvergenceTolerance = 0.01;      // 1 % of alpha (the criterion)
 // Truth of the accuracy study besides alpha: percent-level, the catalog's examples.
 constexpr double kBeta = 0.01;     // [rad]

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "drivers/text/json_string.h"
 #include "tools/echo/json_writer.h"
 #include "tools/echo/lcm_eventlog_reader.h"
 
@@ -42,10 +43,10 @@ std::optional<std::string> format_message_json(const LcmJsonDecoder& decoder, co
   if (!filter.type_matches(msg.type)) return std::nullopt;
 
   std::string line = "{\"channel\":";
-  append_json_string(line, channel_name);
+  text::append_json_string(line, channel_name);
   line += ",\"type\":";
   if (msg.type != nullptr) {
-    append_json_string(line, msg.type->full_name());
+    text::append_json_string(line, msg.type->full_name());
   } else {
     line += "null";
   }
@@ -54,7 +55,7 @@ std::optional<std::string> format_message_json(const LcmJsonDecoder& decoder, co
     line += "null,\"size\":";
     append_json_number(line, static_cast<std::int64_t>(data.size()));
     line += ",\"error\":";
-    append_json_string(line, msg.error);
+    text::append_json_string(line, msg.error);
   } else {
     if (msg.utime_json) {
       line += *msg.utime_json;

@@ -1,4 +1,5 @@
-// Small helpers that append JSON text to a std::string. JSON has no NaN or
+// Small helpers that append JSON numbers to a std::string (strings:
+// drivers/text/json_string.h, the one JSON string writer). JSON has no NaN or
 // infinity, so non-finite numbers are written as null; finite numbers use the
 // shortest text that reads back to the same value (std::to_chars).
 #pragma once
@@ -9,9 +10,6 @@
 
 namespace resolver {
 
-/// Appends `text` as a quoted JSON string. Control characters and invalid
-/// UTF-8 bytes are escaped (\u00XX and U+FFFD), so the output is always valid JSON.
-void append_json_string(std::string& out, std::string_view text);
 void append_json_number(std::string& out, double value);
 void append_json_number(std::string& out, float value);
 void append_json_number(std::string& out, std::int64_t value);

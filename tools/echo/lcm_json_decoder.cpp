@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "drivers/text/json_string.h"
 #include "tools/echo/json_writer.h"
 
 namespace resolver {
@@ -71,7 +72,7 @@ class Decoder {
       }
       if (!first) out.push_back(',');
       first = false;
-      append_json_string(out, m.name);
+      text::append_json_string(out, m.name);
       out.push_back(':');
       out += value;
     }
@@ -251,7 +252,7 @@ class Decoder {
         }
         const auto bytes = take(static_cast<std::size_t>(length));
         // The last byte is the NUL terminator, not text.
-        append_json_string(out, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size() - 1));
+        text::append_json_string(out, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size() - 1));
         return;
       }
     }

@@ -31,7 +31,7 @@ def main():
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
         rows, t0 = [], None
         with open(log, encoding="ascii") as f:
-            for line in f:  # "(1700000000.000500) can0 100#<hex>" (DESIGN 4 payloads)
+            for line in f:  # "(1700000000.000500) can0 100#<hex>" (docs/ARCHITECTURE.md §4 payloads)
                 stamp, _, frame = line.split()
                 can_id, data = frame.split("#")
                 data = bytes.fromhex(data)

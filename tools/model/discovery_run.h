@@ -1,4 +1,4 @@
-// The discovery loop of DESIGN 7 run to its end on one log (what `resolver-model
+// The discovery loop of docs/ARCHITECTURE.md §8 run to its end on one log (what `resolver-model
 // report` shows):
 //
 //   model ─► explain ─► verdict missing_effect? ─► add the best candidate ─► explain again ...

@@ -4,27 +4,11 @@
 
 #include <cmath>
 
+#include "drivers/text/json_string.h"
+
 namespace resolver::json {
 
-std::string str(std::string_view s) {
-  std::string o = "\"";
-  o.reserve(s.size() + 2);
-  for (const char ch : s) {
-    switch (ch) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
-      case '<': o += "\\u003c"; break;
-      case '>': o += "\\u003e"; break;
-      case '&': o += "\\u0026"; break;
-      default:
-        if (static_cast<unsigned char>(ch) < 0x20) o += fmt::format("\\u{:04x}", static_cast<int>(ch));
-        else o += ch;
-    }
-  }
-  return o + "\"";
-}
+std::string str(std::string_view s) { return text::json_string(s, text::JsonEscape::script_safe); }
 
 std::string num(double v, int digits) { return std::isfinite(v) ? fmt::format("{:.{}g}", v, digits) : "null"; }
 

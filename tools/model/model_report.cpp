@@ -5,25 +5,13 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
+#include "drivers/text/json_string.h"
 
 namespace resolver {
 
 namespace {
 
-std::string json_str(std::string_view s) {
-  std::string o = "\"";
-  for (char ch : s) {
-    switch (ch) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      default:
-        if (static_cast<unsigned char>(ch) < 0x20) o += fmt::format("\\u{:04x}", static_cast<int>(ch));
-        else o += ch;
-    }
-  }
-  return o + "\"";
-}
+std::string json_str(std::string_view s) { return text::json_string(s); }
 
 std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
 

@@ -1,4 +1,4 @@
-// resolver-model: offline model discovery on a candump log (issue 4, DESIGN 7).
+// resolver-model: offline model discovery on a candump log (issue 4, docs/ARCHITECTURE.md §8).
 //   resolver-model fit LOG [--effects a,b] [--json]
 //   resolver-model explain LOG [--effects a,b] [--json]
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]

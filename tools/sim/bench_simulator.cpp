@@ -26,7 +26,7 @@ ChainValues default_sim_chain() {
 
 namespace {
 
-constexpr std::int64_t kBenchInfoPeriodUs = 100000;  // 10 Hz (DESIGN 4)
+constexpr std::int64_t kBenchInfoPeriodUs = 100000;  // 10 Hz (docs/ARCHITECTURE.md §4)
 constexpr double kCurrentFullScale = 32767.0 * bench::kCurrentAmpsPerBit;  // [A] i16 at 1 mA/bit
 
 void require(bool ok, const std::string& message) {

@@ -1,6 +1,6 @@
 // The bench simulator: a motor on a dyno with a resolver, an R/D converter, a
 // current-controlled inverter and a reference encoder, producing the CAN frames
-// of the default bench layout (DESIGN 4) with chosen catalog effects.
+// of the default bench layout (docs/ARCHITECTURE.md §4) with chosen catalog effects.
 //
 // Per control sample k (t_k = k / sample_rate_hz):
 //   theta_m(t)  from the speed profile (exact integral), theta = p_r theta_m, theta_e = p theta_m
@@ -106,7 +106,7 @@ class BenchSimulator {
   /// Appends this sample's frames: RESOLVER_SAMPLE at t_us, PHASE_CURRENTS at
   /// t_us + 1, REFERENCE_ANGLE at t_us + 2 (if enabled), then BENCH_INFO at the next
   /// microsecond on the first sample and on every sample that starts a new 100 ms
-  /// of sim time (10 Hz, DESIGN 4). Frames carry config().iface.
+  /// of sim time (10 Hz, docs/ARCHITECTURE.md §4). Frames carry config().iface.
   void append_frames(const SimSample& s, std::vector<CanFrame>& out) const;
 
   [[nodiscard]] std::uint64_t total_samples() const { return total_; }

@@ -3,28 +3,12 @@
 #include <fmt/format.h>
 
 #include "daemon/core/effects/chain_values.h"
+#include "drivers/text/json_string.h"
 
 namespace resolver {
 
 namespace {
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    switch (ch) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(ch) < 0x20) {
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(static_cast<unsigned char>(ch)));
-        } else {
-          out += ch;
-        }
-    }
-  }
-  return out + "\"";
-}
+using text::json_string;  // drivers/text/json_string.h: the one JSON string writer
 
 // fmt's "{}" is the shortest round-trip form of a double, which is valid JSON for finite values.
 std::string parameters_json(const std::vector<std::pair<std::string_view, double>>& params) {

@@ -1,4 +1,4 @@
-// Model discovery (DESIGN 7): fit a model to a log, compare the residual with
+// Model discovery (docs/ARCHITECTURE.md §8): fit a model to a log, compare the residual with
 // the noise floor, say where it fails, and rank the effects not in the model by
 // how much of the residual each explains.
 //

@@ -1,4 +1,4 @@
-// The live model-fit window (DESIGN 7, issue 4 "Live"): collects joined samples
+// The live model-fit window (docs/ARCHITECTURE.md §8, issue 4 "Live"): collects joined samples
 // until they cover a number of resolver electrical revolutions, then hands them
 // over as one DiscoveryInput for fit_model / explain_model. Windows do not
 // overlap. A window that never turns far enough (a stopped motor) is handed over

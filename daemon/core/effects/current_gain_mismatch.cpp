@@ -13,7 +13,7 @@ PhaseCurrents apply_current_gain_mismatch(const CurrentGainMismatch& p, const Ph
 }
 
 DqCurrents current_gain_mismatch_dq_error(const CurrentGainMismatch& p, double i_d, double i_q, double theta_e) {
-  // The Clarke error of the extra a and b parts, then Park (DESIGN 3).
+  // The Clarke error of the extra a and b parts, then Park (docs/ARCHITECTURE.md §3).
   const PhaseCurrents i = ideal_phase_currents(i_d, i_q, theta_e);
   const double d_alpha = p.gain_a * i.a;
   const double d_beta = p.gain_b * i.b / std::numbers::sqrt3;

@@ -4,7 +4,7 @@
 // is the reference; it acts on the MEASUREMENT only.
 // Forward model: i_a_meas = (1 + gain_a) i_a, i_b_meas = (1 + gain_b) i_b,
 // i_c_meas = i_c.
-// Signature (DESIGN 6), for ideal currents i_alpha + j i_beta = I e^{j theta_e},
+// Signature (docs/ARCHITECTURE.md §7), for ideal currents i_alpha + j i_beta = I e^{j theta_e},
 // I = i_d + j i_q (phase_currents.h): i_a = Re(I e^{j theta_e}),
 // i_b = Re(I e^{j(theta_e - 2pi/3)}), and the Clarke error
 // delta = gain_a i_a + j gain_b i_b / sqrt3, rotated by e^{-j theta_e}, is
@@ -15,7 +15,7 @@
 // plus a DC shift. Exact (linear in the gains), proportional to the current,
 // independent of speed except for its frequency 2 omega_e. When p_r = p it lands
 // on the same frequency as the resolver's amplitude imbalance (Hwang eq. 15-16):
-// only the resolver signals tell them apart (DESIGN 6).
+// only the resolver signals tell them apart (docs/ARCHITECTURE.md §7).
 // Compensation: divide the measured a, b currents by (1 + gain).
 #pragma once
 

@@ -1,13 +1,13 @@
 // Effect: offsets of the phase current sensors.
 //
-// The DSP measures all three phases (DESIGN 4 sends i_a, i_b, i_c). Offsets are
+// The DSP measures all three phases (the layout of docs/ARCHITECTURE.md §4 sends i_a, i_b, i_c). Offsets are
 // modelled on the a and b sensors only; c is the reference (any common offset of
-// all three is a zero-sequence term that the Clarke transform of DESIGN 3 does
+// all three is a zero-sequence term that the Clarke transform of docs/ARCHITECTURE.md §3 does
 // not fully remove, so keeping c clean makes off_a, off_b the two observable
 // parameters). They act on the MEASUREMENT: the machine carries the controlled
 // current (Hwang's ideal-control picture, phase_currents.h).
 // Forward model: i_a_meas = i_a + off_a, i_b_meas = i_b + off_b, i_c_meas = i_c [A].
-// Signature (DESIGN 6): through Clarke (i_alpha = i_a, i_beta = (i_b - i_c)/sqrt3)
+// Signature (docs/ARCHITECTURE.md §7): through Clarke (i_alpha = i_a, i_beta = (i_b - i_c)/sqrt3)
 // the offsets are a constant stationary vector (off_a, off_b/sqrt3); in the
 // rotating frame it turns at -theta_e:
 //   delta i_d =  off_a cos theta_e + (off_b/sqrt3) sin theta_e

@@ -19,7 +19,7 @@ double phase_distortion(double k, double magnitude, double psi) {
 
 PhaseCurrents apply_dead_time(const DeadTime& p, const PhaseCurrents& fundamental) {
   if (!p.active()) return fundamental;
-  // Clarke (DESIGN 3) gives the fundamental's vector |I| e^{j psi}; phase x has psi_x = psi - x 2pi/3.
+  // Clarke (docs/ARCHITECTURE.md §3) gives the fundamental's vector |I| e^{j psi}; phase x has psi_x = psi - x 2pi/3.
   const double alpha = fundamental.a;
   const double beta = (fundamental.b - fundamental.c) / std::numbers::sqrt3;
   const double magnitude = std::hypot(alpha, beta);

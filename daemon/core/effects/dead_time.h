@@ -4,7 +4,7 @@
 // voltage a square wave -V_dt sign(i_x), V_dt = t_d f_pwm V_dc, and the machine's
 // impedance turns its 5th (negative sequence) and 7th (positive sequence)
 // harmonics into current harmonics that appear in the rotating frame at 6x
-// theta_e (DESIGN 6). Here we keep only that signature, with one constant:
+// theta_e (docs/ARCHITECTURE.md §7). Here we keep only that signature, with one constant:
 //
 //   each phase current gains  delta i_x = k_dt |I| (sin 7 psi_x - sin 5 psi_x)
 //   where i_x = |I| cos psi_x is the phase's fundamental and

@@ -7,7 +7,7 @@
 // e [rad, mechanical] is the amplitude of the angle error, phase [rad,
 // mechanical] the rotor angle where the error crosses zero rising. |e| < 1
 // keeps theta_seen_m monotone (catalog limit 0.5; realistic e is ~1e-4..1e-3).
-// Signature (DESIGN 6): a 1x MECHANICAL harmonic of the position error,
+// Signature (docs/ARCHITECTURE.md §7): a 1x MECHANICAL harmonic of the position error,
 //   eps_m = theta_m - theta_seen_m = -e sin(theta_m + phase)          [rad, mechanical]
 //   eps   = p_r eps_m                                                 [rad, resolver electrical]
 // exact as a function of the true angle. In the resolver electrical angle it is

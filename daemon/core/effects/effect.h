@@ -30,7 +30,7 @@
 //
 // Units: angles [rad] (resolver electrical unless a name says mechanical or motor
 // electrical), time [s], currents [A], envelopes as a fraction of their nominal
-// amplitude (sin_cos.h). Conventions: daemon/core/angles.h (DESIGN 3).
+// amplitude (sin_cos.h). Conventions: daemon/core/angles.h (docs/ARCHITECTURE.md §3).
 #pragma once
 
 #include <cstdint>

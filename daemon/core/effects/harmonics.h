@@ -20,7 +20,7 @@
 //          - sum K_n_opp sin((n + 1) theta)
 // so K_3 lands on 2theta like amplitude imbalance, K_2 on 1theta like offsets, and
 // K_3_opp, K_5 and K_7_opp ... on 4theta, 4theta, 8theta: only the sin/cos signals
-// tell them apart (DESIGN 6). Omitted terms are second order in the K's.
+// tell them apart (docs/ARCHITECTURE.md §7). Omitted terms are second order in the K's.
 #pragma once
 
 #include <array>

@@ -17,7 +17,7 @@
 //        i_q = i_d* sin theta_0 + i_q* cos theta_0
 //      A constant angle error lies inside any current loop's bandwidth, so unlike the
 //      ripple effects (Hwang's ideal-control picture, phase_currents.h) it is tracked.
-// Signature (DESIGN 6): constant, speed independent.
+// Signature (docs/ARCHITECTURE.md §7): constant, speed independent.
 //   - angle: eps = theta_true - theta_measured = -(p_r / p) theta_0 [rad, resolver electrical]
 //     against the reference angle;
 //   - dq: with the reference angle, a steady i_d = -i_q* sin theta_0 under a pure i_q

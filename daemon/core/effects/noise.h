@@ -1,7 +1,7 @@
 // Effect: measurement noise on the sampled sin/cos envelopes and phase currents.
 //
 // White Gaussian noise added by the inverter's ADCs; it sets the floor every
-// estimate and residual is compared against (DESIGN 6). It is applied where the
+// estimate and residual is compared against (docs/ARCHITECTURE.md §7). It is applied where the
 // DSP samples (ADC counts, amperes), not inside the R/D converter's analog loop.
 //
 // Randomness only through an engine the caller passes in (no global state), so a

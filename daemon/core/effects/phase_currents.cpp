@@ -8,7 +8,7 @@ namespace resolver {
 PhaseCurrents ideal_phase_currents(double i_d, double i_q, double theta_e) {
   const double ce = std::cos(theta_e);
   const double se = std::sin(theta_e);
-  // Inverse Park: the transpose of the rotation in DESIGN 3.
+  // Inverse Park: the transpose of the rotation in docs/ARCHITECTURE.md §3.
   const double i_alpha = i_d * ce - i_q * se;
   const double i_beta = i_d * se + i_q * ce;
   // Inverse amplitude-invariant Clarke with zero sum: i_b - i_c = sqrt(3) i_beta,

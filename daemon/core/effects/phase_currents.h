@@ -4,7 +4,7 @@
 // sinusoids of the TRUE electrical angle: the current controller is assumed
 // ideal, so the machine carries exactly the commanded (i_d, i_q) in the true
 // rotor frame, and any dq ripple seen by the drive comes from the angle it uses.
-// Conventions (DESIGN 3, written once in daemon/core/angles.h):
+// Conventions (docs/ARCHITECTURE.md §3, written once in daemon/core/angles.h):
 //   Clarke (amplitude invariant): i_alpha = i_a, i_beta = (i_b - i_c)/sqrt(3)
 //   Park: i_d = i_alpha cos theta_e + i_beta sin theta_e
 //         i_q = -i_alpha sin theta_e + i_beta cos theta_e

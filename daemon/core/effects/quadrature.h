@@ -3,7 +3,7 @@
 // Cause: the cos winding is not mounted exactly pi/2 from the sin winding.
 // Forward model (Hanselman eq. 6): the fundamental of the cos channel is
 // cos(theta + beta); the sin channel is sin(theta).
-// Signature, eps = theta - phi (DESIGN 3, Hanselman's definition of eps):
+// Signature, eps = theta - phi (docs/ARCHITECTURE.md §3, Hanselman's definition of eps):
 //   eps ~= -(beta/2) (1 - cos 2theta)
 // i.e. the OPPOSITE sign of Hanselman eq. 7 as printed. Derivation: the converter
 // settles at tan(phi) = sin(theta) / cos(theta + beta)

@@ -1,7 +1,7 @@
 // Effect: R/D converter quantization.
 //
 // The converter reports its angle with rd_bits of resolution. On the bench CAN
-// layout (DESIGN 4) the angle travels in a u16 (65536 counts = 2pi resolver
+// layout (docs/ARCHITECTURE.md §4) the angle travels in a u16 (65536 counts = 2pi resolver
 // electrical rad) whose low (16 - rd_bits) bits are zero.
 // Forward model: round phi to the nearest multiple of LSB = 2pi / 2^rd_bits.
 // Signature: eps_q = phi - q(phi), uniform in [-LSB/2, +LSB/2] for a moving

@@ -28,7 +28,7 @@ namespace resolver {
 namespace {
 
 const std::vector<const Effect*>& registry() {
-  // One line per effect. The order is the catalog's (resolver side, DESIGN 6
+  // One line per effect. The order is the catalog's (docs/ARCHITECTURE.md §7: resolver side
   // first; converter; motion against the reference; currents; impairments) and
   // the forward chain's within a stage: the play (backlash) acts on the shaft
   // before the resolver's own geometry (eccentricity, mechanical harmonics).

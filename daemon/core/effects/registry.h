@@ -17,7 +17,7 @@
 
 namespace resolver {
 
-/// Every effect, in catalog order (DESIGN 6, then the later ones). Cannot fail.
+/// Every effect, in catalog order (docs/ARCHITECTURE.md §7). Cannot fail.
 [[nodiscard]] std::span<const Effect* const> effect_registry();
 
 /// The effect called `name`, or nullptr.

@@ -7,7 +7,7 @@
 // Forward model: s = S(theta(t)), c = C(theta(t + tau)), where S, C are the
 // envelopes of the rest of the chain (sensor_chain.h) and theta(.) the resolver
 // electrical angle [rad] of the moving rotor. tau < 0: cos sampled first.
-// Signature (DESIGN 6): at constant resolver electrical speed omega [rad/s],
+// Signature (docs/ARCHITECTURE.md §7): at constant resolver electrical speed omega [rad/s],
 // theta(t + tau) = theta + omega tau exactly, so the fundamental is
 //   {sin theta, cos(theta + beta)}  with  beta = omega tau       (like quadrature)
 //   eps = theta - phi ~= -(beta/2)(1 - cos 2theta)              (quadrature.h)
@@ -39,7 +39,7 @@ struct SamplingSkew {
 }
 
 /// [rad] the equivalent quadrature error beta = omega tau at resolver electrical
-/// speed omega [rad/s] (DESIGN 6). Grows linearly with speed.
+/// speed omega [rad/s] (docs/ARCHITECTURE.md §7). Grows linearly with speed.
 [[nodiscard]] double sampling_skew_beta(const SamplingSkew& p, double omega);
 
 /// Small-(omega tau) position error eps = theta - phi [rad] of the angle computed

@@ -11,7 +11,7 @@
 //   Phi(s)/Theta(s) = H(s) = (2 zeta omega_n s + omega_n^2) / (s^2 + 2 zeta omega_n s + omega_n^2),
 // so a constant speed is tracked with zero error (type II), a constant
 // acceleration a [rad/s^2] lags by a / omega_n^2, and error harmonics of the
-// envelopes at speed-dependent frequencies are filtered by H (DESIGN 6: the
+// envelopes at speed-dependent frequencies are filtered by H (docs/ARCHITECTURE.md §7: the
 // ripple's amplitude and phase change with speed).
 //
 // Integration: classical RK4 with the envelopes evaluated at the true angle of

@@ -5,7 +5,7 @@
 //
 // The series is written in the MEASURED angle theta = theta_rd, because the
 // compensation evaluates it there: theta_c = theta_rd + eps_hat(theta_rd)
-// (DESIGN 3). Writing it in the true angle instead changes the coefficients
+// (docs/ARCHITECTURE.md §3). Writing it in the true angle instead changes the coefficients
 // only at second order in eps.
 //
 // Two ways to obtain eps:

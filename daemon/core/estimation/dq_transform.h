@@ -1,4 +1,4 @@
-// Clarke and Park transforms with the project's conventions (DESIGN 3):
+// Clarke and Park transforms with the project's conventions (docs/ARCHITECTURE.md §3):
 //   Clarke, amplitude-invariant:  i_alpha = i_a,  i_beta = (i_b - i_c) / sqrt(3)
 //   Park:  i_d =  i_alpha cos(theta_e) + i_beta sin(theta_e)
 //          i_q = -i_alpha sin(theta_e) + i_beta cos(theta_e)

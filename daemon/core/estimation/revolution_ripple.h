@@ -8,7 +8,8 @@
 // distorted (the raw R/D angle is non-uniform in time): without it the large
 // DC of i_q would leak into order k as 2 I_q eps_k, a ripple that is not in
 // the current at all. Computed in one pass as
-// sum x w - mean(x) sum w, w = exp(-j k theta). Orders are those DESIGN 5 names: 1x (current-sensor offsets), 2x
+// sum x w - mean(x) sum w, w = exp(-j k theta). Orders are those dq_t carries
+// (docs/ARCHITECTURE.md §4): 1x (current-sensor offsets), 2x
 // (amplitude imbalance, Hwang eqs. 15-16; gain mismatch), 6x (dead time).
 // Noise sets a floor of about 2 sigma / sqrt(N) per order and revolution. The
 // published amplitude is |mean of the complex coefficients of the last K

@@ -1,5 +1,6 @@
 #include "daemon/core/estimation/sample_processor.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -41,14 +42,26 @@ std::vector<ModelParameter> envelope_params(const Fit& f) {
 ModelParameter extra_param(std::string name, double value, double std_error, std::string unit) {
   return ModelParameter{.name = std::move(name), .value = value, .std_error = std_error, .unit = std::move(unit)};
 }
+
+/// Every method, the default first: what the config accepts and what messages list.
+constexpr std::array kEstimatorMethods{EstimatorMethod::kModel, EstimatorMethod::kHwangIntegral,
+                                       EstimatorMethod::kSinCosLeastSquares, EstimatorMethod::kFourierReference};
 }  // namespace
 
 std::optional<EstimatorMethod> estimator_from_name(std::string_view name) {
-  if (name == "model") return EstimatorMethod::kModel;
-  if (name == "hwang_integral") return EstimatorMethod::kHwangIntegral;
-  if (name == "sincos_least_squares") return EstimatorMethod::kSinCosLeastSquares;
-  if (name == "fourier_reference") return EstimatorMethod::kFourierReference;
+  for (const EstimatorMethod m : kEstimatorMethods) {
+    if (estimator_name(m) == name) return m;
+  }
   return std::nullopt;
+}
+
+std::string estimator_names() {
+  std::string out;
+  for (const EstimatorMethod m : kEstimatorMethods) {
+    if (!out.empty()) out += ", ";
+    out += estimator_name(m);
+  }
+  return out;
 }
 
 std::string_view estimator_name(EstimatorMethod method) {
@@ -160,7 +173,7 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   }
   const double omega = speed_.update(in.t, theta_meas);
   out.speed_mech = omega / p_r;
-  // Compensation (DESIGN 3 sign): theta_c = theta_rd + eps_hat.
+  // Compensation (docs/ARCHITECTURE.md §3 sign): theta_c = theta_rd + eps_hat.
   if (table_ && config_.compensate) {
     out.theta_comp = table_->correct(theta_meas, omega, in.has_ref ? wrap_2pi(in.theta_m_ref) : kNaN);
     out.eps_hat = wrap_pi(out.theta_comp - theta_meas);

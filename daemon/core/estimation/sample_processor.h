@@ -33,7 +33,7 @@ namespace resolver {
 /// The processor's input is the shared sample (daemon/core/sample.h).
 using SampleInput = Sample;
 
-/// Which estimator runs (DESIGN 6 "Estimators to provide and compare").
+/// Which estimator runs (docs/ARCHITECTURE.md §5).
 enum class EstimatorMethod : std::uint8_t {
   /// The active model ([model] effects) fitted by the live model fit on the
   /// signals present (sin/cos and R/D angle against the reference when there is
@@ -49,8 +49,12 @@ enum class CompensationDomain : std::uint8_t {
   kAngle,   ///< theta_c = theta_rd + eps_hat(theta_rd)   (Hwang Fig. 5)
   kSignal,  ///< correct sin/cos, then atan2               (sin/cos least squares only)
 };
+/// The method named as in the config ([estimator] method), or nullopt for an unknown name.
 [[nodiscard]] std::optional<EstimatorMethod> estimator_from_name(std::string_view name);
 [[nodiscard]] std::string_view estimator_name(EstimatorMethod method);
+/// "model, hwang_integral, ...": every name estimator_from_name() accepts, the default first
+/// (for messages and help, so no hand-kept list drifts from the code). Cannot fail.
+[[nodiscard]] std::string estimator_names();
 
 /// One parameter of the active model, named "effect.param" as in the catalog.
 /// Everything estimate_t publishes.

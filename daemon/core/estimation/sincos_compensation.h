@@ -1,5 +1,5 @@
 // Compensation in the signal domain: correct the sin/cos envelopes with a
-// SinCosFit before taking the angle (DESIGN 6), Hanselman's sum/difference for
+// SinCosFit before taking the angle (docs/ARCHITECTURE.md §5), Hanselman's sum/difference for
 // quadrature (eqs. 11-12), and a software type-II tracking observer.
 //
 // Inverse of the catalog model (sincos_least_squares.h), in steps:

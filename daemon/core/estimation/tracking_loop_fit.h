@@ -1,6 +1,6 @@
 // Identification of the R/D converter's tracking loop (omega_n, zeta) from how the
-// 2x ripple of the position error changes with speed (DESIGN 6, "R/D tracking-loop
-// dynamics": the ripple's amplitude and phase change with speed).
+// 2x ripple of the position error changes with speed (docs/ARCHITECTURE.md §7,
+// tracking_loop: the ripple's amplitude and phase change with speed).
 //
 // Physics. The sin/cos imperfections give a static error eps_s(theta): the angle
 // an infinitely fast converter would read is theta_app = theta - eps_s(theta)

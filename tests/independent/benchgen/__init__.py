@@ -1,6 +1,6 @@
 """benchgen: an independent resolver-bench log generator.
 
-Written from the physics in DESIGN.md (sections 3, 4, 6), Hanselman 1991 and Hwang 2009,
+Written from docs/ARCHITECTURE.md (§3, §4, §7), Hanselman 1991 and Hwang 2009,
 NOT from the project's C++ effect code, so that a sign slip shared by resolver-sim and the
 fit cannot pass every test. Data flow, one function per stage:
 

@@ -1,13 +1,13 @@
 """One bench run: the samples an inverter's DSP would stream at t_k = k / fs.
 
-Timing of each resolver signal (brief, DESIGN 6):
+Timing of each resolver signal (docs/ARCHITECTURE.md §7):
   R/D angle     converter driven by the analog chain, read at t_k - d          (delay d)
   DSP sin       analog s at t_k - d
   DSP cos       analog c at t_k - d + tau_s   (sampling_skew tau_s; the R/D does not see it)
   reference     true theta_m(t_k), never delayed
   currents      at t_k, never delayed
 Noise and impairments act on the sampled values; the ADC rounds sin/cos to counts and
-saturates at +-32767 (full scale, DESIGN 4).
+saturates at +-32767 (full scale, docs/ARCHITECTURE.md §4).
 """
 from dataclasses import dataclass, field
 
@@ -20,7 +20,7 @@ from .currents import machine_currents, sensed_currents
 from .effects import EffectSet
 from .profile import MotionProfile, parse_profile
 
-FULL_SCALE_COUNTS = 32767  # i16 envelopes (DESIGN 4)
+FULL_SCALE_COUNTS = 32767  # i16 envelopes (docs/ARCHITECTURE.md §4)
 
 # Fixed ids of the random streams: [seed, stream(, instance)] seeds each one, so adding an
 # impairment never changes the draws of another.

@@ -15,7 +15,7 @@ from .profile import PRESETS, MotionProfile, ProfileError, parse_profile
 FORMAT_VERSION = 1
 
 EXAMPLES = """examples:
-  # default bench (DESIGN 4 layout), 200 r/min for 5 s, 0.3 % amplitude imbalance, truth file
+  # default bench (docs/ARCHITECTURE.md §4 layout), 200 r/min for 5 s, 0.3 % amplitude imbalance, truth file
   benchgen.py --out imb.log --truth imb.json -e amplitude_imbalance:alpha=0.003 -e noise:sigma_sc=2,sigma_i=0.01
   # a 1X resolver turned one revolution out and back with standstills, as a scope would record it
   benchgen.py --profile out_and_back --p-r 1 --p 4 --sample-rate 100 --layout angle_only \\
@@ -28,7 +28,7 @@ EXAMPLES = """examples:
 def build_parser():
     ap = argparse.ArgumentParser(
         prog="benchgen.py", formatter_class=argparse.RawDescriptionHelpFormatter, epilog=EXAMPLES,
-        description="Independent resolver-bench log generator (physics from DESIGN.md and the papers, "
+        description="Independent resolver-bench log generator (physics from docs/ARCHITECTURE.md and the papers, "
                     "not from resolver-sim). Writes candump -l, Vector ASC, scope CSV and truth files.")
     out = ap.add_argument_group("outputs (at least one)")
     out.add_argument("--out", metavar="LOG", help="candump -l log of the chosen layout")
@@ -64,7 +64,7 @@ def build_parser():
     bench.add_argument("--seed", type=int, default=1, help="random seed (1): same seed, same files")
     log = ap.add_argument_group("log")
     log.add_argument("--layout", choices=layouts.LAYOUTS, default="default",
-                     help="default (DESIGN 4), angle_only (degrees, no counter/CRC), be_counter (big endian)")
+                     help="default (docs/ARCHITECTURE.md §4), angle_only (degrees, no counter/CRC), be_counter (big endian)")
     log.add_argument("--no-reference", action="store_true", help="no reference angle frames")
     log.add_argument("--no-currents", action="store_true", help="no phase current frames")
     log.add_argument("--iface", default="can0", help="interface name in candump lines (can0)")

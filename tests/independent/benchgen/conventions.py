@@ -1,4 +1,4 @@
-"""Angles, units and frame transforms (DESIGN section 3), written down once.
+"""Angles, units and frame transforms (docs/ARCHITECTURE.md §3), written down once.
 
 theta_m   mechanical angle [rad]
 theta     resolver electrical angle = p_r * theta_m [rad]

@@ -1,6 +1,6 @@
 """CRC-8 SAE J1850: poly 0x1D, init 0xFF, no reflection, final xor 0xFF (check("123456789") = 0x4B).
 
-DESIGN 4: computed over data bytes 0..6 followed by the low byte of the CAN ID.
+docs/ARCHITECTURE.md §4: computed over data bytes 0..6 followed by the low byte of the CAN ID.
 """
 import numpy as np
 
@@ -38,7 +38,7 @@ def crc8_rows(rows):
 
 
 def frame_crc(data7, can_id):
-    """DESIGN 4 CRC for frames: rows of bytes 0..6, then the low byte of the CAN ID."""
+    """docs/ARCHITECTURE.md §4 CRC for frames: rows of bytes 0..6, then the low byte of the CAN ID."""
     data7 = np.asarray(data7, dtype=np.uint8)
     id_column = np.full((data7.shape[0], 1), can_id & 0xFF, dtype=np.uint8)
     return crc8_rows(np.hstack([data7, id_column]))

@@ -7,9 +7,9 @@ The drive's frame angle theta_drive is either
   "rd":        (p / p_r) x the R/D angle as delivered (a closed-loop drive that follows its
                own converter, every resolver error included).
 With a pure i_q command and the "reference" frame, Park with the reference angle gives
-i_d = -i_q sin(theta_0), i_q cos(theta_0) (DESIGN 6, mounting offset).
+i_d = -i_q sin(theta_0), i_q cos(theta_0) (docs/ARCHITECTURE.md §7, mounting_offset).
 
-Dead time (signature model, brief): each phase x gains k |I| (sin 7 psi_x - sin 5 psi_x),
+Dead time (signature model, docs/ARCHITECTURE.md §7): each phase x gains k |I| (sin 7 psi_x - sin 5 psi_x),
 k = t_d / 100 us, psi_x the phase's fundamental angle (i_x = |I| cos psi_x). The 7th is a
 positive and the 5th a negative sequence, so in the frame of the current vector they add to
 -j 2 k |I| cos(6 psi_a): a 6x ripple perpendicular to the current.
@@ -21,7 +21,7 @@ import numpy as np
 
 from .conventions import inverse_clarke, inverse_park
 
-DEAD_TIME_REFERENCE_S = 100e-6  # k = t_d / 100 us (brief's signature model)
+DEAD_TIME_REFERENCE_S = 100e-6  # k = t_d / 100 us (the catalog's signature model)
 
 
 def machine_currents(theta_drive, i_d, i_q, t_d):

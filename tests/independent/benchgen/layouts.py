@@ -1,6 +1,6 @@
 """CAN layouts: samples -> frames (relative time [s], CAN ID, 8 data bytes).
 
-default     DESIGN section 4, encoded here byte by byte (struct layout from the table, own
+default     docs/ARCHITECTURE.md §4, encoded here byte by byte (struct layout from the table, own
             CRC), NOT through a DBC, so tests can check it against proto/resolver_bench.dbc.
 angle_only  dbc/angle_only.dbc: R/D and reference angle in degrees in one message, no counter,
             no CRC (a scope-style 1X bench, typically 100 Hz and p_r = 1).
@@ -20,9 +20,9 @@ from .dbc import read_dbc
 _INDEPENDENT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # tests/independent
 REPO_ROOT = os.path.dirname(os.path.dirname(_INDEPENDENT))
 DBC_DIR = os.path.join(_INDEPENDENT, "dbc")
-BENCH_DBC = os.path.join(REPO_ROOT, "proto", "resolver_bench.dbc")  # DESIGN 4, the default layout
+BENCH_DBC = os.path.join(REPO_ROOT, "proto", "resolver_bench.dbc")  # docs/ARCHITECTURE.md §4, the default layout
 FRAME_SPACING_S = 130e-6  # one 8-byte classic frame at 1 Mbit/s with stuffing ~ 110-130 us
-BENCH_INFO_PERIOD_S = 0.1  # 10 Hz (DESIGN 4)
+BENCH_INFO_PERIOD_S = 0.1  # 10 Hz (docs/ARCHITECTURE.md §4)
 LAYOUT_VERSION = 1
 
 ID_RESOLVER_SAMPLE, ID_PHASE_CURRENTS, ID_REFERENCE_ANGLE, ID_BENCH_INFO = 0x100, 0x101, 0x102, 0x1F0
@@ -67,7 +67,7 @@ def saturate(values, low, high):
 
 
 def encode_default(samples, config, reference=True, currents=True):
-    """DESIGN 4 frames: 0x100, 0x101, 0x102 per sample; 0x1F0 at 10 Hz."""
+    """docs/ARCHITECTURE.md §4 frames: 0x100, 0x101, 0x102 per sample; 0x1F0 at 10 Hz."""
     n = len(samples)
     period = 1.0 / config.sample_rate
     per_sample = 1 + int(currents) + int(reference)
@@ -80,7 +80,7 @@ def encode_default(samples, config, reference=True, currents=True):
     rows[:, 0] = counter
     rows[:, 1:3] = _le_bytes(samples.sin, "<i2")
     rows[:, 3:5] = _le_bytes(samples.cos, "<i2")
-    # rd_angle u16: the converter's rd_bits in the top bits, the low bits zero (DESIGN 4).
+    # rd_angle u16: the converter's rd_bits in the top bits, the low bits zero (docs/ARCHITECTURE.md §4).
     rows[:, 5:7] = _le_bytes(samples.rd_code << (16 - samples.rd_bits), "<u2")
     parts.append((samples.t.copy(), np.full(n, ID_RESOLVER_SAMPLE), _with_crc(rows, ID_RESOLVER_SAMPLE), index))
     slot = 1

@@ -1,5 +1,5 @@
 """Readers for what benchgen writes, used by the tests (and handy for a user's checks):
-a candump -l parser, the DESIGN 4 byte-level decoder with CRC check, a DBC decoder, the
+a candump -l parser, the docs/ARCHITECTURE.md §4 byte-level decoder with CRC check, a DBC decoder, the
 scope CSV parser. Independent of the writers: they parse text, they do not share state.
 """
 import csv
@@ -31,7 +31,7 @@ def read_candump(path):
 
 
 def decode_default(ids, data):
-    """DESIGN 4 frames by ID: dict id -> dict of fields (byte-level, little endian), crc_ok."""
+    """docs/ARCHITECTURE.md §4 frames by ID: dict id -> dict of fields (byte-level, little endian), crc_ok."""
     out = {}
     for can_id in (0x100, 0x101, 0x102, 0x1F0):
         rows = data[ids == can_id]

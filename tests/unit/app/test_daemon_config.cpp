@@ -84,7 +84,9 @@ TEST(DaemonConfig, BadValuesAreRejectedWithTheRule) {
   EXPECT_NE(error_of("[layout]\ncrc = \"crc32\"\n").find("j1850_bench"), std::string::npos);
   EXPECT_NE(error_of("[layout.signals]\nsine = \"A.b\"\n").find("unknown role 'sine'"), std::string::npos);
   EXPECT_NE(error_of("[layout.signals]\nsin = \"nodot\"\n").find("MESSAGE.signal"), std::string::npos);
-  EXPECT_NE(error_of("[estimator]\nmethod = \"magic\"\n").find("available: hwang_integral"), std::string::npos);
+  EXPECT_NE(error_of("[estimator]\nmethod = \"magic\"\n")
+                .find("available: model, hwang_integral, sincos_least_squares, fourier_reference"),
+            std::string::npos);
   // Fuzz finding F4: a float among the harmonic orders was converted out of range
   // (undefined behaviour); integers beyond int wrapped silently (4294967304 -> 8).
   EXPECT_NE(error_of("[estimator]\nharmonics = [3, 1e90]\n").find("orders must be integers 2..16"), std::string::npos);

@@ -1,5 +1,5 @@
 // proto/resolver_bench.dbc must describe exactly what daemon/decode/bench_layout.h
-// encodes (DESIGN.md section 4): the two are independent descriptions of one layout.
+// encodes (docs/ARCHITECTURE.md §4): the two are independent descriptions of one layout.
 #include <gtest/gtest.h>
 
 #include <limits>

@@ -18,6 +18,7 @@
 #include "echo_test_util.h"
 #include "json_test_parser.h"
 #include "tools/echo/echo_output.h"
+#include "drivers/text/json_string.h"
 #include "tools/echo/json_writer.h"
 #include "tools/echo/lcm_json_decoder.h"
 
@@ -356,7 +357,7 @@ TEST_F(EchoDecoder, UnknownFingerprintIsReportedWithItsValue) {
 
 TEST(EchoJsonWriter, InvalidUtf8BecomesReplacementCharacter) {
   std::string out;
-  append_json_string(out, std::string("a\xFF" "b\xC3" "\xA9" "\xE2\x82", 7));
+  text::append_json_string(out, std::string("a\xFF" "b\xC3" "\xA9" "\xE2\x82", 7));
   EXPECT_EQ(out, "\"a\\ufffdb\xC3\xA9\\ufffd\\ufffd\"");
   EXPECT_NO_THROW(parse_json(out));
 }

@@ -107,7 +107,7 @@ TEST(EchoParser, EveryEmbeddedProtoFileParses) {
     ASSERT_NO_THROW(structs = parse_lcm_types(file.text, file.path));
     ASSERT_EQ(structs.size(), 1u);
     EXPECT_EQ(structs[0].package, "resolver");
-    // DESIGN 5: every message has int64_t utime.
+    // docs/ARCHITECTURE.md §4: every message has int64_t utime.
     const LcmMember* utime = structs[0].find_member("utime");
     ASSERT_NE(utime, nullptr);
     EXPECT_EQ(utime->primitive, LcmPrimitive::kInt64);

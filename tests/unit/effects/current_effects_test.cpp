@@ -1,7 +1,7 @@
 // The current-domain effects added in catalog v2: current sensor offsets, gain
 // mismatch and inverter dead time. Each forward model (on phase currents: the
 // registry's forward chain, forward_chain.h, machine then measured currents),
-// transformed with an independent Clarke/Park (DESIGN 3), is Fourier-analysed
+// transformed with an independent Clarke/Park (docs/ARCHITECTURE.md §3), is Fourier-analysed
 // over one electrical turn and compared with the closed-form ripple the effect's
 // header predicts. The models are linear in the currents, so the only error is
 // floating-point rounding: sums of N = 720 terms of <= 20 A give < 1e-11 A, and

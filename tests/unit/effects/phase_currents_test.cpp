@@ -11,7 +11,7 @@
 namespace resolver {
 namespace {
 
-/// Forward Clarke + Park of DESIGN 3, written out independently of the library.
+/// Forward Clarke + Park of docs/ARCHITECTURE.md §3, written out independently of the library.
 struct Dq {
   double d;
   double q;

@@ -144,7 +144,7 @@ TEST(EffectsSignatures, OppositeSequenceHarmonicsLandOnNPlusOne) {
 }
 
 TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
-  // DESIGN 6: K_3 and alpha both give a 2theta error; K_3 = -alpha/2 mimics alpha to first order.
+  // Hanselman eq. 8-9: K_3 and alpha both give a 2theta error; K_3 = -alpha/2 mimics alpha to first order.
   Harmonics k3;
   k3.k[3] = -0.002;
   for (int i = 0; i < 64; ++i) {

@@ -136,7 +136,7 @@ TEST(EffectsTrackingLoop, ClosedLoopGainMatchesAnalyticH) {
 }
 
 TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
-  // DESIGN 6: the loop filters the 2theta error of amplitude imbalance: at resolver
+  // docs/ARCHITECTURE.md §7: the loop filters the 2theta error of amplitude imbalance: at resolver
   // speed w the ripple is (alpha/2)|H(j 2w)| sin(2theta + arg H(j 2w)).
   const double alpha = 0.002;
   const ForwardChain chain = test::forward_chain(

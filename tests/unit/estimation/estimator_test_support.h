@@ -56,7 +56,7 @@ inline std::vector<SimRecord> simulate(const SimConfig& config) {
   std::vector<SimRecord> out;
   out.reserve(sim.total_samples());
   SimSample s{};
-  constexpr double kRefCountsPerTurn = 4294967296.0;  // DESIGN 4: 2^32 counts per mechanical turn
+  constexpr double kRefCountsPerTurn = 4294967296.0;  // docs/ARCHITECTURE.md §4: 2^32 counts per mechanical turn
   while (sim.next(s)) {
     SimRecord r;
     r.t = static_cast<double>(s.index) / config.sample_rate_hz;

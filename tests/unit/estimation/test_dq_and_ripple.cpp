@@ -1,4 +1,4 @@
-// Clarke/Park conventions (DESIGN 3), ripple measurement, and Hwang eqs. 15-16.
+// Clarke/Park conventions (docs/ARCHITECTURE.md §3), ripple measurement, and Hwang eqs. 15-16.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -1,4 +1,4 @@
-// The simulator's samples and frames, decoded by hand from the bytes (DESIGN 4)
+// The simulator's samples and frames, decoded by hand from the bytes (docs/ARCHITECTURE.md §4)
 // with an independent bitwise CRC, against the physics they must carry.
 #include <gtest/gtest.h>
 

@@ -49,7 +49,7 @@ TEST(SimCli, EveryNewEffectThroughDashDashEffect) {
       {"current_offsets:off_a=0.05,off_b=-0.03", "\"current_offsets\": {\"off_a\": 0.05, \"off_b\": -0.03}"},
       {"current_gain_mismatch:gain_a=0.01", "\"current_gain_mismatch\": {\"gain_a\": 0.01, \"gain_b\": 0}"},
       {"dead_time:t_d=2e-6", "\"dead_time\": {\"t_d\": 2e-06}"},
-      // The registry's effects beyond DESIGN 6 (issue 12).
+      // The registry's effects added in issue 12.
       {"delay:d=1e-3", "\"delay\": {\"d\": 0.001}"},
       {"backlash:h=0.01", "\"backlash\": {\"h\": 0.01}"},
       {"channel_delay:tau=2e-6", "\"channel_delay\": {\"tau\": 2e-06}"},

@@ -53,18 +53,18 @@ constexpr unsigned kReference = 8U;
   return mask;
 }
 
-/// [rad] the reference encoder's mechanical angle as transmitted (2^32 counts per turn, DESIGN 4).
+/// [rad] the reference encoder's mechanical angle as transmitted (2^32 counts per turn, docs/ARCHITECTURE.md §4).
 [[nodiscard]] inline double reference_angle_m(const SimSample& s) {
   return static_cast<double>(s.ref_counts) / 4294967296.0 * kTwoPi;
 }
 
 /// [rad] the R/D angle's position error against the reference, eps = p_r theta_ref_m - theta_rd
-/// (DESIGN 3), wrapped to [-pi, pi).
+/// (docs/ARCHITECTURE.md §3), wrapped to [-pi, pi).
 [[nodiscard]] inline double rd_error_vs_reference(const SimSample& s, int p_r) {
   return wrap_pi(p_r * reference_angle_m(s) - s.rd_angle);
 }
 
-/// Clarke + Park (DESIGN 3) of a sample's decoded currents [A].
+/// Clarke + Park (docs/ARCHITECTURE.md §3) of a sample's decoded currents [A].
 [[nodiscard]] inline DqCurrents sample_dq(const SimSample& s, double theta_e) {
   const double i_alpha = s.i_a_ma * 1e-3;
   const double i_beta = (s.i_b_ma - s.i_c_ma) * 1e-3 / std::numbers::sqrt3;
