@@ -10,6 +10,7 @@
 #include "daemon/app/pipeline.h"
 #include "daemon/app/signal_health_log.h"
 #include "daemon/decode/sample_stream.h"
+#include "daemon/service/program_errors.h"
 
 namespace resolver {
 
@@ -74,15 +75,18 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
   if (out.input.samples.empty()) {
     if (options.slice.limited() && out.outside_slice > 0) {
       const std::string to = std::isfinite(options.slice.to_s) ? fmt::format(" to --to {} s", options.slice.to_s) : "";
-      throw std::runtime_error(fmt::format("{}: no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
-                                           path, options.slice.from_s, to, out.outside_slice,
-                                           stream.clock().last_t()));
+      throw InputError(Fault::kData,
+                       fmt::format("no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
+                                   options.slice.from_s, to, out.outside_slice, stream.clock().last_t()),
+                       Where::at_file(path));
     }
     const std::string layout = format == LogFormat::kCsv ? "the [input.csv] column map of " + config.source
                                                          : describe_layout(config, *decoder);
-    throw std::runtime_error(fmt::format("{}: no samples: {} {} read as {}, {} bad lines, none decoded with {}", path,
-                                         out.frames, format == LogFormat::kCsv ? "rows" : "frames",
-                                         log_format_name(format), out.bad_lines, layout));
+    throw InputError(Fault::kData,
+                     fmt::format("no samples: {} {} read as {}, {} bad lines, none decoded with {}", out.frames,
+                                 format == LogFormat::kCsv ? "rows" : "frames", log_format_name(format), out.bad_lines,
+                                 layout),
+                     Where::at_file(path));
   }
   if (!out.bench_info) {
     out.notes.push_back("p_r = " + std::to_string(out.input.p_r) + ", p = " + std::to_string(out.input.p) + " from " +

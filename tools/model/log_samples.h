@@ -45,10 +45,10 @@ struct LogReadOptions {
 };
 
 /// Reads `path`. progress(fraction of the file's bytes) is called now and then
-/// (may be empty). Throws std::runtime_error "cannot open <path>: ..." when the
-/// file cannot be read, "<path>: no samples ..." (naming the layout in use) when
-/// nothing decodes, and ConfigError when the config's DBC, signal map or CSV
-/// column map is bad.
+/// (may be empty). Throws std::system_error "cannot open <path>: ..." when the
+/// file cannot be read, InputError (Fault::kData) "<path>: no samples ..." (naming
+/// the layout in use) when nothing decodes, and ConfigError when the config's DBC,
+/// signal map or CSV column map is bad.
 [[nodiscard]] LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
                                           const DaemonConfig& config = DaemonConfig{},
                                           const LogReadOptions& options = {});

@@ -107,12 +107,7 @@ int write_report(const resolver::LogSamples& samples, const std::string& log, co
     });
   }
   const std::string page = resolver::format_model_html(run, samples, log, options.explained_ratio);
-  try {
-    resolver::write_text_file(html_out, page);
-  } catch (const std::runtime_error& e) {
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kIo;
-  }
+  resolver::write_text_file(html_out, page);  // throws std::system_error: exit 3
   std::cout << resolver::summarize_discovery(run) << "\n"
             << "wrote " << html_out << " (" << (page.size() + 512) / 1024 << " KiB)\n";
   return 0;
@@ -313,7 +308,7 @@ int run(int argc, char** argv) {
     std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
     return resolver::exit_code::kUsage;
   }
-  try {
+  {
     resolver::DaemonConfig config;
     if (!config_path.empty()) config = resolver::load_daemon_config(config_path);  // throws naming file and key
     std::vector<std::string> effects = split_effects(effects_args);
@@ -323,8 +318,7 @@ int run(int argc, char** argv) {
       try {
         (void)resolver::ModelSpec::parse(effects, config.model.customs.get());
       } catch (const std::invalid_argument& e) {
-        std::cerr << "resolver-model: --effects: " << e.what() << "\n";
-        return resolver::exit_code::kUsage;
+        throw resolver::InputError(resolver::Fault::kUsage, e.what(), resolver::Where::at_option("--effects"));
       }
     }
     if (effects.empty()) effects = config.model.effects;  // default ["amplitude_imbalance"]
@@ -351,18 +345,26 @@ int run(int argc, char** argv) {
     for (const std::string& f : resolver::lasting_faults(faults, samples.health_samples, 0.0)) {
       samples.notes.push_back("signal health: " + f);
     }
-    if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
-    if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
-    if (export_data->parsed()) {
-      std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
-      return 0;
+    // The effects were checked before the log was read: what the fit refuses now
+    // (too few samples, the rotor hardly moves, no angle signal) is the data's fault.
+    try {
+      if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
+      if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
+      if (export_data->parsed()) {
+        std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
+        return 0;
+      }
+    } catch (const std::invalid_argument& e) {
+      throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
     }
     resolver::Explanation ex;
-    {
+    try {
       ProgressBar bar("fitting");
       options.progress = [&](double f) { bar(f); };
       if (do_explain) ex = resolver::explain_model(samples.input, effects, options);
       else ex.fit = resolver::fit_model(samples.input, effects, options);
+    } catch (const std::invalid_argument& e) {
+      throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
     }
     std::vector<std::string> notes = samples.notes;
     if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
@@ -370,23 +372,13 @@ int run(int argc, char** argv) {
     std::cout << (json ? resolver::format_model_json(ex, do_explain, notes)
                        : resolver::format_model_text(ex, do_explain, notes));
     return 0;
-  } catch (const resolver::ConfigError& e) {
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kUsage;
-  } catch (const std::exception& e) {
-    // Too few samples, nothing decoded: the log had nothing usable to fit.
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kNoUsableData;
   }
 }
 
 }  // namespace
 
+// Every failure not answered above is an exception: the one rule of program_errors.h
+// gives its exit code (a config error 2, no usable data 1, a failed write 3, out of memory 4).
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {  // e.g. out of memory while building the command line
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kInternal;
-  }
+  return resolver::run_program("resolver-model", [&] { return run(argc, argv); });
 }
