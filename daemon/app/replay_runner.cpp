@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <thread>
 
 #include "daemon/app/log_input.h"
+#include "daemon/app/progress_meter.h"
 
 namespace resolver {
 
@@ -38,9 +40,13 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
                         const std::function<void()>& on_reload, StopFlags& flags, std::ostream& err) {
   ReplayResult result;
   const auto wall_start = Clock::now();
+  // On a terminal: one line rewritten at most 4 times a second (bytes, frames, rate,
+  // ETA), erased at the end. Elsewhere (a journal, a pipe): a line every 2 s.
   const bool tty = isatty(STDERR_FILENO) != 0;
+  ProgressMeter::Options meter_options;
+  meter_options.enabled = options.progress && tty;
+  std::optional<ProgressMeter> meter;
   auto next_progress = wall_start + kProgressEvery;
-  bool printed_progress = false;
   const double rate = options.rate > 0.0 ? options.rate : 1.0;
   // Loop passes: pass k's frame times are shifted by k * loop_span_us.
   std::int64_t loop_span_us = 0;
@@ -51,6 +57,13 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
     const std::unique_ptr<LogInput> reader = open_log_input(options.path, format, current().config());
     reader->set_stop_flag(&flags.stop);
     ++result.passes;
+    if (meter_options.enabled) {
+      meter.reset();
+      meter.emplace(stderr, result.passes > 1 ? fmt::format("resolverd: {} (pass {})", options.path, result.passes)
+                                              : "resolverd: " + options.path,
+                    meter_options);
+      meter->set_items_word("frames");
+    }
     if (result.passes > 1) {
       current().restart_sequence();
       offset_us += loop_span_us;
@@ -108,7 +121,9 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
           target.feed_untimed(record.frame, reader->line_number());
         }
       }
-      if (options.progress && (result.frames & 0xFFFU) == 0) {
+      if (meter && (result.frames & 0xFFFU) == 0) {
+        meter->bytes(reader->bytes_read(), reader->total_bytes(), static_cast<std::int64_t>(result.frames));
+      } else if (options.progress && !tty && (result.frames & 0xFFFU) == 0) {
         const auto now = Clock::now();
         if (now >= next_progress) {
           next_progress = now + kProgressEvery;
@@ -116,13 +131,13 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
           const double pct = reader->total_bytes() > 0
                                  ? 100.0 * static_cast<double>(reader->bytes_read()) / static_cast<double>(reader->total_bytes())
                                  : 0.0;
-          err << fmt::format("{}resolverd: {:5.1f}% of {} ({} frames, {:.0f} frames/s){}", tty ? "\r" : "", pct,
-                             options.path, result.frames, static_cast<double>(result.frames) / s, tty ? "" : "\n");
+          err << fmt::format("resolverd: {:5.1f}% of {} ({} frames, {:.0f} frames/s)\n", pct, options.path,
+                             result.frames, static_cast<double>(result.frames) / s);
           err.flush();
-          printed_progress = true;
         }
       }
     }
+    if (meter) meter->finish();
     if (options.once || reader->stopped() || current().past_slice_end()) break;
     if (pass_frames == 0) {
       // Nothing to loop over: an empty (or all-bad) log would spin here forever.
@@ -134,7 +149,6 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
       loop_span_us = max_us - first_us + std::max<std::int64_t>(interval, 1);
     }
   }
-  if (printed_progress && tty) err << "\n";
   current().finish();
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   return result;

@@ -14,7 +14,7 @@
 
 namespace resolver {
 
-LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
+LogSamples read_log_samples(const std::string& path, const std::function<void(const LogReadProgress&)>& progress,
                             const DaemonConfig& config, const LogReadOptions& options) {
   LogSamples out;
   out.input.p_r = config.bench.p_r;
@@ -61,9 +61,10 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
     } else {
       stream.feed(record.frame, reader->line_number());
     }
-    if (progress && ++since_progress >= 20000 && reader->total_bytes() > 0) {
+    if (progress && ++since_progress >= 4096) {  // a std::function call per 4096 records: not measurable
       since_progress = 0;
-      progress(static_cast<double>(reader->bytes_read()) / static_cast<double>(reader->total_bytes()));
+      progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
+                               static_cast<std::int64_t>(out.input.samples.size()), false});
     }
   }
   stream.flush();
@@ -71,7 +72,10 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
   out.faults = health.faults();
   out.health_samples = health.samples();
   out.outside_slice = stream.samples_outside_slice();
-  if (progress) progress(1.0);
+  if (progress) {
+    progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
+                             static_cast<std::int64_t>(out.input.samples.size()), true});
+  }
   if (out.input.samples.empty()) {
     if (options.slice.limited() && out.outside_slice > 0) {
       const std::string to = std::isfinite(options.slice.to_s) ? fmt::format(" to --to {} s", options.slice.to_s) : "";

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "daemon/app/exit_codes.h"
+#include "daemon/app/progress_meter.h"
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
 #include "daemon/core/model/model_spec.h"
@@ -44,45 +45,6 @@
 
 namespace {
 
-/// A one-line progress bar on stderr, shown only once a run has taken longer
-/// than 1.5 s (short logs stay quiet) and only when stderr is a terminal.
-/// RESOLVER_PROGRESS=1 shows it on a pipe or file too, =0 never;
-/// RESOLVER_PROGRESS_AFTER_MS changes the delay (tests use 0).
-class ProgressBar {
- public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)), start_(Clock::now()) {
-    const char* mode = std::getenv("RESOLVER_PROGRESS");
-    enabled_ = mode != nullptr ? std::string_view(mode) != "0" : ::isatty(STDERR_FILENO) == 1;
-    if (const char* ms = std::getenv("RESOLVER_PROGRESS_AFTER_MS")) {
-      char* end = nullptr;
-      const long v = std::strtol(ms, &end, 10);
-      if (end != ms && *end == '\0' && v >= 0) show_after_ = std::chrono::milliseconds(v);  // else keep the default
-    }
-  }
-  void operator()(double fraction) {
-    if (!enabled_ || Clock::now() - start_ < show_after_) return;
-    const int width = 30;
-    const int filled = static_cast<int>(std::lround(std::clamp(fraction, 0.0, 1.0) * width));
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3.0f%%", label_.c_str(), filled, "##############################",
-                 width - filled, "", fraction * 100.0);
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  ~ProgressBar() {
-    if (shown_) std::fprintf(stderr, "\n");
-  }
-  ProgressBar(const ProgressBar&) = delete;
-  ProgressBar& operator=(const ProgressBar&) = delete;
-
- private:
-  using Clock = std::chrono::steady_clock;
-  std::chrono::milliseconds show_after_{1500};
-  bool enabled_ = false;
-  std::string label_;
-  Clock::time_point start_;
-  bool shown_ = false;
-};
-
 /// The effect references of every --effects argument, split at the commas outside
 /// parentheses ("amplitude_imbalance,harmonics(k3,k5)" is two references).
 std::vector<std::string> split_effects(const std::vector<std::string>& args) {
@@ -95,15 +57,16 @@ std::vector<std::string> split_effects(const std::vector<std::string>& args) {
 
 /// `report`: the discovery steps, the HTML page, one summary line and where it went.
 int write_report(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
-                 resolver::DiscoveryOptions options, int max_steps, const std::string& html_out) {
+                 resolver::DiscoveryOptions options, int max_steps, const std::string& html_out,
+                 const resolver::ProgressMeter::Options& progress) {
   options.series_points = 4000;  // the samples overlay: ~22 per 2 deg angle bin (report_data.h)
   resolver::DiscoveryRun run;
   {
-    std::optional<ProgressBar> bar;  // one per step: the number of steps is not known ahead
-    options.progress = [&](double f) { (*bar)(f); };
+    std::optional<resolver::ProgressMeter> bar;  // one per step: the number of steps is not known ahead
+    options.progress = [&](double f) { bar->fraction(f); };
     run = resolver::run_discovery(samples.input, effects, options, max_steps, [&](int step) {
       bar.reset();
-      bar.emplace("step " + std::to_string(step) + ": explaining");
+      bar.emplace(stderr, "step " + std::to_string(step) + ": explaining", progress);
     });
   }
   const std::string page = resolver::format_model_html(run, samples, log, options.explained_ratio);
@@ -214,6 +177,7 @@ int run(int argc, char** argv) {
                     "the config's [[model.custom]] names (default amplitude_imbalance); fittable: " + fittable);
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
   };
+  bool progress = false;
   std::string direction = "both";
   bool moving_only = false;
   bool reference_aligned = false;
@@ -241,6 +205,9 @@ int run(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--to", slice.to_s, "use samples up to this time [s, from the log's first sample]")
         ->check(CLI::NonNegativeNumber);
+    sub->add_flag("--progress", progress,
+                  "show progress on stderr (bytes read of the total, samples, rate, ETA; then the fit) even when it "
+                  "is not a terminal, one line per update; on a terminal it is shown anyway once a run takes 1.5 s");
   };
   CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
@@ -323,12 +290,15 @@ int run(int argc, char** argv) {
     }
     if (effects.empty()) effects = config.model.effects;  // default ["amplitude_imbalance"]
     resolver::LogSamples samples;
+    const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(progress);
     {
-      ProgressBar bar("reading " + log);
+      resolver::ProgressMeter bar(stderr, "reading " + log, shown);
       resolver::LogReadOptions read_options;
       read_options.format = resolver::log_format_from_name(format_name);
       read_options.slice = slice;
-      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config, read_options);
+      samples = resolver::read_log_samples(
+          log, [&](const resolver::LogReadProgress& p) { bar.bytes(p.bytes_read, p.total_bytes, p.samples, p.done); },
+          config, read_options);
     }
     resolver::DiscoveryOptions options;
     options.max_report_order = resolver::kOfflineReportOrder;
@@ -348,7 +318,7 @@ int run(int argc, char** argv) {
     // The effects were checked before the log was read: what the fit refuses now
     // (too few samples, the rotor hardly moves, no angle signal) is the data's fault.
     try {
-      if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
+      if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out, shown);
       if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
       if (export_data->parsed()) {
         std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
@@ -359,10 +329,11 @@ int run(int argc, char** argv) {
     }
     resolver::Explanation ex;
     try {
-      ProgressBar bar("fitting");
-      options.progress = [&](double f) { bar(f); };
+      resolver::ProgressMeter bar(stderr, "fitting", shown);
+      options.progress = [&](double f) { bar.fraction(f); };
       if (do_explain) ex = resolver::explain_model(samples.input, effects, options);
       else ex.fit = resolver::fit_model(samples.input, effects, options);
+      bar.fraction(1.0);  // fit_model reports only its first steps
     } catch (const std::invalid_argument& e) {
       throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
     }
