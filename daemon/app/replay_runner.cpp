@@ -1,6 +1,7 @@
 #include "daemon/app/replay_runner.h"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 
 #include "daemon/app/log_input.h"
 #include "daemon/app/progress_meter.h"
+#include "daemon/service/program_errors.h"
 
 namespace resolver {
 
@@ -53,6 +55,11 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
   std::int64_t offset_us = 0;
 
   const LogFormat format = resolve_log_format(options.path, options.format, current().config());
+  // A FIFO, pipe or device is read once: what was read from it is gone, so a loop
+  // has nothing to read again (a reopened pipe is at its end, a FIFO waits for
+  // another writer's unrelated data).
+  struct stat st {};
+  const bool regular = ::stat(options.path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
   while (!flags.stop.load()) {
     const std::unique_ptr<LogInput> reader = open_log_input(options.path, format, current().config());
     reader->set_stop_flag(&flags.stop);
@@ -73,10 +80,14 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
     std::int64_t log_t0 = 0, last_us = 0;
     Clock::time_point wall_t0;
     std::int64_t first_us = 0, max_us = 0, pass_frames = 0;
+    bool at_end = false;  // the end of the file, not of --to or a stop
     while (!flags.stop.load() && !current().past_slice_end()) {
       if (flags.reload.load(std::memory_order_relaxed) && flags.reload.exchange(false)) on_reload();
       const auto status = reader->next(record);
-      if (status == LogInput::Status::kEnd) break;
+      if (status == LogInput::Status::kEnd) {
+        at_end = !reader->stopped();
+        break;
+      }
       Pipeline& pipeline = current();
       if (status == LogInput::Status::kBadLine) {
         ++result.bad_lines;
@@ -138,7 +149,25 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
       }
     }
     if (meter) meter->finish();
+    // A regular file read to its end gave the bytes it had when opened; fewer: it was
+    // truncated or replaced meanwhile (an I/O error), more: a log still being written.
+    const std::uint64_t at_open = reader->total_bytes();
+    if (at_end && at_open > 0 && reader->bytes_read() < at_open) {
+      throw IoError(fmt::format("{}: the file shrank while it was replayed: {} bytes when opened, its end came after {} "
+                                "(truncated, or replaced by another file?); replay a copy that nothing writes to",
+                                options.path, at_open, reader->bytes_read()));
+    }
+    if (at_end && at_open > 0 && reader->bytes_read() > at_open) {
+      err << fmt::format("resolverd: {} grew while it was replayed ({} bytes when opened, {} read to the end): a log "
+                         "still being written; this pass ended at the end it met\n",
+                         options.path, at_open, reader->bytes_read());
+    }
     if (options.once || reader->stopped() || current().past_slice_end()) break;
+    if (!regular) {
+      err << "resolverd: " << options.path << " is not a regular file (a FIFO, pipe or device): it is read once, "
+          << "there is nothing to replay again; stopping after one pass (--once says so; to loop, replay a file)\n";
+      break;
+    }
     if (pass_frames == 0) {
       // Nothing to loop over: an empty (or all-bad) log would spin here forever.
       err << "resolverd: " << options.path << " has no frames to loop over; stopping after one pass\n";

@@ -5,6 +5,12 @@
                  lines (bytes of the total, samples, rate, ETA; then the fit), at most
                  ~4 a second, and stdout byte for byte as without --progress; without
                  --progress and with stderr not a terminal: no progress at all
+  ChangingFile   a log that grows while resolver-model reads it: exit 0, a warning and
+                 a note saying so; one truncated while it is read: exit 3 naming it
+  ReadOnce       a FIFO or a pipe read where a loop would read it twice: resolverd
+                 --replay without --once stops after one pass saying why (exit 0, it
+                 used to wait for another writer or say "no frames to loop over");
+                 resolver-model reads a pipe (/dev/stdin) once, as a file
 
   test_long_runs.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -49,7 +55,7 @@ def copy(src, name):
     return dst
 
 
-def wait_until_reading(proc, path, settle_s=0.05, timeout_s=20.0):
+def wait_until_reading(proc, path, settle_s=0.01, timeout_s=20.0):
     """Waits until `proc` has `path` open (and still open `settle_s` later: the
     reader, not the quick look at the first bytes). False if it never does."""
     real = os.path.realpath(path)
@@ -106,6 +112,78 @@ class Progress(unittest.TestCase):
         p = run([f"{ARGS.bin}/resolver-model", "explain", sim_log(2)], env=env)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertRegex(p.stderr, r"fitting .*100%")
+
+
+class ChangingFile(unittest.TestCase):
+    def test_a_log_growing_while_it_is_read(self):
+        log = copy(sim_log(120), "growing.log")  # 33 MB: read in ~0.25 s here, acted on ~10 ms after opening
+        with open(sim_log(2)) as f:
+            more = f.read()
+        proc = subprocess.Popen([f"{ARGS.bin}/resolver-model", "fit", log], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        if not wait_until_reading(proc, log):
+            proc.kill()
+            self.skipTest("resolver-model read the log before it could be made to grow")
+        with open(log, "a") as f:
+            f.write(more)
+        out, err = proc.communicate(timeout=120)
+        self.assertEqual(proc.returncode, 0, err)
+        self.assertIn(f"resolver-model: warning: {log} grew while it was read", err)
+        self.assertRegex(out, rf"note: {re.escape(log)} grew while it was read \((\d+) bytes when opened, (\d+) read")
+
+    def test_a_log_truncated_while_it_is_read(self):
+        log = copy(sim_log(120), "truncated.log")
+        proc = subprocess.Popen([f"{ARGS.bin}/resolver-model", "fit", log], stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        if not wait_until_reading(proc, log):
+            proc.kill()
+            self.skipTest("resolver-model read the log before it could be truncated")
+        os.truncate(log, os.path.getsize(log) // 4)
+        _, err = proc.communicate(timeout=120)
+        self.assertEqual(proc.returncode, 3, err)
+        self.assertRegex(err, rf"^resolver-model: {re.escape(log)}: the file shrank while it was read")
+
+
+class ReadOnce(unittest.TestCase):
+    def test_resolverd_replay_loop_of_a_fifo_stops_after_one_pass(self):
+        fifo = work("loop.fifo")
+        if os.path.exists(fifo):
+            os.remove(fifo)
+        os.mkfifo(fifo)
+        log = sim_log(2)
+
+        def feed():
+            with open(log, "rb") as src, open(fifo, "wb") as dst:
+                dst.write(src.read())
+
+        writer = threading.Thread(target=feed)
+        writer.start()
+        try:
+            p = run([f"{ARGS.bin}/resolverd", "--replay", fifo, "--fast", "--quiet", "--lcm", "memq://"], timeout=60)
+        finally:
+            writer.join(timeout=10)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn(f"resolverd: {fifo} is not a regular file (a FIFO, pipe or device): it is read once", p.stderr)
+        self.assertNotIn("no frames to loop over", p.stderr)
+        self.assertIn("resolverd report:", p.stdout)
+
+    def test_resolverd_replay_loop_of_stdin_pipe(self):
+        with open(sim_log(2), "rb") as f:
+            data = f.read()
+        p = subprocess.run([f"{ARGS.bin}/resolverd", "--replay", "/dev/stdin", "--fast", "--quiet", "--lcm", "memq://"],
+                           input=data, capture_output=True, timeout=60)
+        err = p.stderr.decode(errors="replace")
+        self.assertEqual(p.returncode, 0, err)
+        self.assertIn("is not a regular file (a FIFO, pipe or device): it is read once", err)
+
+    def test_resolver_model_reads_a_pipe_once(self):
+        log = sim_log(2)
+        from_file = run([f"{ARGS.bin}/resolver-model", "fit", log])
+        self.assertEqual(from_file.returncode, 0, from_file.stderr)
+        # cat | ...: stdin a pipe, not the file itself
+        p = run(["sh", "-c", 'cat "$1" | "$0" fit /dev/stdin', f"{ARGS.bin}/resolver-model", log], timeout=60)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(p.stdout.replace("/dev/stdin", log), from_file.stdout)
 
 
 if __name__ == "__main__":

@@ -48,9 +48,13 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
                           }});
   LogRecord record;
   std::int64_t since_progress = 0;
+  bool at_end = false;  // the end of the file, not of --to
   while (!stream.past_slice_end()) {
     const auto st = reader->next(record);
-    if (st == LogInput::Status::kEnd) break;
+    if (st == LogInput::Status::kEnd) {
+      at_end = true;
+      break;
+    }
     if (st == LogInput::Status::kBadLine) {
       ++out.bad_lines;
       continue;
@@ -66,6 +70,22 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
       progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
                                static_cast<std::int64_t>(out.input.samples.size()), false});
     }
+  }
+  // A regular file read to its end has given exactly the bytes it had when opened.
+  // Fewer: it was truncated or replaced while read, and the samples may mix two logs.
+  // More: a log still being written (candump -l running); the samples are those read.
+  const std::uint64_t at_open = reader->total_bytes();  // 0: a FIFO, pipe or device
+  if (at_end && at_open > 0 && reader->bytes_read() < at_open) {
+    throw IoError(fmt::format("{}: the file shrank while it was read: {} bytes when opened, its end came after {} "
+                              "(truncated, or replaced by another file?); read a copy that nothing writes to",
+                              path, at_open, reader->bytes_read()));
+  }
+  if (at_end && at_open > 0 && reader->bytes_read() > at_open) {
+    out.grew_while_read = fmt::format("{} grew while it was read ({} bytes when opened, {} read to the end): a log "
+                                      "still being written; these are the samples of the bytes read, and a last "
+                                      "line cut short counts as a bad line",
+                                      path, at_open, reader->bytes_read());
+    out.notes.push_back(out.grew_while_read);
   }
   stream.flush();
   health.finish();

@@ -29,6 +29,7 @@ struct LogSamples {
   std::int64_t problems = 0;       ///< decode problems (CRC, counters, odd time, ...)
   std::int64_t outside_slice = 0;  ///< samples before --from or after --to
   bool bench_info = false;
+  std::string grew_while_read;     ///< a log still being written: the note (also in notes) that says so
   std::vector<std::string> notes;  ///< what the log lacks, what was odd
   /// Signal health over every sample read, judged as resolverd judges it ([health],
   /// the DBC's or the CSV column's full scale): what each fault held for.
@@ -54,9 +55,10 @@ struct LogReadOptions {
 
 /// Reads `path`. progress(how far) is called every 4096 records and at the end
 /// (may be empty). Throws std::system_error "cannot open <path>: ..." when the
-/// file cannot be read, InputError (Fault::kData) "<path>: no samples ..." (naming
-/// the layout in use) when nothing decodes, and ConfigError when the config's DBC,
-/// signal map or CSV column map is bad.
+/// file cannot be read or shrank while it was read (IoError), InputError
+/// (Fault::kData) "<path>: no samples ..." (naming the layout in use) when nothing
+/// decodes, and ConfigError when the config's DBC, signal map or CSV column map is
+/// bad. A file that grew while it was read is read to the end met (grew_while_read says so).
 [[nodiscard]] LogSamples read_log_samples(const std::string& path,
                                           const std::function<void(const LogReadProgress&)>& progress,
                                           const DaemonConfig& config = DaemonConfig{},

@@ -300,6 +300,7 @@ int run(int argc, char** argv) {
           log, [&](const resolver::LogReadProgress& p) { bar.bytes(p.bytes_read, p.total_bytes, p.samples, p.done); },
           config, read_options);
     }
+    if (!samples.grew_while_read.empty()) std::cerr << "resolver-model: warning: " << samples.grew_while_read << "\n";
     resolver::DiscoveryOptions options;
     options.max_report_order = resolver::kOfflineReportOrder;
     options.harmonic_families = true;
