@@ -41,12 +41,13 @@ set(resolver_man_pages "")
 
 # resolver_add_program(NAME TARGET target | SCRIPT path  SUMMARY "one line")
 # Installs the program and makes its man page. C++ programs also get the
-# --version helper (daemon/service/program_version.h) linked in here, so the
-# list of programs lives in one place.
+# --version helper (daemon/service/program_version.h) and the exit-code rule
+# (daemon/service/program_errors.h) linked in here, so the list of programs lives
+# in one place.
 function(resolver_add_program name)
   cmake_parse_arguments(ARG "" "TARGET;SCRIPT;SUMMARY" "" ${ARGN})
   if(ARG_TARGET)
-    target_link_libraries(${ARG_TARGET} PRIVATE resolver_version)
+    target_link_libraries(${ARG_TARGET} PRIVATE resolver_version resolver_program_errors)
     install(TARGETS ${ARG_TARGET} RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
     set(program $<TARGET_FILE:${ARG_TARGET}>)
     set(depends ${ARG_TARGET})

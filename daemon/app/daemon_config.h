@@ -94,6 +94,7 @@
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/row_decoder.h"
 #include "daemon/decode/signal_map.h"
+#include "daemon/service/program_errors.h"
 #include "drivers/csv/csv_format.h"
 
 namespace resolver {
@@ -191,10 +192,11 @@ struct DaemonConfig {
 };
 
 /// Thrown for unreadable or invalid configuration; what() names the file,
-/// the line where known, the key and what is expected.
-class ConfigError : public std::runtime_error {
+/// the line where known, the key and what is expected. A usage fault: every
+/// program exits 2 for it (daemon/service/program_errors.h).
+class ConfigError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  explicit ConfigError(const std::string& message) : InputError(Fault::kUsage, message) {}
 };
 
 /// Reads a TOML config over the defaults. Unknown keys are errors (a typo

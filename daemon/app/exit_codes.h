@@ -1,13 +1,6 @@
-// Exit codes shared by every program of the project (resolverd, resolver-sim,
-// resolver-model, resolver-echo, resolver-accuracy), so a script can tell "the
-// data was bad" from "I called it wrong" from "the disk said no":
-//
-//   0  done
-//   1  the input had no usable data (nothing decoded, a damaged log)
-//   2  usage or configuration error (bad option, bad config file or DBC)
-//   3  I/O error (a file missing or unreadable, a directory for a file, a write that failed,
-//      a --state-dir that is missing, unwritable or locked by another resolverd)
-//   70 internal error (an unexpected exception: a bug, please report it)
+// The command-line side of the exit codes (daemon/service/program_errors.h has
+// the codes, their --help paragraph and the exception -> code rule): CLI11's
+// parse errors and unreadable files, checked before anything is read.
 //
 // CLI11's own codes (105 for a missing --config file, 106 for a missing
 // option, ...) never leave a program: parse_command_line() maps them.
@@ -24,18 +17,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "daemon/service/program_errors.h"
+
 namespace resolver::exit_code {
-
-inline constexpr int kDone = 0;
-inline constexpr int kNoUsableData = 1;
-inline constexpr int kUsage = 2;
-inline constexpr int kIo = 3;
-inline constexpr int kInternal = 70;  // sysexits.h EX_SOFTWARE
-
-/// The paragraph every --help ends with.
-inline constexpr const char* kHelpText =
-    "Exit codes: 0 done; 1 the input had no usable data; 2 usage or configuration error; "
-    "3 I/O error (a file missing or unreadable, a write failed); 70 internal error (a bug).";
 
 /// Parses the command line. Returns nullopt to go on, or the code to exit with:
 /// 0 after --help (printed), kUsage after printing CLI11's message.

@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <system_error>
 
 namespace resolver {
 
@@ -40,7 +41,7 @@ std::optional<LcmLogWriter::FileUrl> LcmLogWriter::parse_url(std::string_view ur
 LcmLogWriter::LcmLogWriter(const FileUrl& file) : path_(file.path), buffer_(kFlushAt + 4096) {
   const int flags = O_WRONLY | O_CREAT | O_CLOEXEC | (file.append ? O_APPEND : O_TRUNC);
   fd_ = ::open(path_.c_str(), flags, 0644);
-  if (fd_ < 0) throw std::runtime_error("cannot open " + path_ + " for the LCM log: " + std::strerror(errno));
+  if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + path_ + " for the LCM log");
 }
 
 LcmLogWriter::~LcmLogWriter() {

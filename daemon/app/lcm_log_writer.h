@@ -29,7 +29,7 @@ class LcmLogWriter {
   /// URL, or file:// with other options, which stay with liblcm.
   [[nodiscard]] static std::optional<FileUrl> parse_url(std::string_view url);
 
-  /// Opens (creates or truncates; appends with `append`). Throws std::runtime_error
+  /// Opens (creates or truncates; appends with `append`). Throws std::system_error
   /// "cannot open <path> for the LCM log: <reason>".
   explicit LcmLogWriter(const FileUrl& file);
   ~LcmLogWriter();

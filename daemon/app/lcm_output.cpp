@@ -1,5 +1,7 @@
 #include "daemon/app/lcm_output.h"
 
+#include "daemon/service/program_errors.h"
+
 namespace resolver {
 
 LcmOutput::LcmOutput(const std::string& url, LcmChannels channels) : channels_(std::move(channels)) {
@@ -9,7 +11,7 @@ LcmOutput::LcmOutput(const std::string& url, LcmChannels channels) : channels_(s
   }
   lcm_ = std::make_unique<lcm::LCM>(url);
   if (!lcm_->good()) {
-    throw std::runtime_error("cannot initialise LCM with URL '" + (url.empty() ? std::string("(default)") : url) +
+    throw IoError("cannot initialise LCM with URL '" + (url.empty() ? std::string("(default)") : url) +
                              "': check the URL (udpm://239.255.76.67:7667?ttl=0, file:///path?mode=w, memq://) "
                              "and, for udpm, that a multicast route exists (ip route add 224.0.0.0/4 dev lo)");
   }

@@ -28,7 +28,7 @@ namespace resolver {
 
 class LcmOutput final : public OutputSink {
  public:
-  /// Opens LCM on `url` ("" = LCM's default). Throws std::runtime_error when
+  /// Opens LCM on `url` ("" = LCM's default). Throws std::system_error when
   /// LCM cannot be initialised (bad URL, no multicast route).
   LcmOutput(const std::string& url, LcmChannels channels);
 

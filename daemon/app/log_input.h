@@ -35,7 +35,7 @@ class LogInput {
  public:
   enum class Status { kRecord, kBadLine, kEnd };
   virtual ~LogInput() = default;
-  /// The next frame or row. Throws std::runtime_error on an I/O failure.
+  /// The next frame or row. Throws std::system_error on an I/O failure.
   virtual Status next(LogRecord& record) = 0;
   /// Valid after kBadLine: counter name, 1-based column, message.
   [[nodiscard]] virtual const TextProblem& problem() const = 0;
@@ -66,7 +66,7 @@ class LogInput {
 /// magic 1f 8b). The content is looked at only in a regular file.
 void refuse_unreadable_format(const std::string& path);
 
-/// Opens `path`. Throws std::runtime_error when it cannot be opened, and
+/// Opens `path`. Throws std::system_error when it cannot be opened, and
 /// ConfigError when a CSV has no column map or names a column the export lacks,
 /// or the file is BLF or gzip (refuse_unreadable_format).
 [[nodiscard]] std::unique_ptr<LogInput> open_log_input(const std::string& path, LogFormat format,

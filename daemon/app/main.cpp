@@ -190,12 +190,7 @@ static int run(int argc, char** argv) {
   }
 
   DaemonConfig config;
-  try {
-    if (!config_path.empty()) config = load_daemon_config(config_path);
-  } catch (const ConfigError& e) {
-    std::cerr << "resolverd: " << e.what() << "\n";
-    return exit_code::kUsage;
-  }
+  if (!config_path.empty()) config = load_daemon_config(config_path);  // ConfigError: exit 2
   if (lcm_url) config.lcm_url = *lcm_url;
   std::string config_crc = file_crc32(config_path);  // provenance of a saved calibration
   // Held for the whole run (see state_dir_lock.h); taken before anything is read from the directory.
@@ -215,20 +210,10 @@ static int run(int argc, char** argv) {
     }
   }
 
-  std::unique_ptr<LcmOutput> output;
-  std::unique_ptr<Pipeline> pipeline;
-  try {
-    output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
-  } catch (const std::exception& e) {
-    std::cerr << "resolverd: " << e.what() << "\n";
-    return exit_code::kIo;
-  }
-  try {
-    pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty(), slice);
-  } catch (const std::exception& e) {
-    std::cerr << "resolverd: " << e.what() << "\n";
-    return exit_code::kUsage;
-  }
+  // LCM that cannot start throws std::system_error (exit 3); a DBC or signal map that
+  // does not fit, ConfigError or std::invalid_argument (exit 2).
+  const auto output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
+  const auto pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty(), slice);
   if (fast && is_udpm(config.lcm_url)) {
     std::cerr << "resolverd: --fast on udpm publishes as fast as the CPU allows (hundreds of thousands of messages/s); "
                  "listeners such as lcm-logger and lcm-spy drop what their socket buffers cannot hold. "
@@ -242,22 +227,15 @@ static int run(int argc, char** argv) {
       std::cerr << "resolverd: compensating with the table " << calibration_file << " (" << table.correction.size()
                 << " points, p_r " << table.p_r << ", interpolation error " << table.interpolation_error << " rad)\n";
       pipeline->use_table(std::move(table));
-    } catch (const std::exception& e) {
-      std::cerr << "resolverd: " << e.what() << "\n";
-      return exit_code::kUsage;
+    } catch (const std::runtime_error& e) {  // not a table, a bad number, rows out of order
+      throw InputError(Fault::kUsage, e.what(), Where::at_option("--calibration"));
     }
   }
   if (!state_dir.empty()) {
     LoadResult loaded = load_calibration(state_dir);
     if (loaded.status == LoadResult::Status::kLoaded) {
       const Calibration::Provenance& saved = loaded.calibration->provenance;
-      LayoutIdentity here;
-      try {
-        here = layout_identity(config);
-      } catch (const std::exception& e) {
-        std::cerr << "resolverd: " << e.what() << "\n";
-        return exit_code::kUsage;
-      }
+      const LayoutIdentity here = layout_identity(config);  // ConfigError (the DBC): exit 2
       if (saved.layout_id.empty()) {
         std::cerr << "resolverd: " << calibration_path(state_dir)
                   << " records no layout (written by an older resolverd); it is applied unchecked and the next save "
@@ -319,7 +297,9 @@ static int run(int argc, char** argv) {
     }
     notifier.ready();
   };
-  try {
+  // Opening or reading the input fails with std::system_error (exit 3), a CSV column
+  // map that does not fit the export with ConfigError (exit 2): program_errors.h.
+  {
     if (!replay_path.empty()) {
       ReplayOptions ro;
       ro.path = replay_path;
@@ -337,13 +317,6 @@ static int run(int argc, char** argv) {
       info.source = can_iface;
       info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }
-  } catch (const ConfigError& e) {  // e.g. a CSV column map that does not fit the export
-    std::cerr << "resolverd: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    // Opening or reading the input failed (the log vanished, a read error).
-    std::cerr << "resolverd: " << e.what() << "\n";
-    return exit_code::kIo;
   }
 
   // The calibration: judged, saved or not, before the report so the report says which.
@@ -417,14 +390,8 @@ static int run(int argc, char** argv) {
   return code;
 }
 
+// Every failure that is an exception gets its exit code from the one rule
+// (daemon/service/program_errors.h) and one line "resolverd: ...".
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    // Last resort: every expected failure is reported where it happens.
-    std::cerr << "resolverd: unexpected error: " << e.what() << "\n";
-  } catch (...) {
-    std::cerr << "resolverd: unexpected non-standard exception\n";
-  }
-  return resolver::exit_code::kInternal;
+  return resolver::run_program("resolverd", [&] { return run(argc, argv); });
 }

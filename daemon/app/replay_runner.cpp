@@ -1,13 +1,17 @@
 #include "daemon/app/replay_runner.h"
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <thread>
 
 #include "daemon/app/log_input.h"
+#include "daemon/app/progress_meter.h"
+#include "daemon/service/program_errors.h"
 
 namespace resolver {
 
@@ -38,19 +42,35 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
                         const std::function<void()>& on_reload, StopFlags& flags, std::ostream& err) {
   ReplayResult result;
   const auto wall_start = Clock::now();
+  // On a terminal: one line rewritten at most 4 times a second (bytes, frames, rate,
+  // ETA), erased at the end. Elsewhere (a journal, a pipe): a line every 2 s.
   const bool tty = isatty(STDERR_FILENO) != 0;
+  ProgressMeter::Options meter_options;
+  meter_options.enabled = options.progress && tty;
+  std::optional<ProgressMeter> meter;
   auto next_progress = wall_start + kProgressEvery;
-  bool printed_progress = false;
   const double rate = options.rate > 0.0 ? options.rate : 1.0;
   // Loop passes: pass k's frame times are shifted by k * loop_span_us.
   std::int64_t loop_span_us = 0;
   std::int64_t offset_us = 0;
 
   const LogFormat format = resolve_log_format(options.path, options.format, current().config());
+  // A FIFO, pipe or device is read once: what was read from it is gone, so a loop
+  // has nothing to read again (a reopened pipe is at its end, a FIFO waits for
+  // another writer's unrelated data).
+  struct stat st {};
+  const bool regular = ::stat(options.path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
   while (!flags.stop.load()) {
     const std::unique_ptr<LogInput> reader = open_log_input(options.path, format, current().config());
     reader->set_stop_flag(&flags.stop);
     ++result.passes;
+    if (meter_options.enabled) {
+      meter.reset();
+      meter.emplace(stderr, result.passes > 1 ? fmt::format("resolverd: {} (pass {})", options.path, result.passes)
+                                              : "resolverd: " + options.path,
+                    meter_options);
+      meter->set_items_word("frames");
+    }
     if (result.passes > 1) {
       current().restart_sequence();
       offset_us += loop_span_us;
@@ -60,10 +80,14 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
     std::int64_t log_t0 = 0, last_us = 0;
     Clock::time_point wall_t0;
     std::int64_t first_us = 0, max_us = 0, pass_frames = 0;
+    bool at_end = false;  // the end of the file, not of --to or a stop
     while (!flags.stop.load() && !current().past_slice_end()) {
       if (flags.reload.load(std::memory_order_relaxed) && flags.reload.exchange(false)) on_reload();
       const auto status = reader->next(record);
-      if (status == LogInput::Status::kEnd) break;
+      if (status == LogInput::Status::kEnd) {
+        at_end = !reader->stopped();
+        break;
+      }
       Pipeline& pipeline = current();
       if (status == LogInput::Status::kBadLine) {
         ++result.bad_lines;
@@ -108,7 +132,9 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
           target.feed_untimed(record.frame, reader->line_number());
         }
       }
-      if (options.progress && (result.frames & 0xFFFU) == 0) {
+      if (meter && (result.frames & 0xFFFU) == 0) {
+        meter->bytes(reader->bytes_read(), reader->total_bytes(), static_cast<std::int64_t>(result.frames));
+      } else if (options.progress && !tty && (result.frames & 0xFFFU) == 0) {
         const auto now = Clock::now();
         if (now >= next_progress) {
           next_progress = now + kProgressEvery;
@@ -116,14 +142,32 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
           const double pct = reader->total_bytes() > 0
                                  ? 100.0 * static_cast<double>(reader->bytes_read()) / static_cast<double>(reader->total_bytes())
                                  : 0.0;
-          err << fmt::format("{}resolverd: {:5.1f}% of {} ({} frames, {:.0f} frames/s){}", tty ? "\r" : "", pct,
-                             options.path, result.frames, static_cast<double>(result.frames) / s, tty ? "" : "\n");
+          err << fmt::format("resolverd: {:5.1f}% of {} ({} frames, {:.0f} frames/s)\n", pct, options.path,
+                             result.frames, static_cast<double>(result.frames) / s);
           err.flush();
-          printed_progress = true;
         }
       }
     }
+    if (meter) meter->finish();
+    // A regular file read to its end gave the bytes it had when opened; fewer: it was
+    // truncated or replaced meanwhile (an I/O error), more: a log still being written.
+    const std::uint64_t at_open = reader->total_bytes();
+    if (at_end && at_open > 0 && reader->bytes_read() < at_open) {
+      throw IoError(fmt::format("{}: the file shrank while it was replayed: {} bytes when opened, its end came after {} "
+                                "(truncated, or replaced by another file?); replay a copy that nothing writes to",
+                                options.path, at_open, reader->bytes_read()));
+    }
+    if (at_end && at_open > 0 && reader->bytes_read() > at_open) {
+      err << fmt::format("resolverd: {} grew while it was replayed ({} bytes when opened, {} read to the end): a log "
+                         "still being written; this pass ended at the end it met\n",
+                         options.path, at_open, reader->bytes_read());
+    }
     if (options.once || reader->stopped() || current().past_slice_end()) break;
+    if (!regular) {
+      err << "resolverd: " << options.path << " is not a regular file (a FIFO, pipe or device): it is read once, "
+          << "there is nothing to replay again; stopping after one pass (--once says so; to loop, replay a file)\n";
+      break;
+    }
     if (pass_frames == 0) {
       // Nothing to loop over: an empty (or all-bad) log would spin here forever.
       err << "resolverd: " << options.path << " has no frames to loop over; stopping after one pass\n";
@@ -134,7 +178,6 @@ ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeli
       loop_span_us = max_us - first_us + std::max<std::int64_t>(interval, 1);
     }
   }
-  if (printed_progress && tty) err << "\n";
   current().finish();
   result.wall_seconds = std::chrono::duration<double>(Clock::now() - wall_start).count();
   return result;

@@ -6,7 +6,10 @@
 //
 // A loop is one continuous bench run to everything downstream: each pass's
 // frame times are shifted by the log's span (plus one frame interval) per pass,
-// so utime and the health_t period keep counting up. SIGINT/SIGTERM end the
+// so utime and the health_t period keep counting up. A FIFO, pipe or device is
+// read once (its data is gone once read): the loop stops after one pass, saying
+// so. A file that shrank while it was read throws IoError; one that grew is read
+// to the end met, with a warning. SIGINT/SIGTERM end the
 // replay within LineReader::kStopPollMs on any input (a pause in the log's
 // timing is slept in slices); SIGHUP rebuilds the pipeline from the config
 // between two frames, as live.
@@ -35,7 +38,7 @@ struct ReplayOptions {
   std::string path;
   bool fast = false;   ///< ignore log timing
   bool once = true;    ///< stop at the end of the log (else loop)
-  bool progress = true;  ///< progress lines on stderr for long runs
+  bool progress = true;  ///< progress on stderr for long runs (a terminal: one line, 4x/s; else every 2 s)
   double rate = 1.0;   ///< paced replay at this many times the log's speed (> 0; not with fast)
   std::optional<LogFormat> format;  ///< --format; nullopt: [input] format, else the extension
 };
@@ -50,8 +53,8 @@ struct ReplayResult {
 /// Runs until the end of the log (once), past the pipeline's slice, or until
 /// flags.stop. `current` is the pipeline to feed; `on_reload` is called between
 /// frames when flags.reload is set and may replace it (the old one is finished by
-/// on_reload). Throws std::runtime_error when the log cannot be opened or read and
-/// ConfigError when a CSV's column map does not fit it.
+/// on_reload). Throws std::system_error when the log cannot be opened or read or
+/// shrank while it was read, and ConfigError when a CSV's column map does not fit it.
 ReplayResult run_replay(const ReplayOptions& options, const std::function<Pipeline&()>& current,
                         const std::function<void()>& on_reload, StopFlags& flags, std::ostream& err);
 /// The same with one pipeline and SIGHUP ignored.

@@ -19,12 +19,12 @@ class AscReader {
   /// trailing field is ~400 bytes.
   static constexpr std::size_t kMaxLineLength = 4096;
 
-  /// Opens `path`. Throws std::runtime_error("cannot open <path>: <strerror>").
+  /// Opens `path`. Throws std::system_error("cannot open <path>: <strerror>").
   explicit AscReader(const std::string& path, std::size_t buffer_bytes = LineReader::kDefaultBufferBytes)
       : lines_(path, kMaxLineLength, buffer_bytes) {}
 
   enum class Status { kFrame, kBadLine, kEnd };
-  /// Throws std::runtime_error naming the path and strerror if read(2) fails.
+  /// Throws std::system_error naming the path and strerror if read(2) fails.
   Status next(CanFrame& frame);
 
   [[nodiscard]] const TextProblem& problem() const { return problem_; }

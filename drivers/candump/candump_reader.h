@@ -6,7 +6,7 @@
 //
 // Bad input never throws: next() returns kBadLine, problem() says why, and the
 // next call continues with the following line, so callers can count problems
-// by to_string(problem().kind). Only I/O failures throw (std::runtime_error).
+// by to_string(problem().kind). Only I/O failures throw (std::system_error).
 // Timestamps are passed on as they are, also when they step back or jump:
 // what time means is the sample clock's business (daemon/decode/sample_clock.h),
 // and a step is no reason to lose the frames after it.
@@ -33,7 +33,7 @@ class CandumpReader {
   /// next read, so a refill never finds the buffer full.
   static constexpr std::size_t kMinBufferBytes = LineReader::min_buffer_bytes(kMaxCandumpLineLength);
 
-  /// Opens `path`. Throws std::runtime_error("cannot open <path>: <strerror>").
+  /// Opens `path`. Throws std::system_error("cannot open <path>: <strerror>").
   /// `buffer_bytes` is raised to kMinBufferBytes; a small buffer only costs
   /// syscalls (the fuzz target uses it so each run does not pay for 1 MiB).
   explicit CandumpReader(const std::string& path, std::size_t buffer_bytes = kDefaultBufferBytes)
@@ -44,7 +44,7 @@ class CandumpReader {
   /// kFrame: `frame` holds the next frame. kBadLine: problem() describes the
   /// line (frame contents unspecified). kEnd: no more lines (repeats).
   /// Blank lines are skipped silently.
-  /// Throws std::runtime_error naming the path and strerror if read(2) fails.
+  /// Throws std::system_error naming the path and strerror if read(2) fails.
   Status next(CanFrame& frame);
 
   /// The last bad line's problem; valid after next() returned kBadLine.

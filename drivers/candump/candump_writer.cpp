@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <system_error>
 
 #include <fmt/format.h>
 
@@ -24,7 +25,7 @@ constexpr std::size_t kLineHeadroom = 256;
 CandumpWriter::CandumpWriter(const std::string& path) : path_(path) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
-    throw std::runtime_error(fmt::format("cannot create {}: {}", path, std::strerror(errno)));
+    throw std::system_error(errno, std::generic_category(), "cannot create " + path);
   }
   buffer_.reserve(kFlushBytes + kLineHeadroom);
 }
@@ -58,8 +59,7 @@ void CandumpWriter::flush() {
       if (errno == EINTR) continue;
       const int err = errno;
       buffer_.clear();  // do not retry the same bytes from the destructor
-      throw std::runtime_error(
-          fmt::format("write error on {}: {} (disk full?)", path_, std::strerror(err)));
+      throw std::system_error(err, std::generic_category(), "write error on " + path_);
     }
     done += static_cast<std::size_t>(n);
   }
@@ -78,7 +78,7 @@ void CandumpWriter::close() {
   const int fd = fd_;
   fd_ = -1;
   if (::close(fd) != 0) {
-    throw std::runtime_error(fmt::format("close of {} failed: {}", path_, std::strerror(errno)));
+    throw std::system_error(errno, std::generic_category(), "close of " + path_ + " failed");
   }
 }
 

@@ -15,7 +15,7 @@ namespace resolver {
 
 class CandumpWriter {
  public:
-  /// Creates or truncates `path` (mode 0644). Throws std::runtime_error
+  /// Creates or truncates `path` (mode 0644). Throws std::system_error
   /// ("cannot create <path>: <strerror>").
   explicit CandumpWriter(const std::string& path);
   /// Closes without throwing; a failure here is lost, so call close() to see it.
@@ -24,10 +24,10 @@ class CandumpWriter {
   CandumpWriter& operator=(const CandumpWriter&) = delete;
 
   /// Appends one line. Throws std::invalid_argument if check_loggable()
-  /// rejects the frame (nothing is written), std::runtime_error on an I/O
+  /// rejects the frame (nothing is written), std::system_error on an I/O
   /// error or after close().
   void write(const CanFrame& frame);
-  /// Flushes and closes; throws std::runtime_error naming the path and strerror.
+  /// Flushes and closes; throws std::system_error naming the path and strerror.
   /// A second call does nothing.
   void close();
   [[nodiscard]] std::uint64_t frames_written() const { return frames_written_; }

@@ -56,7 +56,8 @@ SocketCanError::SocketCanError(std::string operation, std::string iface, int err
     : SocketCanError(operation, iface, err, socketcan_error_hint(err, operation, iface)) {}
 
 SocketCanError::SocketCanError(std::string operation, std::string iface, int err, std::string hint)
-    : std::runtime_error(format_message(operation, iface, err, hint)),
+    : std::system_error(err, std::system_category()),
+      message_(format_message(operation, iface, err, hint)),
       operation_(std::move(operation)),
       iface_(std::move(iface)),
       err_(err) {}

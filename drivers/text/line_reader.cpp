@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <system_error>
 #include <utility>
 
 #include <fmt/format.h>
@@ -35,7 +36,7 @@ LineReader::LineReader(const std::string& path, std::size_t max_line_length, std
   // O_NONBLOCK only for the open: a FIFO without a writer would block it, out of
   // reach of any stop flag. Reads are blocking again (and polled first, below).
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd_ < 0) throw std::runtime_error(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
+  if (fd_ < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + path);
   const int flags = ::fcntl(fd_, F_GETFL);
   if (flags >= 0) (void)::fcntl(fd_, F_SETFL, flags & ~O_NONBLOCK);
   struct stat st {};
@@ -102,7 +103,7 @@ bool LineReader::wait_readable() {
     const int r = ::poll(&p, 1, stop_ != nullptr ? kStopPollMs : -1);
     if (r > 0) return true;  // data, end of input or an error: read() tells which
     if (r < 0 && errno != EINTR) {
-      throw std::runtime_error(fmt::format("cannot wait for input from {}: {}", path_, std::strerror(errno)));
+      throw std::system_error(errno, std::generic_category(), "cannot wait for input from " + path_);
     }
   }
 }
@@ -124,8 +125,8 @@ void LineReader::fill() {
       return;
     }
     if (errno != EINTR) {
-      throw std::runtime_error(fmt::format("read error in {} after {} bytes: {}", path_,
-                                           bytes_consumed_ + (end_ - begin_), std::strerror(errno)));
+      throw std::system_error(errno, std::generic_category(),
+                              fmt::format("read error in {} after {} bytes", path_, bytes_consumed_ + (end_ - begin_)));
     }
   }
 }

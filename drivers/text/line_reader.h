@@ -5,7 +5,7 @@
 // line in place as a string_view (valid until the next call), so the good path
 // makes no allocation per line. A line longer than the limit is skipped to its
 // end and reported, so one corrupt stretch (a binary file read by mistake)
-// cannot make the buffer grow. Only I/O failures throw (std::runtime_error
+// cannot make the buffer grow. Only I/O failures throw (std::system_error
 // naming the path and strerror). Not thread-safe; one reader per thread.
 //
 // Stopping: with set_stop_flag(), every read checks the flag, and input that is
@@ -35,7 +35,7 @@ class LineReader {
   /// [ms] longest wait for input between two looks at the stop flag.
   static constexpr int kStopPollMs = 100;
 
-  /// Opens `path`. Throws std::runtime_error("cannot open <path>: <strerror>").
+  /// Opens `path`. Throws std::system_error("cannot open <path>: <strerror>").
   /// `buffer_bytes` is raised to min_buffer_bytes(max_line_length).
   LineReader(const std::string& path, std::size_t max_line_length, std::size_t buffer_bytes = kDefaultBufferBytes);
   ~LineReader();
@@ -52,7 +52,7 @@ class LineReader {
   /// kLine: `line` is the next line without its '\n' (the last line may lack
   /// one). kTooLong: a line of more than max_line_length bytes was skipped;
   /// skipped_length() says how long it was. kEnd: no more lines (repeats).
-  /// Throws std::runtime_error naming the path and strerror if read(2) fails.
+  /// Throws std::system_error naming the path and strerror if read(2) fails.
   Result next(std::string_view& line);
 
   /// 1-based number of the line last returned.

@@ -11,6 +11,11 @@ message that names the option or file and says what to do (README: exit codes).
                    directory (was: read as an empty file, all defaults, exit 0);
                    likewise a directory as resolverd --replay, resolver-model's LOG
                    or resolver-echo --log
+  OutOfMemory      resolver-model under an address-space limit (prlimit --as) too small
+                   for the log: exit 4, "resolver-model: out of memory: ..." on one line
+                   (was: a bare "std::bad_alloc", exit 1)
+  NotAFile         a FIFO as resolver-echo --log: exit 2 at once, naming it (was: it
+                   waited for a writer)
   BinaryLogs       a Vector BLF log (.blf, or the magic "LOGG") and a gzip file (.gz,
                    or the magic 1f 8b) given to resolverd --replay or resolver-model:
                    exit 2 naming the file and the conversion command (was: read as
@@ -246,6 +251,45 @@ class BinaryLogs(unittest.TestCase):
             with open(sim_log()) as src:
                 f.write(src.read())
         decoded_samples(text)
+
+
+class OutOfMemory(unittest.TestCase):
+    """A log larger than the memory resolver-model may use (an address-space limit set
+    with prlimit --as, as ulimit -v does): exit 4 and one line that says so, not a bare
+    std::bad_alloc with exit 1 or 70."""
+
+    def test_model_out_of_memory(self):
+        prlimit = shutil.which("prlimit")
+        if prlimit is None:
+            self.skipTest("no prlimit (util-linux)")
+        model = f"{ARGS.bin}/resolver-model"
+        if "asan" in run(["ldd", model]).stdout:
+            self.skipTest("AddressSanitizer reserves terabytes of address space: no --as limit fits")
+        big = work("oom_60s.log")  # 60 s at 2 kHz: ~40 MiB more than the 1 s log once read
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", big, "--duration", "60", "--seed", "5"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        # The smallest limit (8 MiB steps) under which the 1 s log is still fitted.
+        for mib in range(16, 1024, 8):
+            if run([prlimit, f"--as={mib << 20}", model, "fit", sim_log()]).returncode == 0:
+                break
+        else:
+            self.fail("resolver-model fit of a 1 s log fails under any address-space limit up to 1 GiB")
+        p = run([prlimit, f"--as={mib << 20}", model, "fit", big])
+        self.assertEqual(p.returncode, 4, f"--as={mib} MiB: {p.stderr}")
+        self.assertRegex(p.stderr, r"^resolver-model: out of memory: ")
+        self.assertNotIn("std::bad_alloc", p.stderr)
+        self.assertEqual(p.stderr.count("\n"), 1, "one line: " + p.stderr)
+
+
+class NotAFile(unittest.TestCase):
+    def test_echo_refuses_a_fifo_without_waiting_for_a_writer(self):
+        fifo = work("echo.fifo")
+        if os.path.exists(fifo):
+            os.remove(fifo)
+        os.mkfifo(fifo)
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", fifo], timeout=30)
+        self.assertEqual(p.returncode, USAGE, p.stderr)
+        self.assertIn(f"{fifo}: not a regular file", p.stderr)
 
 
 if __name__ == "__main__":

@@ -230,7 +230,7 @@ class ExportData(unittest.TestCase):
         self.assertIn("give --csv OUT, --mat OUT or both", p.stderr)
         for option in ("--csv", "--mat"):
             bad = os.path.join(ARGS.work, "no-such-dir", "x" + option.replace("--", "."))
-            p = run([self.model, "export-data", self.log, option, bad], expect_rc=1)
+            p = run([self.model, "export-data", self.log, option, bad], expect_rc=3)  # a failed write: I/O
             self.assertIn(f"cannot write {bad}: No such file or directory", p.stderr)
 
 

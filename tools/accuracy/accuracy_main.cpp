@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
 #include <string>
 
 #include "daemon/app/exit_codes.h"
@@ -115,9 +116,7 @@ void print_ripple(const std::vector<RippleStudy>& studies) {
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{"resolver-accuracy: estimator bias and spread against the Cramer-Rao bound, convergence and 2x dq "
                "ripple reduction on simulated data with known truth; prints a markdown report.",
                "resolver-accuracy"};  // the name in the usage line, not argv[0] (a build path)
@@ -130,6 +129,8 @@ int main(int argc, char** argv) {
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
   if (quick && app.get_option("--seeds")->count() == 0) seeds = 10;
 
+  // No input to blame: what a study throws is a bug (70; a refused argument too, not a
+  // usage error), or out of memory (4).
   try {
     const auto t0 = std::chrono::steady_clock::now();
     fmt::print("# resolver-accuracy\n\n");
@@ -150,9 +151,14 @@ int main(int argc, char** argv) {
     print_ripple(ripple);
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     fmt::print("\nRun time {:.1f} s.\n", secs);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "resolver-accuracy: %s\n", e.what());
-    return resolver::exit_code::kInternal;  // no input to blame: a failed study is a bug
+  } catch (const std::invalid_argument& e) {
+    throw std::logic_error(e.what());
   }
   return std::fflush(stdout) == 0 ? resolver::exit_code::kDone : resolver::exit_code::kIo;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return resolver::run_program("resolver-accuracy", [&] { return run(argc, argv); });
 }

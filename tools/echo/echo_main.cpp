@@ -73,17 +73,15 @@ Examples:
 Exit status:
   0 done; 1 the input had no usable data (a malformed or truncated log, --timeout expired
   before --count messages arrived, --csv and no message matched); 2 usage error (bad
-  option, --type or --channel, a bad .lcm file in --types); 3 I/O error (--log missing or unreadable, LCM cannot start,
-  stdout or a --csv file cannot be written); 70 internal error (a bug).)";
+  option, --type or --channel, a bad .lcm file in --types, a FIFO or pipe as --log); 3 I/O error (--log missing or
+  unreadable, LCM cannot start, stdout or a --csv file cannot be written); 4 out of memory; 70 internal error (a bug).)";
 
 void print_line(const std::string& line) {
   std::fwrite(line.data(), 1, line.size(), stdout);
   std::fputc('\n', stdout);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{kDescription, "resolver-echo"};
   app.footer(kFooter);
   app.set_version_flag("--version", resolver::version_line("resolver-echo"));
@@ -217,13 +215,16 @@ int main(int argc, char** argv) {
       return exit_code::kNoUsableData;
     }
     return exit_code::kDone;
-  } catch (const resolver::EventLogError& e) {
-    // A malformed or truncated log (the file itself was readable: checked above).
-    std::fflush(stdout);
-    std::cerr << "resolver-echo: " << e.what() << '\n';
-    return exit_code::kNoUsableData;
-  } catch (const std::exception& e) {
-    std::cerr << "resolver-echo: " << e.what() << '\n';
+  } catch (...) {
+    std::fflush(stdout);  // the messages echoed before the failure come first
+    throw;
   }
-  return exit_code::kInternal;
+}
+
+}  // namespace
+
+// What run() throws gets its exit code from the one rule (program_errors.h): a
+// malformed or truncated log (EventLogError) 1, a file that cannot be read 3, ...
+int main(int argc, char** argv) {
+  return resolver::run_program("resolver-echo", [&] { return run(argc, argv); });
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <system_error>
 #include <sys/stat.h>
 
 #include <fmt/format.h>
@@ -24,14 +25,20 @@ std::uint64_t be(const std::uint8_t* p, std::size_t n) {
 }  // namespace
 
 EventLogReader::EventLogReader(std::string path) : path_(std::move(path)) {
+  // A FIFO, pipe or device: the reader needs the file's size to tell a cut-off event
+  // from the end. Looked at before opening: opening a FIFO waits for its writer.
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    throw InputError(Fault::kUsage, fmt::format("{}: not a regular file; --log needs an LCM event log file (a FIFO or "
+                                                "pipe: save it to a file first)", path_));
+  }
   file_.reset(std::fopen(path_.c_str(), "rb"));
   if (!file_) {
-    throw EventLogError(fmt::format("{}: cannot open the LCM log ({}); check the path given to --log", path_,
-                                    std::strerror(errno)));
+    throw std::system_error(errno, std::generic_category(),
+                            fmt::format("{}: cannot open the LCM log (check the path given to --log)", path_));
   }
-  struct stat st {};
   if (fstat(fileno(file_.get()), &st) != 0 || !S_ISREG(st.st_mode)) {
-    throw EventLogError(fmt::format("{}: not a regular file; --log needs an LCM event log file", path_));
+    throw InputError(Fault::kUsage, fmt::format("{}: not a regular file; --log needs an LCM event log file", path_));
   }
   file_size_ = static_cast<std::uint64_t>(st.st_size);
 }

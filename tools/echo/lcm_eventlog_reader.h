@@ -17,11 +17,14 @@
 #include <string>
 #include <vector>
 
+#include "daemon/service/program_errors.h"
+
 namespace resolver {
 
-class EventLogError : public std::runtime_error {
+class EventLogError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  /// A fault of the data (exit 1): the file was readable, its contents are not an LCM log.
+  explicit EventLogError(const std::string& message) : InputError(Fault::kData, message) {}
 };
 
 struct LogEvent {
@@ -37,7 +40,8 @@ class EventLogReader {
   /// LCM refuses channel names longer than this; longer means a corrupt header.
   static constexpr std::int32_t kMaxChannelLength = 255;
 
-  /// Opens `path`. Throws EventLogError if it cannot be opened.
+  /// Opens `path`. Throws std::system_error if it cannot be opened, InputError (a usage
+  /// fault) if it is not a regular file.
   explicit EventLogReader(std::string path);
 
   /// The next event, or nullopt at the clean end of the file.

@@ -10,8 +10,10 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <system_error>
 
 #include "daemon/core/angles.h"
+#include "daemon/service/program_errors.h"
 #include "tools/model/report_data.h"
 #include "tools/model/row_prediction.h"
 
@@ -68,7 +70,7 @@ std::string csv_number(double v) {
 class CsvFile {
  public:
   explicit CsvFile(const std::string& path) : path_(path), f_(std::fopen(path.c_str(), "wb")) {
-    if (f_ == nullptr) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+    if (f_ == nullptr) throw std::system_error(errno, std::generic_category(), "cannot write " + path);
   }
   CsvFile(const CsvFile&) = delete;
   CsvFile& operator=(const CsvFile&) = delete;
@@ -81,11 +83,11 @@ class CsvFile {
   void close() {
     std::FILE* f = f_;
     f_ = nullptr;
-    if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno));
+    if (std::fclose(f) != 0) throw std::system_error(errno, std::generic_category(), "cannot write " + path_);
   }
 
  private:
-  [[noreturn]] void fail() const { throw std::runtime_error("cannot write " + path_ + ": " + std::strerror(errno)); }
+  [[noreturn]] void fail() const { throw std::system_error(errno, std::generic_category(), "cannot write " + path_); }
   std::string path_;
   std::FILE* f_;
 };
@@ -286,7 +288,8 @@ void write_export_mat(const ExportTable& table, const std::string& path) {
   errno = 0;
   std::unique_ptr<mat_t, int (*)(mat_t*)> mat(Mat_CreateVer(path.c_str(), header.c_str(), MAT_FT_MAT5), &Mat_Close);
   if (!mat) {
-    throw std::runtime_error("cannot write " + path + ": " + (errno != 0 ? std::strerror(errno) : "matio failed"));
+    if (errno != 0) throw std::system_error(errno, std::generic_category(), "cannot write " + path);
+    throw IoError("cannot write " + path + ": matio failed");
   }
   std::vector<std::pair<std::string, Var>> samples, units, descriptions;
   for (const auto& c : table.columns) {
@@ -322,10 +325,12 @@ void write_export_mat(const ExportTable& table, const std::string& path) {
   vars.push_back(mat_struct("info", std::move(info)));
   for (const Var& v : vars) {
     if (Mat_VarWrite(mat.get(), v.get(), MAT_COMPRESSION_ZLIB) != 0) {
-      throw std::runtime_error(fmt::format("cannot write {}: matio failed writing {}", path, v->name));
+      throw IoError(fmt::format("cannot write {}: matio failed writing {}", path, v->name));
     }
   }
-  if (Mat_Close(mat.release()) != 0) throw std::runtime_error("cannot write " + path + ": closing failed");
+  if (Mat_Close(mat.release()) != 0) {
+    throw IoError("cannot write " + path + ": closing failed");
+  }
 }
 
 std::string export_data(const DiscoveryInput& input, std::span<const std::string> effects,

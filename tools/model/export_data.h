@@ -59,10 +59,10 @@ struct ExportTable {
 [[nodiscard]] std::string params_csv_path(const std::string& csv_path);
 
 /// Writes the samples to `path` and the parameters to params_csv_path(path).
-/// Throws std::runtime_error "cannot write <path>: <reason>".
+/// Throws std::system_error "cannot write <path>: <reason>".
 void write_export_csv(const ExportTable& table, const std::string& path);
 
-/// Writes the MAT-5 file. Throws std::runtime_error "cannot write <path>: <reason>".
+/// Writes the MAT-5 file. Throws std::system_error "cannot write <path>: <reason>".
 void write_export_mat(const ExportTable& table, const std::string& path);
 
 /// The whole subcommand: prepares the rows, fits `effects`, writes the CSV (when

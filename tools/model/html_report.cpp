@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <system_error>
 
 #include "daemon/core/angles.h"
 #include "tools/model/report_assets.h"
@@ -438,11 +439,11 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
 
 void write_text_file(const std::string& path, std::string_view text) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
-  if (f == nullptr) throw std::runtime_error("cannot write " + path + ": " + std::strerror(errno));
+  if (f == nullptr) throw std::system_error(errno, std::generic_category(), "cannot write " + path);
   const bool wrote = std::fwrite(text.data(), 1, text.size(), f) == text.size();
   const int write_errno = errno;
   if (std::fclose(f) != 0 || !wrote) {
-    throw std::runtime_error("cannot write " + path + ": " + std::strerror(wrote ? errno : write_errno));
+    throw std::system_error(wrote ? errno : write_errno, std::generic_category(), "cannot write " + path);
   }
 }
 

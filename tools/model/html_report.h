@@ -23,7 +23,7 @@ namespace resolver {
 [[nodiscard]] std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, std::string_view log_path,
                                             double explained_ratio);
 
-/// Writes `text` to `path` (replacing it). Throws std::runtime_error
+/// Writes `text` to `path` (replacing it). Throws std::system_error
 /// "cannot write <path>: <reason>".
 void write_text_file(const std::string& path, std::string_view text);
 

@@ -10,10 +10,11 @@
 #include "daemon/app/pipeline.h"
 #include "daemon/app/signal_health_log.h"
 #include "daemon/decode/sample_stream.h"
+#include "daemon/service/program_errors.h"
 
 namespace resolver {
 
-LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
+LogSamples read_log_samples(const std::string& path, const std::function<void(const LogReadProgress&)>& progress,
                             const DaemonConfig& config, const LogReadOptions& options) {
   LogSamples out;
   out.input.p_r = config.bench.p_r;
@@ -47,9 +48,13 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
                           }});
   LogRecord record;
   std::int64_t since_progress = 0;
+  bool at_end = false;  // the end of the file, not of --to
   while (!stream.past_slice_end()) {
     const auto st = reader->next(record);
-    if (st == LogInput::Status::kEnd) break;
+    if (st == LogInput::Status::kEnd) {
+      at_end = true;
+      break;
+    }
     if (st == LogInput::Status::kBadLine) {
       ++out.bad_lines;
       continue;
@@ -60,29 +65,52 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(do
     } else {
       stream.feed(record.frame, reader->line_number());
     }
-    if (progress && ++since_progress >= 20000 && reader->total_bytes() > 0) {
+    if (progress && ++since_progress >= 4096) {  // a std::function call per 4096 records: not measurable
       since_progress = 0;
-      progress(static_cast<double>(reader->bytes_read()) / static_cast<double>(reader->total_bytes()));
+      progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
+                               static_cast<std::int64_t>(out.input.samples.size()), false});
     }
+  }
+  // A regular file read to its end has given exactly the bytes it had when opened.
+  // Fewer: it was truncated or replaced while read, and the samples may mix two logs.
+  // More: a log still being written (candump -l running); the samples are those read.
+  const std::uint64_t at_open = reader->total_bytes();  // 0: a FIFO, pipe or device
+  if (at_end && at_open > 0 && reader->bytes_read() < at_open) {
+    throw IoError(fmt::format("{}: the file shrank while it was read: {} bytes when opened, its end came after {} "
+                              "(truncated, or replaced by another file?); read a copy that nothing writes to",
+                              path, at_open, reader->bytes_read()));
+  }
+  if (at_end && at_open > 0 && reader->bytes_read() > at_open) {
+    out.grew_while_read = fmt::format("{} grew while it was read ({} bytes when opened, {} read to the end): a log "
+                                      "still being written; these are the samples of the bytes read, and a last "
+                                      "line cut short counts as a bad line",
+                                      path, at_open, reader->bytes_read());
+    out.notes.push_back(out.grew_while_read);
   }
   stream.flush();
   health.finish();
   out.faults = health.faults();
   out.health_samples = health.samples();
   out.outside_slice = stream.samples_outside_slice();
-  if (progress) progress(1.0);
+  if (progress) {
+    progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
+                             static_cast<std::int64_t>(out.input.samples.size()), true});
+  }
   if (out.input.samples.empty()) {
     if (options.slice.limited() && out.outside_slice > 0) {
       const std::string to = std::isfinite(options.slice.to_s) ? fmt::format(" to --to {} s", options.slice.to_s) : "";
-      throw std::runtime_error(fmt::format("{}: no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
-                                           path, options.slice.from_s, to, out.outside_slice,
-                                           stream.clock().last_t()));
+      throw InputError(Fault::kData,
+                       fmt::format("no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
+                                   options.slice.from_s, to, out.outside_slice, stream.clock().last_t()),
+                       Where::at_file(path));
     }
     const std::string layout = format == LogFormat::kCsv ? "the [input.csv] column map of " + config.source
                                                          : describe_layout(config, *decoder);
-    throw std::runtime_error(fmt::format("{}: no samples: {} {} read as {}, {} bad lines, none decoded with {}", path,
-                                         out.frames, format == LogFormat::kCsv ? "rows" : "frames",
-                                         log_format_name(format), out.bad_lines, layout));
+    throw InputError(Fault::kData,
+                     fmt::format("no samples: {} {} read as {}, {} bad lines, none decoded with {}", out.frames,
+                                 format == LogFormat::kCsv ? "rows" : "frames", log_format_name(format), out.bad_lines,
+                                 layout),
+                     Where::at_file(path));
   }
   if (!out.bench_info) {
     out.notes.push_back("p_r = " + std::to_string(out.input.p_r) + ", p = " + std::to_string(out.input.p) + " from " +

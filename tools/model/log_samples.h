@@ -29,6 +29,7 @@ struct LogSamples {
   std::int64_t problems = 0;       ///< decode problems (CRC, counters, odd time, ...)
   std::int64_t outside_slice = 0;  ///< samples before --from or after --to
   bool bench_info = false;
+  std::string grew_while_read;     ///< a log still being written: the note (also in notes) that says so
   std::vector<std::string> notes;  ///< what the log lacks, what was odd
   /// Signal health over every sample read, judged as resolverd judges it ([health],
   /// the DBC's or the CSV column's full scale): what each fault held for.
@@ -39,17 +40,27 @@ struct LogSamples {
 /// Samples each fault held for (lasting_faults(), signal_health.h, words them).
 [[nodiscard]] FaultCounts fault_counts(const LogSamples& log);
 
+/// How far read_log_samples() is: called every few thousand records and once at the end.
+struct LogReadProgress {
+  std::uint64_t bytes_read = 0;
+  std::uint64_t total_bytes = 0;  ///< 0: not known (a FIFO or pipe)
+  std::int64_t samples = 0;
+  bool done = false;  ///< the last call: the end of the log (or of --to)
+};
+
 struct LogReadOptions {
   std::optional<LogFormat> format;  ///< --format; nullopt: [input] format, else the extension
   SampleSlice slice;                ///< --from/--to [s]
 };
 
-/// Reads `path`. progress(fraction of the file's bytes) is called now and then
-/// (may be empty). Throws std::runtime_error "cannot open <path>: ..." when the
-/// file cannot be read, "<path>: no samples ..." (naming the layout in use) when
-/// nothing decodes, and ConfigError when the config's DBC, signal map or CSV
-/// column map is bad.
-[[nodiscard]] LogSamples read_log_samples(const std::string& path, const std::function<void(double)>& progress,
+/// Reads `path`. progress(how far) is called every 4096 records and at the end
+/// (may be empty). Throws std::system_error "cannot open <path>: ..." when the
+/// file cannot be read or shrank while it was read (IoError), InputError
+/// (Fault::kData) "<path>: no samples ..." (naming the layout in use) when nothing
+/// decodes, and ConfigError when the config's DBC, signal map or CSV column map is
+/// bad. A file that grew while it was read is read to the end met (grew_while_read says so).
+[[nodiscard]] LogSamples read_log_samples(const std::string& path,
+                                          const std::function<void(const LogReadProgress&)>& progress,
                                           const DaemonConfig& config = DaemonConfig{},
                                           const LogReadOptions& options = {});
 

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "daemon/app/exit_codes.h"
+#include "daemon/app/progress_meter.h"
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
 #include "daemon/core/model/model_spec.h"
@@ -44,45 +45,6 @@
 
 namespace {
 
-/// A one-line progress bar on stderr, shown only once a run has taken longer
-/// than 1.5 s (short logs stay quiet) and only when stderr is a terminal.
-/// RESOLVER_PROGRESS=1 shows it on a pipe or file too, =0 never;
-/// RESOLVER_PROGRESS_AFTER_MS changes the delay (tests use 0).
-class ProgressBar {
- public:
-  explicit ProgressBar(std::string label) : label_(std::move(label)), start_(Clock::now()) {
-    const char* mode = std::getenv("RESOLVER_PROGRESS");
-    enabled_ = mode != nullptr ? std::string_view(mode) != "0" : ::isatty(STDERR_FILENO) == 1;
-    if (const char* ms = std::getenv("RESOLVER_PROGRESS_AFTER_MS")) {
-      char* end = nullptr;
-      const long v = std::strtol(ms, &end, 10);
-      if (end != ms && *end == '\0' && v >= 0) show_after_ = std::chrono::milliseconds(v);  // else keep the default
-    }
-  }
-  void operator()(double fraction) {
-    if (!enabled_ || Clock::now() - start_ < show_after_) return;
-    const int width = 30;
-    const int filled = static_cast<int>(std::lround(std::clamp(fraction, 0.0, 1.0) * width));
-    std::fprintf(stderr, "\r%s [%.*s%*s] %3.0f%%", label_.c_str(), filled, "##############################",
-                 width - filled, "", fraction * 100.0);
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  ~ProgressBar() {
-    if (shown_) std::fprintf(stderr, "\n");
-  }
-  ProgressBar(const ProgressBar&) = delete;
-  ProgressBar& operator=(const ProgressBar&) = delete;
-
- private:
-  using Clock = std::chrono::steady_clock;
-  std::chrono::milliseconds show_after_{1500};
-  bool enabled_ = false;
-  std::string label_;
-  Clock::time_point start_;
-  bool shown_ = false;
-};
-
 /// The effect references of every --effects argument, split at the commas outside
 /// parentheses ("amplitude_imbalance,harmonics(k3,k5)" is two references).
 std::vector<std::string> split_effects(const std::vector<std::string>& args) {
@@ -95,24 +57,20 @@ std::vector<std::string> split_effects(const std::vector<std::string>& args) {
 
 /// `report`: the discovery steps, the HTML page, one summary line and where it went.
 int write_report(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
-                 resolver::DiscoveryOptions options, int max_steps, const std::string& html_out) {
+                 resolver::DiscoveryOptions options, int max_steps, const std::string& html_out,
+                 const resolver::ProgressMeter::Options& progress) {
   options.series_points = 4000;  // the samples overlay: ~22 per 2 deg angle bin (report_data.h)
   resolver::DiscoveryRun run;
   {
-    std::optional<ProgressBar> bar;  // one per step: the number of steps is not known ahead
-    options.progress = [&](double f) { (*bar)(f); };
+    std::optional<resolver::ProgressMeter> bar;  // one per step: the number of steps is not known ahead
+    options.progress = [&](double f) { bar->fraction(f); };
     run = resolver::run_discovery(samples.input, effects, options, max_steps, [&](int step) {
       bar.reset();
-      bar.emplace("step " + std::to_string(step) + ": explaining");
+      bar.emplace(stderr, "step " + std::to_string(step) + ": explaining", progress);
     });
   }
   const std::string page = resolver::format_model_html(run, samples, log, options.explained_ratio);
-  try {
-    resolver::write_text_file(html_out, page);
-  } catch (const std::runtime_error& e) {
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kIo;
-  }
+  resolver::write_text_file(html_out, page);  // throws std::system_error: exit 3
   std::cout << resolver::summarize_discovery(run) << "\n"
             << "wrote " << html_out << " (" << (page.size() + 512) / 1024 << " KiB)\n";
   return 0;
@@ -219,6 +177,7 @@ int run(int argc, char** argv) {
                     "the config's [[model.custom]] names (default amplitude_imbalance); fittable: " + fittable);
     sub->add_flag("--json", json, "print one JSON object instead of the text report");
   };
+  bool progress = false;
   std::string direction = "both";
   bool moving_only = false;
   bool reference_aligned = false;
@@ -246,6 +205,9 @@ int run(int argc, char** argv) {
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--to", slice.to_s, "use samples up to this time [s, from the log's first sample]")
         ->check(CLI::NonNegativeNumber);
+    sub->add_flag("--progress", progress,
+                  "show progress on stderr (bytes read of the total, samples, rate, ETA; then the fit) even when it "
+                  "is not a terminal, one line per update; on a terminal it is shown anyway once a run takes 1.5 s");
   };
   CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
   CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
@@ -313,7 +275,7 @@ int run(int argc, char** argv) {
     std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
     return resolver::exit_code::kUsage;
   }
-  try {
+  {
     resolver::DaemonConfig config;
     if (!config_path.empty()) config = resolver::load_daemon_config(config_path);  // throws naming file and key
     std::vector<std::string> effects = split_effects(effects_args);
@@ -323,19 +285,22 @@ int run(int argc, char** argv) {
       try {
         (void)resolver::ModelSpec::parse(effects, config.model.customs.get());
       } catch (const std::invalid_argument& e) {
-        std::cerr << "resolver-model: --effects: " << e.what() << "\n";
-        return resolver::exit_code::kUsage;
+        throw resolver::InputError(resolver::Fault::kUsage, e.what(), resolver::Where::at_option("--effects"));
       }
     }
     if (effects.empty()) effects = config.model.effects;  // default ["amplitude_imbalance"]
     resolver::LogSamples samples;
+    const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(progress);
     {
-      ProgressBar bar("reading " + log);
+      resolver::ProgressMeter bar(stderr, "reading " + log, shown);
       resolver::LogReadOptions read_options;
       read_options.format = resolver::log_format_from_name(format_name);
       read_options.slice = slice;
-      samples = resolver::read_log_samples(log, [&](double f) { bar(f); }, config, read_options);
+      samples = resolver::read_log_samples(
+          log, [&](const resolver::LogReadProgress& p) { bar.bytes(p.bytes_read, p.total_bytes, p.samples, p.done); },
+          config, read_options);
     }
+    if (!samples.grew_while_read.empty()) std::cerr << "resolver-model: warning: " << samples.grew_while_read << "\n";
     resolver::DiscoveryOptions options;
     options.max_report_order = resolver::kOfflineReportOrder;
     options.harmonic_families = true;
@@ -351,18 +316,27 @@ int run(int argc, char** argv) {
     for (const std::string& f : resolver::lasting_faults(faults, samples.health_samples, 0.0)) {
       samples.notes.push_back("signal health: " + f);
     }
-    if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out);
-    if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
-    if (export_data->parsed()) {
-      std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
-      return 0;
+    // The effects were checked before the log was read: what the fit refuses now
+    // (too few samples, the rotor hardly moves, no angle signal) is the data's fault.
+    try {
+      if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out, shown);
+      if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
+      if (export_data->parsed()) {
+        std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
+        return 0;
+      }
+    } catch (const std::invalid_argument& e) {
+      throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
     }
     resolver::Explanation ex;
-    {
-      ProgressBar bar("fitting");
-      options.progress = [&](double f) { bar(f); };
+    try {
+      resolver::ProgressMeter bar(stderr, "fitting", shown);
+      options.progress = [&](double f) { bar.fraction(f); };
       if (do_explain) ex = resolver::explain_model(samples.input, effects, options);
       else ex.fit = resolver::fit_model(samples.input, effects, options);
+      bar.fraction(1.0);  // fit_model reports only its first steps
+    } catch (const std::invalid_argument& e) {
+      throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
     }
     std::vector<std::string> notes = samples.notes;
     if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
@@ -370,23 +344,13 @@ int run(int argc, char** argv) {
     std::cout << (json ? resolver::format_model_json(ex, do_explain, notes)
                        : resolver::format_model_text(ex, do_explain, notes));
     return 0;
-  } catch (const resolver::ConfigError& e) {
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kUsage;
-  } catch (const std::exception& e) {
-    // Too few samples, nothing decoded: the log had nothing usable to fit.
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kNoUsableData;
   }
 }
 
 }  // namespace
 
+// Every failure not answered above is an exception: the one rule of program_errors.h
+// gives its exit code (a config error 2, no usable data 1, a failed write 3, out of memory 4).
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {  // e.g. out of memory while building the command line
-    std::cerr << "resolver-model: " << e.what() << "\n";
-    return resolver::exit_code::kInternal;
-  }
+  return resolver::run_program("resolver-model", [&] { return run(argc, argv); });
 }

@@ -207,9 +207,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
   return c;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   CLI::App app{
       "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
       "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects.",
@@ -277,7 +275,8 @@ int main(int argc, char** argv) {
                fps, kBusFramesPerSecond);
   }
 
-  try {
+  // The log that cannot be created or written throws std::system_error: exit 3.
+  {
     resolver::CandumpWriter writer(o.out);
     resolver::SimSample s{};
     std::vector<resolver::CanFrame> frames;
@@ -308,8 +307,13 @@ int main(int argc, char** argv) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     fmt::print(stderr, "resolver-sim: wrote {} frames ({} samples, {:.3g} s of bench time) to {} in {:.2f} s\n",
                writer.frames_written(), total, sim->profile().duration(), o.out, wall);
-  } catch (const std::exception& e) {
-    fail(e.what(), resolver::exit_code::kIo);  // the log could not be opened or written
   }
   return 0;
+}
+
+}  // namespace
+
+// What run() throws gets its exit code from the one rule (daemon/service/program_errors.h).
+int main(int argc, char** argv) {
+  return resolver::run_program("resolver-sim", [&] { return run(argc, argv); });
 }
