@@ -159,26 +159,10 @@ void check_turns_with_reference(const std::vector<const Sample*>& s, const std::
   }
 }
 
-}  // namespace
 
-std::int64_t PreparedLog::fitted_rows() const {
-  return std::count_if(rows.begin(), rows.end(), [](const FitRow& r) { return r.fitted(); });
-}
-
-std::int64_t PreparedLog::outlier_rows() const {
-  return std::count_if(rows.begin(), rows.end(), [](const FitRow& r) { return r.has(FitRow::kOutlier); });
-}
-
-double PreparedLog::electrical_revolutions() const { return motion.travelled * p_r / kTwoPi; }
-
-PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
-  if (in.p_r < 1 || in.p < 1) {
-    throw std::invalid_argument(fmt::format("pole pairs p_r = {} and p = {} must be >= 1", in.p_r, in.p));
-  }
-  PreparedLog p;
-  p.p_r = in.p_r;
-  p.p = in.p;
-  p.samples_in = static_cast<std::int64_t>(in.samples.size());
+/// Which signals the log carries (each in at least 90 % of its samples), and the
+/// notes on what that leaves out. Returns whether phase currents are there.
+bool detect_signals(const DiscoveryInput& in, const PrepareOptions& opt, PreparedLog& p) {
   std::size_t with_rd = 0, with_sc = 0, with_ref = 0, with_cur = 0;
   for (const Sample& s : in.samples) {
     with_rd += s.has_rd ? 1 : 0;
@@ -215,8 +199,12 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   if (!p.rd) p.notes.emplace_back("no R/D angle: the position error is the sin/cos angle's");
   if (!currents) p.notes.emplace_back("no phase currents in the log: current-side effects are not evaluated");
   else if (!p.reference) p.notes.emplace_back("phase currents present but not fitted without a reference angle (dq needs the true theta_e)");
+  return currents;
+}
 
-  // The samples the fit can use: a primary angle, and the reference in reference mode.
+/// The samples the fit can use: a primary angle, and the reference in reference
+/// mode (the others counted in `p`).
+std::vector<const Sample*> usable_samples(const DiscoveryInput& in, PreparedLog& p) {
   std::vector<const Sample*> s;
   s.reserve(in.samples.size());
   for (const Sample& x : in.samples) {
@@ -231,63 +219,74 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
     }
     s.push_back(&x);
   }
-  const std::size_t n = s.size();
-  if (n < static_cast<std::size_t>(kMinMovingSamples)) {
-    throw std::invalid_argument(fmt::format("too few samples with an angle ({}): nothing to fit", n));
+  if (s.size() < static_cast<std::size_t>(kMinMovingSamples)) {
+    throw std::invalid_argument(fmt::format("too few samples with an angle ({}): nothing to fit", s.size()));
   }
+  return s;
+}
+
+/// [s] each sample's time from the first; sets the median sample period.
+std::vector<double> sample_times(const std::vector<const Sample*>& s, PreparedLog& p) {
+  const std::size_t n = s.size();
   std::vector<double> t(n), dts;
   for (std::size_t i = 0; i < n; ++i) t[i] = s[i]->t - s.front()->t;
   dts.reserve(n);
   for (std::size_t i = 1; i < n; ++i) dts.push_back(t[i] - t[i - 1]);
   p.sample_period = std::max(median(dts), 1e-9);
+  return t;
+}
 
-  // Envelope amplitude [counts]: the median radius (robust to outliers and clipping).
-  if (p.sincos) {
-    std::vector<double> radius;
-    radius.reserve(n);
-    for (const Sample* x : s) {
-      if (x->has_sincos) radius.push_back(std::hypot(x->sin, x->cos));
-    }
-    p.amplitude = median(radius);
-    if (!(p.amplitude > 0.0)) {
-      p.sincos = false;
-      p.notes.emplace_back("sin/cos envelopes are zero: loss of signal; the sin/cos rows are not fitted");
-    }
+/// Envelope amplitude [counts]: the median radius (robust to outliers and clipping).
+void measure_amplitude(const std::vector<const Sample*>& s, PreparedLog& p) {
+  std::vector<double> radius;
+  radius.reserve(s.size());
+  for (const Sample* x : s) {
+    if (x->has_sincos) radius.push_back(std::hypot(x->sin, x->cos));
   }
-  // Primary measured angle (wrapped) per sample.
-  std::vector<double> primary(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    primary[i] = p.rd ? wrap_2pi(s[i]->theta_rd) : wrap_2pi(std::atan2(s[i]->sin, s[i]->cos));
+  p.amplitude = median(radius);
+  if (!(p.amplitude > 0.0)) {
+    p.sincos = false;
+    p.notes.emplace_back("sin/cos envelopes are zero: loss of signal; the sin/cos rows are not fitted");
   }
-  // True angle and motion.
-  std::vector<double> theta(n), theta_m(n);
+}
+
+/// The true angle of every sample and the motion: from the reference, or else
+/// self-calibrated from the primary angle.
+struct TrueAngles {
+  std::vector<double> theta, theta_m;
   std::vector<MotionSample> motion;
-  std::vector<bool> usable(n, true);
+  std::vector<bool> usable;
+};
+
+TrueAngles true_angles(const std::vector<const Sample*>& s, const std::vector<double>& t, PreparedLog& p) {
+  const std::size_t n = s.size();
+  TrueAngles a{std::vector<double>(n), std::vector<double>(n), {}, std::vector<bool>(n, true)};
   if (p.reference) {
     AngleUnwrapper un;
     for (std::size_t i = 0; i < n; ++i) {
-      theta_m[i] = un.update(wrap_2pi(s[i]->theta_m_ref));
-      theta[i] = p.p_r * theta_m[i];
+      a.theta_m[i] = un.update(wrap_2pi(s[i]->theta_m_ref));
+      a.theta[i] = p.p_r * a.theta_m[i];
     }
-    motion = analyse_motion(t, theta_m, p.motion);
-    check_turns_with_reference(s, theta, motion, p.rd, p.sincos, p.p_r);
+    a.motion = analyse_motion(t, a.theta_m, p.motion);
+    check_turns_with_reference(s, a.theta, a.motion, p.rd, p.sincos, p.p_r);
   } else {
-    std::vector<double> cont(n), mech(n);
+    std::vector<double> primary(n), cont(n), mech(n);
     AngleUnwrapper un;
     for (std::size_t i = 0; i < n; ++i) {
+      primary[i] = p.rd ? wrap_2pi(s[i]->theta_rd) : wrap_2pi(std::atan2(s[i]->sin, s[i]->cos));
       cont[i] = un.update(primary[i]);
       mech[i] = cont[i] / p.p_r;
     }
     MotionSummary raw_motion;
-    motion = analyse_motion(t, mech, raw_motion);
-    const SelfCalibration cal = self_calibrate(t, cont, primary, motion, p.sample_period);
+    const std::vector<MotionSample> raw = analyse_motion(t, mech, raw_motion);
+    const SelfCalibration cal = self_calibrate(t, cont, primary, raw, p.sample_period);
     p.unusable_self_calibration = cal.unusable;
     for (std::size_t i = 0; i < n; ++i) {
-      theta[i] = cal.ideal[i];
-      theta_m[i] = theta[i] / p.p_r;
-      usable[i] = cal.usable[i];
+      a.theta[i] = cal.ideal[i];
+      a.theta_m[i] = a.theta[i] / p.p_r;
+      a.usable[i] = cal.usable[i];
     }
-    motion = analyse_motion(t, theta_m, p.motion);
+    a.motion = analyse_motion(t, a.theta_m, p.motion);
     if (cal.unusable > 0) {
       p.notes.push_back(fmt::format("{} moving samples are in stretches shorter than one electrical revolution: "
                                     "without a reference they cannot be self-calibrated and are not fitted",
@@ -298,103 +297,124 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
     throw std::invalid_argument(fmt::format("the rotor hardly moves: {}; at least {} moving samples are needed",
                                             motion_words(p.motion, p.p_r), kMinMovingSamples));
   }
-  // Travel since the last reversal, from its turning point (backlash's take-up).
+  return a;
+}
+
+/// [rad, mechanical] travel since the last reversal, from its turning point
+/// (backlash's take-up); infinity before the first reversal.
+std::vector<double> travel_since_reversal(const TrueAngles& a) {
+  const std::size_t n = a.theta_m.size();
   std::vector<double> since(n, std::numeric_limits<double>::infinity());
-  {
-    double held = motion.empty() ? 1.0 : motion.front().direction;
-    double extremum = theta_m.empty() ? 0.0 : theta_m.front();
-    double turning = 0.0;
-    bool reversed = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (motion[i].direction != held) {
-        turning = extremum;
-        reversed = true;
-        held = motion[i].direction;
-        extremum = theta_m[i];
-      }
-      extremum = held > 0.0 ? std::max(extremum, theta_m[i]) : std::min(extremum, theta_m[i]);
-      if (reversed) since[i] = std::abs(theta_m[i] - turning);
+  double held = a.motion.empty() ? 1.0 : a.motion.front().direction;
+  double extremum = a.theta_m.empty() ? 0.0 : a.theta_m.front();
+  double turning = 0.0;
+  bool reversed = false;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (a.motion[i].direction != held) {
+      turning = extremum;
+      reversed = true;
+      held = a.motion[i].direction;
+      extremum = a.theta_m[i];
     }
+    extremum = held > 0.0 ? std::max(extremum, a.theta_m[i]) : std::min(extremum, a.theta_m[i]);
+    if (reversed) since[i] = std::abs(a.theta_m[i] - turning);
   }
-  // Rows.
+  return since;
+}
+
+/// One fit row per usable sample: its angles and motion, which rows are fitted,
+/// and the measured errors of every signal.
+void build_rows(const DiscoveryInput& in, const std::vector<const Sample*>& s, const std::vector<double>& t,
+                const TrueAngles& a, bool currents, const PrepareOptions& opt, PreparedLog& p) {
+  const std::size_t n = s.size();
+  const std::vector<double> since = travel_since_reversal(a);
   p.rows.resize(n);
   p.sample_of_row.resize(n);
   for (std::size_t i = 0; i < n; ++i) p.sample_of_row[i] = static_cast<std::size_t>(s[i] - in.samples.data());
-  double i_d0 = 0.0, i_q0 = 0.0;
-  std::int64_t n_cur = 0;
   for (std::size_t i = 0; i < n; ++i) {
     FitRow& r = p.rows[i];
     const Sample& x = *s[i];
+    const MotionSample& m = a.motion[i];
     r.sig.t = t[i];
-    r.sig.theta = theta[i];
-    r.sig.theta_m = theta_m[i];
-    r.sig.omega = motion[i].omega * p.p_r;
-    r.sig.accel = motion[i].accel * p.p_r;
-    r.sig.direction = motion[i].direction;
+    r.sig.theta = a.theta[i];
+    r.sig.theta_m = a.theta_m[i];
+    r.sig.omega = m.omega * p.p_r;
+    r.sig.accel = m.accel * p.p_r;
+    r.sig.direction = m.direction;
     r.sig.since_reversal = since[i];
     r.sig.p_r = p.p_r;
     r.sig.p = p.p;
-    if (motion[i].moving && usable[i]) r.flags |= FitRow::kMoving;
-    const bool wrong_way = (opt.direction == DirectionFilter::kForward && motion[i].direction < 0.0) ||
-                           (opt.direction == DirectionFilter::kBackward && motion[i].direction > 0.0);
+    if (m.moving && a.usable[i]) r.flags |= FitRow::kMoving;
+    const bool wrong_way = (opt.direction == DirectionFilter::kForward && m.direction < 0.0) ||
+                           (opt.direction == DirectionFilter::kBackward && m.direction > 0.0);
     if (wrong_way && r.has(FitRow::kMoving)) {
       r.flags &= static_cast<std::uint16_t>(~FitRow::kMoving);
       r.flags |= FitRow::kExcluded;
       ++p.excluded_direction;
     }
     if (opt.moving_only && !r.has(FitRow::kMoving)) r.flags |= FitRow::kExcluded;
-    if (!usable[i]) r.flags |= FitRow::kExcluded;
+    if (!a.usable[i]) r.flags |= FitRow::kExcluded;
     if (p.rd && x.has_rd) {
-      r.y_rd = wrap_pi(theta[i] - x.theta_rd);
+      r.y_rd = wrap_pi(a.theta[i] - x.theta_rd);
       r.flags |= FitRow::kHasRd;
     }
     if (p.sincos && x.has_sincos) {
-      r.y_sa = wrap_pi(theta[i] - std::atan2(x.sin, x.cos));
+      r.y_sa = wrap_pi(a.theta[i] - std::atan2(x.sin, x.cos));
       r.y_sr = std::hypot(x.sin, x.cos) / p.amplitude - 1.0;
       r.flags |= FitRow::kHasSc;
     }
     if (currents && p.reference && x.has_currents) {
-      r.sig.theta_e = p.p * theta_m[i];
+      r.sig.theta_e = p.p * a.theta_m[i];
       const ClarkeTransform ab(x.i_a, x.i_b, x.i_c);
       const ParkTransform dq(ab.alpha, ab.beta, r.sig.theta_e);
       r.y_d = dq.d;
       r.y_q = dq.q;
       r.flags |= FitRow::kHasCur;
-      if (r.has(FitRow::kMoving)) {
-        i_d0 += dq.d;
-        i_q0 += dq.q;
-        ++n_cur;
-      }
     }
+  }
+}
+
+/// The operating point of the currents: i_d, i_q averaged over the moving rows,
+/// given to every row. Sets p.currents to whether any row has them.
+void set_current_operating_point(PreparedLog& p) {
+  double i_d0 = 0.0, i_q0 = 0.0;
+  std::int64_t n_cur = 0;
+  for (const FitRow& r : p.rows) {
+    if (!r.has(FitRow::kHasCur) || !r.has(FitRow::kMoving)) continue;
+    i_d0 += r.y_d;
+    i_q0 += r.y_q;
+    ++n_cur;
   }
   p.currents = n_cur > 0;
-  if (n_cur > 0) {
-    i_d0 /= static_cast<double>(n_cur);
-    i_q0 /= static_cast<double>(n_cur);
-    for (FitRow& r : p.rows) {
-      r.sig.i_d0 = i_d0;
-      r.sig.i_q0 = i_q0;
-    }
+  if (n_cur == 0) return;
+  i_d0 /= static_cast<double>(n_cur);
+  i_q0 /= static_cast<double>(n_cur);
+  for (FitRow& r : p.rows) {
+    r.sig.i_d0 = i_d0;
+    r.sig.i_q0 = i_q0;
   }
-  // A position error is known modulo 2 pi. Near +-pi (a reference whose zero is
-  // half a turn from the resolver's: any real bench's encoder) wrapping to
-  // (-pi, pi] would cut the error in two; put the cut opposite its circular mean.
-  auto recenter = [&](FitRow::Flag has, double FitRow::*field) {
-    double sx = 0.0, sy = 0.0;
-    for (const FitRow& r : p.rows) {
-      if (!r.has(has)) continue;
-      sx += std::cos(r.*field);
-      sy += std::sin(r.*field);
-    }
-    if (sx == 0.0 && sy == 0.0) return;
-    const double centre = std::atan2(sy, sx);
-    for (FitRow& r : p.rows) {
-      if (r.has(has)) r.*field = centre + wrap_pi(r.*field - centre);
-    }
-  };
-  if (p.rd) recenter(FitRow::kHasRd, &FitRow::y_rd);
-  if (p.sincos) recenter(FitRow::kHasSc, &FitRow::y_sa);
-  // Outliers, per signal over consecutive samples.
+}
+
+/// A position error is known modulo 2 pi. Near +-pi (a reference whose zero is
+/// half a turn from the resolver's: any real bench's encoder) wrapping to
+/// (-pi, pi] would cut the error in two; put the cut opposite its circular mean.
+void recenter(PreparedLog& p, FitRow::Flag has, double FitRow::*field) {
+  double sx = 0.0, sy = 0.0;
+  for (const FitRow& r : p.rows) {
+    if (!r.has(has)) continue;
+    sx += std::cos(r.*field);
+    sy += std::sin(r.*field);
+  }
+  if (sx == 0.0 && sy == 0.0) return;
+  const double centre = std::atan2(sy, sx);
+  for (FitRow& r : p.rows) {
+    if (r.has(has)) r.*field = centre + wrap_pi(r.*field - centre);
+  }
+}
+
+/// Outliers, per signal over consecutive samples: flagged rows, counted per signal.
+void flag_outliers(const std::vector<double>& t, PreparedLog& p) {
+  const std::size_t n = p.rows.size();
   std::vector<bool> flags(n, false), ok(n);
   std::vector<double> y(n);
   auto scan = [&](FitRow::Flag has, double FitRow::*field, const std::string& name) {
@@ -425,10 +445,13 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   for (std::size_t i = 0; i < n; ++i) {
     if (flags[i]) p.rows[i].flags |= FitRow::kOutlier;
   }
-  p.fold_rule = assign_folds(p.rows, p);
-  // Quanta of the raw channels and the floors.
+}
+
+/// The raw channels' quanta and every signal's noise floor; a signal whose floor
+/// cannot be estimated is not fitted (the position error's is required).
+void measure_floors(const std::vector<const Sample*>& s, const PrepareOptions& opt, PreparedLog& p) {
   std::vector<double> v;
-  v.reserve(n);
+  v.reserve(s.size());
   auto quantum = [&](auto get) {
     v.clear();
     for (const Sample* x : s) v.push_back(get(*x));
@@ -453,6 +476,40 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
     p.currents = false;
     p.notes.emplace_back("phase currents present but their noise floor could not be estimated: not fitted");
   }
+}
+
+}  // namespace
+
+std::int64_t PreparedLog::fitted_rows() const {
+  return std::count_if(rows.begin(), rows.end(), [](const FitRow& r) { return r.fitted(); });
+}
+
+std::int64_t PreparedLog::outlier_rows() const {
+  return std::count_if(rows.begin(), rows.end(), [](const FitRow& r) { return r.has(FitRow::kOutlier); });
+}
+
+double PreparedLog::electrical_revolutions() const { return motion.travelled * p_r / kTwoPi; }
+
+PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
+  if (in.p_r < 1 || in.p < 1) {
+    throw std::invalid_argument(fmt::format("pole pairs p_r = {} and p = {} must be >= 1", in.p_r, in.p));
+  }
+  PreparedLog p;
+  p.p_r = in.p_r;
+  p.p = in.p;
+  p.samples_in = static_cast<std::int64_t>(in.samples.size());
+  const bool currents = detect_signals(in, opt, p);
+  const std::vector<const Sample*> s = usable_samples(in, p);
+  const std::vector<double> t = sample_times(s, p);
+  if (p.sincos) measure_amplitude(s, p);
+  const TrueAngles angles = true_angles(s, t, p);
+  build_rows(in, s, t, angles, currents, opt, p);
+  set_current_operating_point(p);
+  if (p.rd) recenter(p, FitRow::kHasRd, &FitRow::y_rd);
+  if (p.sincos) recenter(p, FitRow::kHasSc, &FitRow::y_sa);
+  flag_outliers(t, p);
+  p.fold_rule = assign_folds(p.rows, p);
+  measure_floors(s, opt, p);
   return p;
 }
 
