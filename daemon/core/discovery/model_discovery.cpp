@@ -115,6 +115,128 @@ std::vector<std::string_view> fittable_effects() {
   return out;
 }
 
+namespace {
+
+/// The nuisance constants at the solution (the last step solved them from zero),
+/// into f.nuisance; returned as the residual pass measures about them.
+NuisanceValues nuisance_at_solution(const Design& d, const FitResult& fr, ModelFit& f) {
+  NuisanceValues nv;
+  for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
+    const double v = fr.last.dz[static_cast<Eigen::Index>(j)];
+    // The position errors' constants: the prediction carries -frame_shift (design.h),
+    // the solution what is left.
+    double total = v;
+    switch (d.nuisances()[j]) {
+      case Nuisance::kRdConstant: nv.rd = v; total -= d.frame_shift(); break;
+      case Nuisance::kSaConstant: nv.sa = v; total -= d.frame_shift(); break;
+      case Nuisance::kScGain: nv.sr = v; break;
+      case Nuisance::kIdConstant: nv.d = v; break;
+      case Nuisance::kIqConstant: nv.q = v; break;
+    }
+    f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])), total, kNaN, ""});
+  }
+  return nv;
+}
+
+/// The parameters' covariance: from the revolution-to-revolution spread of the
+/// scores when the log has enough revolutions (honest with correlated residuals),
+/// else formal. Sets f.robust_errors.
+Eigen::MatrixXd parameter_covariance(const StepSolution& s, const ResidualPass& pass, const std::vector<int>& cols,
+                                     ModelFit& f) {
+  const double dof = static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k);
+  Eigen::MatrixXd cov = s.inverse * (s.rss_w / std::max(dof, 1.0));
+  if (pass.blocks < kMinRobustBlocks) return cov;
+  const auto k = static_cast<Eigen::Index>(cols.size());
+  Eigen::MatrixXd m_inv(k, k);
+  for (Eigen::Index a = 0; a < k; ++a) {
+    for (Eigen::Index b = 0; b < k; ++b) m_inv(a, b) = s.inverse(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
+  }
+  const double correction = static_cast<double>(pass.blocks) / (pass.blocks - 1.0);
+  const Eigen::MatrixXd robust = m_inv * pass.score_outer * m_inv * correction;
+  for (Eigen::Index a = 0; a < k; ++a) {
+    for (Eigen::Index b = 0; b < k; ++b) {
+      cov(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]) = robust(a, b);
+    }
+  }
+  f.robust_errors = true;
+  return cov;
+}
+
+/// Every fitted signal's residual against its floor, raw and held back, into
+/// f.signals; a residual whose evaluated and linearised figures differ marks the
+/// fit unconverged (the notes say which).
+std::vector<std::string> signal_residuals(const PreparedLog& log, const FitResult& fr, const ResidualPass& pass,
+                                          const StepSolution& raw, const GroupFloors& floors,
+                                          const std::vector<int>& cols, ModelFit& f) {
+  const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
+  std::vector<std::string> convergence_notes;
+  const double gf[kGroups] = {floors.rd, floors.sc, floors.cur};
+  const StepSolution& s = fr.last;
+  for (int g = 0; g < kGroups; ++g) {
+    if (!(gf[g] > 0.0) || s.n[g] == 0) continue;
+    SignalResidual r;
+    r.signal = names[g];
+    // The residual with the prediction evaluated at the fitted values. The step's
+    // own figure is linearised; where they differ the fit has not converged (a
+    // nonlinear parameter at its bound, or out of passes) and the evaluated one is
+    // what the data says.
+    r.rms = rms(pass.rss[g], pass.n[g]);
+    const double linearised = rms(s.rss[g], s.n[g]);
+    if (std::abs(r.rms - linearised) > 0.01 * std::max(r.rms, gf[g])) {
+      f.converged = false;
+      convergence_notes.push_back(fmt::format("{}: the fit did not converge: evaluated residual {:.4g} against its linearised "
+                                    "{:.4g} (a nonlinear parameter at its bound, or the passes ran out)",
+                                    names[g], r.rms, linearised));
+    }
+    r.floor = gf[g];
+    r.raw_rms = rms(raw.rss[g], raw.n[g]);
+    r.held_back_rms = held_back_rms(fr.stats, floors, cols, static_cast<Group>(g));
+    r.rows = s.n[g];
+    r.rms_with_outliers = rms(pass.rss_with_outliers[g], pass.n_with_outliers[g]);
+    f.signals.push_back(r);
+  }
+  if (!log.rd && log.sincos) {
+    // Without an R/D angle the position error is the sin/cos angle's.
+    SignalResidual r;
+    r.signal = "position_error";
+    r.rms = rms(pass.rss_position, pass.n_position);
+    r.floor = floors.sc;
+    r.raw_rms = kNaN;
+    r.held_back_rms = kNaN;
+    r.rows = pass.n_position;
+    f.signals.insert(f.signals.begin(), r);
+  }
+  return convergence_notes;
+}
+
+/// The residual pass's breakdowns as the fit reports them.
+void take_breakdowns(const ResidualPass& pass, ModelFit& f) {
+  f.rms_with_outliers_rad = rms(pass.rss_position_with_outliers, pass.n_position_with_outliers);
+  f.harmonics = pass.harmonics;
+  f.harmonics_mech = pass.harmonics_mech;
+  f.harmonics_id = pass.harmonics_id;
+  f.harmonics_iq = pass.harmonics_iq;
+  f.speed_bins = pass.speed_bins;
+  f.time_bins = pass.time_bins;
+  f.directions = pass.directions;
+  f.whiteness = pass.whiteness;
+  f.series = pass.series;
+}
+
+/// Explained: every signal at its floor, in-sample and held back, and no outliers
+/// that matter (the residual with them included also at the floor).
+bool at_floor(const ModelFit& f, double explained_ratio) {
+  bool ok = !f.signals.empty() && f.converged;
+  for (const SignalResidual& r : f.signals) {
+    if (r.rms > explained_ratio * r.floor) ok = false;
+    if (std::isfinite(r.held_back_rms) && r.held_back_rms > explained_ratio * r.floor) ok = false;
+    if (!f.outliers.empty() && r.rms_with_outliers > explained_ratio * r.floor) ok = false;
+  }
+  return ok;
+}
+
+}  // namespace
+
 ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effects, const DiscoveryOptions& options) {
   const ModelSpec spec = ModelSpec::parse(effects, options.customs);
   check_model_against_log(spec, log);
@@ -141,96 +263,16 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   accumulate(raw, log.rows, floors, raw_stats);
   ++f.passes;
   const StepSolution raw_sol = solve_step(raw_stats.all, floors);
-  // The nuisance constants at the solution (the last step solved them from zero).
-  NuisanceValues nv;
-  for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
-    const double v = fr.last.dz[static_cast<Eigen::Index>(j)];
-    // The position errors' constants: the prediction carries -frame_shift (design.h),
-    // the solution what is left.
-    double total = v;
-    switch (d.nuisances()[j]) {
-      case Nuisance::kRdConstant: nv.rd = v; total -= d.frame_shift(); break;
-      case Nuisance::kSaConstant: nv.sa = v; total -= d.frame_shift(); break;
-      case Nuisance::kScGain: nv.sr = v; break;
-      case Nuisance::kIdConstant: nv.d = v; break;
-      case Nuisance::kIqConstant: nv.q = v; break;
-    }
-    f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])), total, kNaN, ""});
-  }
+  const NuisanceValues nv = nuisance_at_solution(d, fr, f);
   // One pass at the solution: breakdowns, whiteness, robust scores, series.
   const ResidualPass pass = residual_pass(d, log, floors, cols, options, nv);
   ++f.passes;
   const StepSolution& s = fr.last;
-  // Standard errors: from the revolution-to-revolution spread of the scores when the
-  // log has enough revolutions (honest with correlated residuals), else formal.
-  const double dof = static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k);
-  Eigen::MatrixXd cov = s.inverse * (s.rss_w / std::max(dof, 1.0));
-  if (pass.blocks >= kMinRobustBlocks) {
-    const auto k = static_cast<Eigen::Index>(cols.size());
-    Eigen::MatrixXd m_inv(k, k);
-    for (Eigen::Index a = 0; a < k; ++a) {
-      for (Eigen::Index b = 0; b < k; ++b) m_inv(a, b) = s.inverse(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
-    }
-    const double correction = static_cast<double>(pass.blocks) / (pass.blocks - 1.0);
-    const Eigen::MatrixXd robust = m_inv * pass.score_outer * m_inv * correction;
-    for (Eigen::Index a = 0; a < k; ++a) {
-      for (Eigen::Index b = 0; b < k; ++b) {
-        cov(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]) = robust(a, b);
-      }
-    }
-    f.robust_errors = true;
-  }
-  fill_params(f, d, cov);
-  // Signals.
-  const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
-  std::vector<std::string> convergence_notes;
-  const double gf[kGroups] = {floors.rd, floors.sc, floors.cur};
-  for (int g = 0; g < kGroups; ++g) {
-    if (!(gf[g] > 0.0) || s.n[g] == 0) continue;
-    SignalResidual r;
-    r.signal = names[g];
-    // The residual with the prediction evaluated at the fitted values. The step's
-    // own figure is linearised; where they differ the fit has not converged (a
-    // nonlinear parameter at its bound, or out of passes) and the evaluated one is
-    // what the data says.
-    r.rms = rms(pass.rss[g], pass.n[g]);
-    const double linearised = rms(s.rss[g], s.n[g]);
-    if (std::abs(r.rms - linearised) > 0.01 * std::max(r.rms, gf[g])) {
-      f.converged = false;
-      convergence_notes.push_back(fmt::format("{}: the fit did not converge: evaluated residual {:.4g} against its linearised "
-                                    "{:.4g} (a nonlinear parameter at its bound, or the passes ran out)",
-                                    names[g], r.rms, linearised));
-    }
-    r.floor = gf[g];
-    r.raw_rms = rms(raw_sol.rss[g], raw_sol.n[g]);
-    r.held_back_rms = held_back_rms(fr.stats, floors, cols, static_cast<Group>(g));
-    r.rows = s.n[g];
-    r.rms_with_outliers = rms(pass.rss_with_outliers[g], pass.n_with_outliers[g]);
-    f.signals.push_back(r);
-  }
-  if (!log.rd && log.sincos) {
-    // Without an R/D angle the position error is the sin/cos angle's.
-    SignalResidual r;
-    r.signal = "position_error";
-    r.rms = rms(pass.rss_position, pass.n_position);
-    r.floor = floors.sc;
-    r.raw_rms = kNaN;
-    r.held_back_rms = kNaN;
-    r.rows = pass.n_position;
-    f.signals.insert(f.signals.begin(), r);
-  }
+  fill_params(f, d, parameter_covariance(s, pass, cols, f));
+  const std::vector<std::string> convergence_notes = signal_residuals(log, fr, pass, raw_sol, floors, cols, f);
   f.residual_rms_rad = f.signals.empty() ? 0.0 : f.signals.front().rms;
   f.noise_floor_rad = f.signals.empty() ? 0.0 : f.signals.front().floor;
-  f.rms_with_outliers_rad = rms(pass.rss_position_with_outliers, pass.n_position_with_outliers);
-  f.harmonics = pass.harmonics;
-  f.harmonics_mech = pass.harmonics_mech;
-  f.harmonics_id = pass.harmonics_id;
-  f.harmonics_iq = pass.harmonics_iq;
-  f.speed_bins = pass.speed_bins;
-  f.time_bins = pass.time_bins;
-  f.directions = pass.directions;
-  f.whiteness = pass.whiteness;
-  f.series = pass.series;
+  take_breakdowns(pass, f);
   f.floors = log.floors;
   f.account = account_of(log);
   f.outliers = log.outliers;
@@ -242,18 +284,10 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   f.currents_used = log.currents;
   f.notes = log.notes;
   f.notes.insert(f.notes.end(), convergence_notes.begin(), convergence_notes.end());
-  // Explained: every signal at its floor, in-sample and held back, and no outliers
-  // that matter (the residual with them included also at the floor).
-  bool ok = !f.signals.empty() && f.converged;
-  for (const SignalResidual& r : f.signals) {
-    if (r.rms > options.explained_ratio * r.floor) ok = false;
-    if (std::isfinite(r.held_back_rms) && r.held_back_rms > options.explained_ratio * r.floor) ok = false;
-    if (!f.outliers.empty() && r.rms_with_outliers > options.explained_ratio * r.floor) ok = false;
-  }
   // Faulty signals for a large part of the log (a dead excitation, a lost channel,
   // clipping, a lost track): a fit at the floor on them is no evidence.
   f.untrusted = !options.untrusted_input.empty();
-  f.explained = ok && options.untrusted_input.empty();
+  f.explained = at_floor(f, options.explained_ratio) && options.untrusted_input.empty();
   if (!f.robust_errors) {
     f.notes.push_back(fmt::format("standard errors are formal (only {} revolutions: the revolution-to-revolution "
                                   "spread needs {})",

@@ -218,6 +218,133 @@ std::vector<ModelParameter> term_params(const Design& design, std::size_t term, 
   return out;
 }
 
+/// What a candidate's step leaves: residuals, BIC against the model's, the share of
+/// the model's excess it explains, and whether it is proposed and reaches the floor.
+void score_candidate(Candidate& c, const StepSolution& s, const PreparedLog& log, const StepSolution& base,
+                     const GroupFloors& floors, const DiscoveryOptions& options) {
+  const double base_bic = bic_of(base);
+  c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
+  c.sincos_residual_after = rms(s.rss[1], s.n[1]);
+  c.dq_residual_after = rms(s.rss[2], s.n[2]);
+  c.weighted_rss = s.rss_w;
+  c.score = bic_of(s);
+  c.bic_drop = base_bic - c.score;
+  c.err = base.rss_w > 0.0 ? (base.rss_w - s.rss_w) / base.rss_w : 0.0;
+  c.proposed = c.bic_drop > options.proposal_bic_drop;
+  c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
+}
+
+/// The linearised step of candidate `term` (design `d`) on the model's columns.
+/// Part of a multi-parameter candidate may be the model's already (a 2 theta_m
+/// order at p_r = 1 without sin/cos: its sin part is alpha's): then each parameter
+/// alone is tried and the best the log separates kept (`t` narrowed to it).
+StepSolution solve_candidate(const Design& d, std::size_t term, ModelTerm& t, const PassStatistics& stats,
+                             const GroupFloors& floors, const std::vector<int>& base_cols) {
+  const std::vector<int> tcols = term_columns(d, term);
+  std::vector<int> cols = base_cols;
+  cols.insert(cols.end(), tcols.begin(), tcols.end());
+  StepSolution s = solve_step(stats.all, floors, cols);
+  if (s.ok || t.params.size() <= 1) return s;
+  StepSolution best_part;
+  std::size_t best_k = 0;
+  for (std::size_t k = 0; k < tcols.size(); ++k) {
+    if (t.effect->params()[static_cast<std::size_t>(t.params[k])].polar != Polar::kNone) continue;
+    std::vector<int> one = base_cols;
+    one.push_back(tcols[k]);
+    const StepSolution part = solve_step(stats.all, floors, one);
+    if (part.ok && (!best_part.ok || part.rss_w < best_part.rss_w)) {
+      best_part = part;
+      best_k = k;
+    }
+  }
+  if (!best_part.ok) return s;
+  t = ModelTerm{t.effect, {t.params[best_k]}};
+  return best_part;
+}
+
+/// Nonlinear candidates: the linearised step is only the start; the best proposed
+/// ones are refitted to convergence with the model. Envelope effects enter through
+/// atan2 too: at real magnitudes (a 15 % harmonic) one linearised step from zero
+/// leaves second-order terms far above the floor. Where that step already reaches
+/// the floor (small magnitudes) a refit would only cost the live daemon its time.
+void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
+                     const GroupFloors& floors, const DiscoveryOptions& options) {
+  int refits = 0;
+  for (Candidate& c : out.candidates) {
+    if (refits >= kNonlinearRefits || !c.proposed) continue;
+    const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
+    const ModelTerm& term = one.terms.front();
+    bool nonlinear = term.effect->envelope_only() && !c.family && !c.reaches_floor;
+    for (int p : term.params) nonlinear = nonlinear || term.effect->params()[static_cast<std::size_t>(p)].nonlinear;
+    if (!nonlinear) continue;
+    ++refits;
+    ModelSpec with = fit.model.spec();
+    with.add(term);
+    Design dm(with, fit.model.values(), nuisances_for(log));
+    const FitResult fr = fit_design(dm, log.rows, floors);
+    out.passes += fr.passes;
+    if (!fr.ok) continue;
+    score_candidate(c, fr.last, log, base, floors, options);
+    c.params = term_params(dm, dm.terms().size() - 1, fr.last, false);
+    c.reason = reason_of(term, c.params);
+  }
+}
+
+/// Alike: what they leave differs by less than the BIC's resolution, or by less
+/// than a small share of what the better one leaves (second-order differences of a
+/// large effect); never when only one of them reaches the floor.
+bool alike(const Candidate& a, const Candidate& b) {
+  if (a.reaches_floor != b.reaches_floor) return false;
+  const double left = std::min(a.weighted_rss, b.weighted_rss);
+  return std::abs(a.score - b.score) < kIndistinguishableBic ||
+         std::abs(a.weighted_rss - b.weighted_rss) < kIndistinguishableShare * left;
+}
+
+/// Among candidates the log cannot tell apart (each lists the others), the simplest
+/// first: fewer parameters, then one that needs no change of speed (constant at one
+/// speed is the plainer explanation), then the lower BIC.
+void order_alike_simplest_first(std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
+  for (Candidate& c : candidates) {
+    if (!c.proposed) continue;
+    for (const Candidate& o : candidates) {
+      if (&o != &c && o.proposed && alike(c, o)) c.fits_as_well.push_back(o.effect);
+    }
+  }
+  auto simpler = [&options](const Candidate& a, const Candidate& b) {
+    const ModelSpec sa = ModelSpec::parse(std::vector<std::string>{a.effect}, options.customs);
+    if (a.params.size() != b.params.size()) return a.params.size() < b.params.size();
+    const ModelSpec sb = ModelSpec::parse(std::vector<std::string>{b.effect}, options.customs);
+    const bool va = sa.terms.front().effect->needs_speed_change(), vb = sb.terms.front().effect->needs_speed_change();
+    if (va != vb) return !va;
+    return a.score < b.score;
+  };
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    for (std::size_t j = i + 1; j < candidates.size(); ++j) {
+      const Candidate& a = candidates[i];
+      const Candidate& b = candidates[j];
+      if (a.proposed && b.proposed && alike(a, b) && simpler(b, a)) std::swap(candidates[i], candidates[j]);
+    }
+  }
+}
+
+/// A family is the one step that reaches the floor where a smooth pattern spreads
+/// over many orders. First only when it does and nothing smaller does: one effect
+/// that reaches the floor is the plainer explanation (the family's extra orders may
+/// be a converter's quantization pattern at a speed commensurate with the sample
+/// rate), and a family that does not reach it is a curve fit, not a finding.
+void family_first_only_alone(std::vector<Candidate>& candidates) {
+  if (candidates.empty() || !candidates.front().family) return;
+  const bool family_explains = candidates.front().reaches_floor;
+  const auto smaller = std::find_if(candidates.begin() + 1, candidates.end(), [&](const Candidate& c) {
+    return !c.family && c.proposed && (c.reaches_floor || !family_explains);
+  });
+  if (smaller != candidates.end()) std::rotate(candidates.begin(), smaller, smaller + 1);
+}
+
+void sort_by_score(std::vector<Candidate>& candidates) {
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
+}
+
 }  // namespace
 
 Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
@@ -238,35 +365,9 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   ++out.passes;
   const std::vector<int> base_cols = model_columns(d);
   const StepSolution base = solve_step(stats.all, floors, base_cols);
-  const double base_bic = bic_of(base);
-  const double excess_base = base.rss_w;
   for (std::size_t i = 0; i < terms.size(); ++i) {
     const std::size_t term = first_candidate + i;
-    std::vector<int> cols = base_cols;
-    for (int c : term_columns(d, term)) cols.push_back(c);
-    StepSolution s = solve_step(stats.all, floors, cols);
-    if (!s.ok && terms[i].params.size() > 1) {
-      // Part of a multi-parameter candidate may be the model's already (a 2 theta_m
-      // order at p_r = 1 without sin/cos: its sin part is alpha's): try each
-      // parameter alone and keep the best that the log separates.
-      StepSolution best_part;
-      std::size_t best_k = 0;
-      const std::vector<int> tcols = term_columns(d, term);
-      for (std::size_t k = 0; k < tcols.size(); ++k) {
-        if (terms[i].effect->params()[static_cast<std::size_t>(terms[i].params[k])].polar != Polar::kNone) continue;
-        std::vector<int> one = base_cols;
-        one.push_back(tcols[k]);
-        const StepSolution part = solve_step(stats.all, floors, one);
-        if (part.ok && (!best_part.ok || part.rss_w < best_part.rss_w)) {
-          best_part = part;
-          best_k = k;
-        }
-      }
-      if (best_part.ok) {
-        s = best_part;
-        terms[i] = ModelTerm{terms[i].effect, {terms[i].params[best_k]}};
-      }
-    }
+    const StepSolution s = solve_candidate(d, term, terms[i], stats, floors, base_cols);
     if (!s.ok) {
       out.not_evaluated.push_back(terms[i].reference() + ": not separable from the model with the signals in this log" +
                                   (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));
@@ -275,15 +376,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     Candidate c;
     c.effect = terms[i].reference();
     c.family = terms[i].params.size() >= 2 * static_cast<std::size_t>(kFamilyFrom);
-    c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
-    c.sincos_residual_after = rms(s.rss[1], s.n[1]);
-    c.dq_residual_after = rms(s.rss[2], s.n[2]);
-    c.weighted_rss = s.rss_w;
-    c.score = bic_of(s);
-    c.bic_drop = base_bic - c.score;
-    c.err = excess_base > 0.0 ? (excess_base - s.rss_w) / excess_base : 0.0;
-    c.proposed = c.bic_drop > options.proposal_bic_drop;
-    c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
+    score_candidate(c, s, log, base, floors, options);
     c.params = term_params(d, term, s, true);
     std::erase_if(c.params, [&](const ModelParameter& pv) {
       for (int p : terms[i].params) {
@@ -295,91 +388,11 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     out.candidates.push_back(std::move(c));
     if (options.progress) options.progress(0.5 + 0.3 * static_cast<double>(i + 1) / static_cast<double>(terms.size()));
   }
-  std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
-  // Nonlinear candidates: the linearised step is only the start; refit the best ones.
-  int refits = 0;
-  for (Candidate& c : out.candidates) {
-    if (refits >= kNonlinearRefits || !c.proposed) continue;
-    const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
-    // Envelope effects enter through atan2 too: at real magnitudes (a 15 % harmonic)
-    // one linearised step from zero leaves second-order terms far above the floor.
-    // Where that step already reaches the floor (small magnitudes) a refit would only
-    // cost the live daemon its time.
-    bool nonlinear = one.terms.front().effect->envelope_only() && !c.family && !c.reaches_floor;
-    for (int p : one.terms.front().params) {
-      nonlinear = nonlinear || one.terms.front().effect->params()[static_cast<std::size_t>(p)].nonlinear;
-    }
-    if (!nonlinear) continue;
-    ++refits;
-    ModelSpec with = fit.model.spec();
-    with.add(one.terms.front());
-    Model m(with, log.p_r, log.p);
-    std::vector<std::vector<double>> values = fit.model.values();
-    Design dm = Design(with, values, nuisances_for(log));
-    const FitResult fr = fit_design(dm, log.rows, floors);
-    out.passes += fr.passes;
-    if (!fr.ok) continue;
-    const StepSolution& s = fr.last;
-    c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
-    c.sincos_residual_after = rms(s.rss[1], s.n[1]);
-    c.dq_residual_after = rms(s.rss[2], s.n[2]);
-    c.weighted_rss = s.rss_w;
-    c.score = bic_of(s);
-    c.bic_drop = base_bic - c.score;
-    c.err = excess_base > 0.0 ? (excess_base - s.rss_w) / excess_base : 0.0;
-    c.proposed = c.bic_drop > options.proposal_bic_drop;
-    c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
-    c.params = term_params(dm, dm.terms().size() - 1, s, false);
-    c.reason = reason_of(one.terms.front(), c.params);
-  }
-  std::sort(out.candidates.begin(), out.candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
-  // Candidates this log cannot tell apart.
-  // Alike: what they leave differs by less than the BIC's resolution, or by less
-  // than a small share of what the better one leaves (second-order differences of a
-  // large effect); never when only one of them reaches the floor.
-  auto alike = [&](const Candidate& a, const Candidate& b) {
-    if (a.reaches_floor != b.reaches_floor) return false;
-    const double left = std::min(a.weighted_rss, b.weighted_rss);
-    return std::abs(a.score - b.score) < kIndistinguishableBic ||
-           std::abs(a.weighted_rss - b.weighted_rss) < kIndistinguishableShare * left;
-  };
-  for (Candidate& c : out.candidates) {
-    if (!c.proposed) continue;
-    for (const Candidate& o : out.candidates) {
-      if (&o == &c || !o.proposed) continue;
-      if (alike(c, o)) c.fits_as_well.push_back(o.effect);
-    }
-  }
-  // Among candidates the log cannot tell apart, name the simplest first: fewer
-  // parameters, then one that needs no change of speed (constant at one speed is the
-  // plainer explanation), then the lower BIC.
-  auto simpler = [&options](const Candidate& a, const Candidate& b) {
-    const ModelSpec sa = ModelSpec::parse(std::vector<std::string>{a.effect}, options.customs);
-    if (a.params.size() != b.params.size()) return a.params.size() < b.params.size();
-    const ModelSpec sb = ModelSpec::parse(std::vector<std::string>{b.effect}, options.customs);
-    const bool va = sa.terms.front().effect->needs_speed_change(), vb = sb.terms.front().effect->needs_speed_change();
-    if (va != vb) return !va;
-    return a.score < b.score;
-  };
-  for (std::size_t i = 0; i < out.candidates.size(); ++i) {
-    for (std::size_t j = i + 1; j < out.candidates.size(); ++j) {
-      const Candidate& a = out.candidates[i];
-      const Candidate& b = out.candidates[j];
-      if (a.proposed && b.proposed && alike(a, b) && simpler(b, a)) std::swap(out.candidates[i], out.candidates[j]);
-    }
-  }
-  // A family is the one step that reaches the floor where a smooth pattern spreads over
-  // many orders. First only when it does and nothing smaller does: one effect that
-  // reaches the floor is the plainer explanation (the family's extra orders may be a
-  // converter's quantization pattern at a speed commensurate with the sample rate), and
-  // a family that does not reach it is a curve fit, not a finding.
-  if (!out.candidates.empty() && out.candidates.front().family) {
-    const bool family_explains = out.candidates.front().reaches_floor;
-    const auto smaller = std::find_if(out.candidates.begin() + 1, out.candidates.end(), [&](const Candidate& c) {
-      return !c.family && c.proposed && (c.reaches_floor || !family_explains);
-    });
-    if (smaller != out.candidates.end()) std::rotate(out.candidates.begin(), smaller, smaller + 1);
-  }
+  sort_by_score(out.candidates);
+  refit_nonlinear(out, log, fit, base, floors, options);
+  sort_by_score(out.candidates);
+  order_alike_simplest_first(out.candidates, options);
+  family_first_only_alone(out.candidates);
   return out;
 }
 
