@@ -80,10 +80,22 @@ class CsvInput final : public ReaderInput<CsvReader> {
       throw ConfigError(path + (reader_.names_line() > 0 ? ":" + std::to_string(reader_.names_line()) : std::string()) +
                         ": [input.csv.columns] " + *missing);
     }
+    // The first row decides whether the columns line up at all: a first row
+    // with more fields than the names (decimal commas split at a ',') would be
+    // read, row after row, as other numbers. Refused before anything runs.
+    if (first_ == CsvReader::Status::kRow) {
+      first_problem_ = decoder_.decode(row_, decimal_, first_row_, reader_.delimiter());
+      if (first_problem_ && first_problem_->reason == "extra_fields") {
+        throw ConfigError(path + ":" + std::to_string(reader_.line_number()) + ":" +
+                          std::to_string(first_problem_->column) + ": the first data row does not match [input.csv]: " +
+                          first_problem_->message);
+      }
+    }
   }
   Status next(LogRecord& record) override {
     record.is_row = true;
     CsvReader::Status st = CsvReader::Status::kEnd;
+    const bool decoded = first_ == CsvReader::Status::kRow;
     if (first_) {
       st = *first_;
       first_.reset();
@@ -95,7 +107,15 @@ class CsvInput final : public ReaderInput<CsvReader> {
       problem_ = reader_.problem();
       return Status::kBadLine;
     }
-    if (auto p = decoder_.decode(row_, decimal_, record.row)) {
+    std::optional<TextProblem> p;
+    if (decoded) {
+      record.row = first_row_;
+      p = std::move(first_problem_);
+      first_problem_.reset();
+    } else {
+      p = decoder_.decode(row_, decimal_, record.row, reader_.delimiter());
+    }
+    if (p) {
       problem_ = std::move(*p);
       return Status::kBadLine;
     }
@@ -111,6 +131,8 @@ class CsvInput final : public ReaderInput<CsvReader> {
   double row_rate_hz_;
   CsvRow row_;
   std::optional<CsvReader::Status> first_;
+  RowSample first_row_;                       ///< the first row, decoded in the constructor
+  std::optional<TextProblem> first_problem_;  ///< and its problem
 };
 
 /// The extension of `path`, lower case, without the dot ("" when none).

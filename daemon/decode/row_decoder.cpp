@@ -26,6 +26,20 @@ int time_scale_exp10(TimeUnit unit) {
 
 bool is_angle(Role r) { return r == Role::kRdAngle || r == Role::kRefAngle; }
 
+/// Fields without the empty ones at the end (a trailing delimiter).
+std::size_t used_fields(const std::vector<std::string_view>& fields) {
+  std::size_t n = fields.size();
+  while (n > 0 && fields[n - 1].empty()) --n;
+  return n;
+}
+
+/// When `text` is a number with the other decimal mark: a hint naming the setting.
+std::string decimal_hint(std::string_view text, char decimal) {
+  const char other = decimal == ',' ? '.' : ',';
+  if (!parse_csv_number(text, other)) return {};
+  return fmt::format(" (a '{}' decimal mark: set [input.csv] decimal = \"{}\")", other, other);
+}
+
 }  // namespace
 
 std::string ColumnRef::describe() const {
@@ -60,6 +74,9 @@ std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& name
   for (std::size_t r = 0; r < kRoleCount; ++r) {
     if (map_.roles[r]) roles_[r] = resolve(map_.roles[r]->column, std::string(role_name(static_cast<Role>(r))));
   }
+  std::vector<std::string_view> views(names.begin(), names.end());
+  expected_fields_ = used_fields(views);
+  fields_from_names_ = expected_fields_ > 0;
   if (missing.empty()) return std::nullopt;
   std::string have;
   for (const std::string& n : names) have += (have.empty() ? "'" : ", '") + n + "'";
@@ -68,9 +85,26 @@ std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& name
                                   : " (the columns are " + have + ")");
 }
 
-std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, RowSample& out) {
+std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, RowSample& out,
+                                              CsvFormat::Delimiter delimiter) {
   out = RowSample{};
   out.sequence = sequence_++;
+  const std::size_t fields = used_fields(row.fields);
+  if (expected_fields_ == 0) expected_fields_ = fields;
+  if (fields > expected_fields_) {
+    std::string why = fields_from_names_
+                          ? fmt::format("the row has {} fields, the column-name line has {}", fields, expected_fields_)
+                          : fmt::format("the row has {} fields, the first data row has {}", fields, expected_fields_);
+    why += ": its fields do not line up with the columns, so the row is not read";
+    if (delimiter == CsvFormat::Delimiter::kComma) {
+      why += fmt::format(
+          "; the delimiter is ',' and a decimal comma splits a number in two (\"1,5,2,3\" for 1.5 and 2.3 reads as 4 "
+          "fields): if the export writes decimal commas, its delimiter is ';' or a tab and [input.csv] needs "
+          "decimal = \",\" (with delimiter = \";\" or \"tab\")");
+    }
+    const std::size_t at = expected_fields_ < row.columns.size() ? row.columns[expected_fields_] : row.end_column;
+    return TextProblem{"extra_fields", at, why};
+  }
   auto field = [&](const Bound& b, const ColumnRef& ref, std::string_view& text) -> std::optional<TextProblem> {
     if (b.field >= row.fields.size()) {
       return TextProblem{"missing_column", row.end_column,
@@ -86,8 +120,8 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     const auto t = parse_csv_scaled_integer(text, decimal, time_scale_exp10(map_.time_unit));
     if (!t || (map_.time_unit == TimeUnit::kFiletime && *t < 0)) {
       return TextProblem{"bad_number", row.columns[time_->field],
-                         fmt::format("{} (time): expected a number with '{}' as decimal mark, found '{}'",
-                                     map_.time->describe(), decimal, text.substr(0, 40))};
+                         fmt::format("{} (time): expected a number with '{}' as decimal mark, found '{}'{}",
+                                     map_.time->describe(), decimal, text.substr(0, 40), decimal_hint(text, decimal))};
     }
     out.has_time = true;
     out.time_us = map_.time_unit == TimeUnit::kFiletime ? *t - kFiletimeToUnixUs : *t;
@@ -101,9 +135,9 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     const auto v = parse_csv_number(text, decimal);
     if (!v) {
       return TextProblem{"bad_number", row.columns[roles_[r]->field],
-                         fmt::format("{} ({}): expected a number with '{}' as decimal mark, found '{}'",
+                         fmt::format("{} ({}): expected a number with '{}' as decimal mark, found '{}'{}",
                                      role.column.describe(), role_name(static_cast<Role>(r)), decimal,
-                                     text.substr(0, 40))};
+                                     text.substr(0, 40), decimal_hint(text, decimal))};
     }
     raw[r] = (*v * role.scale + role.offset) * role.to_role_unit;
   }

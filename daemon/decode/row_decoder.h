@@ -13,9 +13,14 @@
 //   currents  "A" or "mA", after scale and offset
 //   sin, cos  raw * scale + offset, any consistent unit
 //
-// Every row yields a sample or a problem (bad_number, missing_column) naming
-// the column; rows with odd times are the sample clock's business (it counts
-// and re-anchors them, sample_clock.h). Pure: no I/O.
+// Every row yields a sample or a problem (bad_number, missing_column,
+// extra_fields) naming the column; rows with odd times are the
+// sample clock's business (it counts and re-anchors them, sample_clock.h).
+// A row with more fields than the column-name line (or, without one, than the
+// first data row) is refused whole: its fields do not line up with the names,
+// most often because a decimal comma was split at a ',' delimiter ("1,5,2,3"
+// for 1.5 and 2.3), which would otherwise read as other, wrong numbers.
+// Pure: no I/O.
 #pragma once
 
 #include <array>
@@ -71,9 +76,11 @@ class RowDecoder {
   [[nodiscard]] std::optional<std::string> bind(const std::vector<std::string>& names);
 
   /// Decodes one data row (after bind()). A problem names the column (reason
-  /// bad_number or missing_column); the row still counts as one in the
-  /// sequence. Never throws except std::bad_alloc.
-  std::optional<TextProblem> decode(const CsvRow& row, char decimal, RowSample& out);
+  /// bad_number or missing_column) or the field count
+  /// (extra_fields); the row still counts as one in the sequence. `delimiter`
+  /// only words the extra_fields message. Never throws except std::bad_alloc.
+  std::optional<TextProblem> decode(const CsvRow& row, char decimal, RowSample& out,
+                                    CsvFormat::Delimiter delimiter = CsvFormat::Delimiter::kAuto);
 
   [[nodiscard]] const RowMap& map() const { return map_; }
 
@@ -86,6 +93,9 @@ class RowDecoder {
   std::array<std::optional<Bound>, kRoleCount> roles_;
   std::array<AngleUnwrapper, kRoleCount> unwrap_{};
   std::int64_t sequence_ = 0;
+  /// Fields a row may have: the column-name line's (bind), else the first row's; 0 = not known yet.
+  std::size_t expected_fields_ = 0;
+  bool fields_from_names_ = false;
 };
 
 }  // namespace resolver

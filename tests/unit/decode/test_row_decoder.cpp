@@ -154,6 +154,68 @@ TEST(RowDecoder, BadRowsNameTheColumnAndKeepTheSequence) {
   EXPECT_EQ(s.sequence, 2);  // the two bad rows still count
 }
 
+// Issue 25: a European export's decimal commas split at a ',' delimiter read as
+// other numbers ("0,001,359,9" as 0 s, 1 deg, 359 deg); the row must be refused.
+TEST(RowDecoder, DecimalCommasSplitAtACommaAreRefusedNotMisread) {
+  RowMap m;
+  m.time = ColumnRef{"t", 0};
+  RowRole rd;
+  rd.column = ColumnRef{"rd", 0};
+  rd.unit = "deg";
+  rd.to_role_unit = kPi / 180.0;
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  RowRole ref = rd;
+  ref.column = ColumnRef{"ref", 0};
+  m.roles[static_cast<std::size_t>(Role::kRefAngle)] = ref;
+  RowDecoder d(m);
+  ASSERT_FALSE(d.bind({"t", "rd", "ref"}));
+  RowSample s;
+  CsvRow row;
+  split_csv_line("0,001,359,9451,0,5", CsvFormat::Delimiter::kComma, row);
+  const auto p = d.decode(row, '.', s, CsvFormat::Delimiter::kComma);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "extra_fields");
+  EXPECT_EQ(p->column, 11U);  // where the fourth field, "9451", starts
+  EXPECT_NE(p->message.find("the row has 6 fields, the column-name line has 3"), std::string::npos) << p->message;
+  EXPECT_NE(p->message.find("decimal comma"), std::string::npos) << p->message;
+  EXPECT_EQ(s.roles, 0U);
+  // Control: the same values with '.' decimals, and a trailing delimiter, read.
+  split_csv_line("0.001,359.9451,0.5,", CsvFormat::Delimiter::kComma, row);
+  ASSERT_FALSE(d.decode(row, '.', s, CsvFormat::Delimiter::kComma));
+  EXPECT_EQ(s.time_us, 1000);
+  EXPECT_NEAR(s.values[static_cast<std::size_t>(Role::kRefAngle)], 0.5 * kPi / 180.0, 1e-12);
+}
+
+TEST(RowDecoder, WithoutNamesTheFirstRowSetsTheFieldCount) {
+  RowMap m;
+  RowRole rd;
+  rd.column = ColumnRef{"", 2};
+  rd.unit = "rad";
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  m.row_rate_hz = 1000.0;
+  RowDecoder d(m);
+  ASSERT_FALSE(d.bind({}));
+  RowSample s;
+  CsvRow row;
+  split_csv_line("0,1", CsvFormat::Delimiter::kComma, row);
+  ASSERT_FALSE(d.decode(row, '.', s, CsvFormat::Delimiter::kComma));
+  split_csv_line("0,1,5", CsvFormat::Delimiter::kComma, row);  // 1,5 meant 1.5
+  const auto p = d.decode(row, '.', s, CsvFormat::Delimiter::kComma);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "extra_fields");
+  EXPECT_NE(p->message.find("the first data row has 2"), std::string::npos) << p->message;
+}
+
+TEST(RowDecoder, ADecimalCommaWhereAPointIsExpectedSaysSo) {
+  RowDecoder d(degree_map());
+  ASSERT_FALSE(d.bind({"Time", "Resolver", "Encoder"}));
+  RowSample s;
+  const auto p = d.decode(row_of("133485408000000000;1,5;2"), '.', s);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "bad_number");
+  EXPECT_NE(p->message.find("set [input.csv] decimal = \",\""), std::string::npos) << p->message;
+}
+
 TEST(RowDecoder, AColumnTheExportLacksIsNamed) {
   RowDecoder d(degree_map());
   const auto msg = d.bind({"time", "resolver"});

@@ -1,0 +1,130 @@
+#!/usr/bin/python3
+"""Issue 25 ("Trust": no verdict from garbage, nothing lost silently) through the
+real programs: inputs that used to be read as wrong numbers, hang or crash, and
+now are refused or counted with a message naming the file, line, column or option.
+
+  DecimalCommas   a European export (decimal commas) read with a ',' delimiter:
+                  "0,0010,359,9451,0,00000" was read as 0 s, 10 deg, 359 deg with
+                  nothing rejected; now refused up front (exit 2, file:line:column)
+                  when the first row does not line up with the column names, and a
+                  later row that does not is counted as extra_fields
+
+Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
+export, semicolons and decimal commas), so each case has its clean control.
+
+  test_garbage_inputs.py --bin BUILD/bin --repo SOURCE --work DIR [unittest arguments]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import unittest
+
+ARGS = None
+USAGE = 2  # README: 2 usage or configuration error
+
+SWEEP_TOML = """[bench]
+p_r = 1
+p = 4
+reference_aligned = true
+[input.csv]
+%s
+time_column = "Time [s]"
+time_unit = "s"
+[input.csv.columns]
+rd_angle = { column = "R/D angle [deg]", unit = "deg" }
+ref_angle = { column = "Encoder [deg]", unit = "deg" }
+"""
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, errors="replace", **kw)
+
+
+def work(name):
+    return os.path.join(ARGS.work, name)
+
+
+def write(name, text):
+    path = work(name)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def sweep_rows():
+    """The example export's column-name line and data rows (semicolons, decimal commas)."""
+    with open(os.path.join(ARGS.repo, "tools", "examples", "scope_sweep.csv")) as f:
+        lines = f.read().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("Time [s]"))
+    return lines[start], [line for line in lines[start + 1:] if line.strip()]
+
+
+def replay(csv, config, name, expect_rc=0):
+    report = work(name + ".json")
+    if os.path.exists(report):
+        os.remove(report)
+    proc = run([os.path.join(ARGS.bin, "resolverd"), "--replay", csv, "--config", config, "--once", "--fast",
+                "--lcm", "file://" + work(name + ".lcmlog") + "?mode=w", "--report", report])
+    if proc.returncode != expect_rc:
+        raise AssertionError(f"resolverd exited {proc.returncode}, expected {expect_rc}:\n{proc.stderr[-3000:]}")
+    if expect_rc != 0:
+        return None, proc.stderr
+    with open(report) as f:
+        return json.load(f), proc.stderr
+
+
+def model(*args):
+    return run([os.path.join(ARGS.bin, "resolver-model"), *args])
+
+
+class DecimalCommas(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        names, rows = sweep_rows()
+        cls.rows = len(rows)
+        # The same export written with ',' as the delimiter, decimal commas kept.
+        cls.comma = write("eu_comma.csv", "\n".join([names.replace(";", ",")] + [r.replace(";", ",") for r in rows]) + "\n")
+        # Its first rows happen to have whole numbers (3 fields): the rest do not.
+        whole = ["%d,359,0" % k for k in range(3)]
+        cls.late = write("eu_late.csv",
+                         "\n".join([names.replace(";", ",")] + whole + [r.replace(";", ",") for r in rows[3:]]) + "\n")
+        cls.auto = write("auto.toml", SWEEP_TOML % "")
+        cls.right = write("semicolon.toml", SWEEP_TOML % 'delimiter = ";"\ndecimal = ","')
+        cls.semicolon = write("eu_semicolon.csv", "\n".join([names] + rows) + "\n")
+
+    def test_refused_up_front_naming_file_line_and_the_fix(self):
+        for prog in ([os.path.join(ARGS.bin, "resolverd"), "--replay", self.comma, "--once", "--fast"],
+                     [os.path.join(ARGS.bin, "resolver-model"), "explain", self.comma]):
+            proc = run(prog + ["--config", self.auto])
+            self.assertEqual(proc.returncode, USAGE, proc.stderr)
+            self.assertIn("eu_comma.csv:2:12: the first data row does not match [input.csv]", proc.stderr)
+            self.assertIn("the row has 6 fields, the column-name line has 3", proc.stderr)
+            self.assertIn('decimal = ","', proc.stderr)
+
+    def test_later_rows_that_do_not_line_up_are_counted_not_misread(self):
+        report, err = replay(self.late, self.auto, "late")
+        self.assertEqual(report["rejects"], {"extra_fields": self.rows - 3})
+        self.assertEqual(report["samples_complete"], 3)
+        self.assertIn("eu_late.csv:5:12: the row has 6 fields", err)
+
+    def test_a_point_expected_where_the_export_has_commas_says_so(self):
+        _, err = replay(self.semicolon, self.auto, "semicolon_point", expect_rc=1)  # 1: no sample decoded
+        self.assertIn("eu_semicolon.csv:2:1: column 'Time [s]' (time): expected a number with '.' as decimal mark, "
+                      "found '0,0000' (a ',' decimal mark: set [input.csv] decimal = \",\")", err)
+
+    def test_control_the_right_config_reads_every_row(self):
+        report, _ = replay(self.semicolon, self.right, "semicolon_right")
+        self.assertEqual(report["rejects"], {})
+        self.assertEqual(report["samples_complete"], self.rows)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--bin", required=True)
+    parser.add_argument("--repo", required=True)
+    parser.add_argument("--work", required=True)
+    ARGS, rest = parser.parse_known_args()
+    os.makedirs(ARGS.work, exist_ok=True)
+    unittest.main(argv=[sys.argv[0]] + rest, verbosity=2)
