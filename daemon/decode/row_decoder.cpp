@@ -1,6 +1,8 @@
 #include "daemon/decode/row_decoder.h"
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -25,6 +27,7 @@ int time_scale_exp10(TimeUnit unit) {
 }
 
 bool is_angle(Role r) { return r == Role::kRdAngle || r == Role::kRefAngle; }
+bool is_current(Role r) { return r == Role::kIA || r == Role::kIB || r == Role::kIC; }
 
 /// Fields without the empty ones at the end (a trailing delimiter).
 std::size_t used_fields(const std::vector<std::string_view>& fields) {
@@ -38,6 +41,13 @@ std::string decimal_hint(std::string_view text, char decimal) {
   const char other = decimal == ',' ? '.' : ',';
   if (!parse_csv_number(text, other)) return {};
   return fmt::format(" (a '{}' decimal mark: set [input.csv] decimal = \"{}\")", other, other);
+}
+
+/// The largest magnitude a value of role `r` may have, in the role's unit, and that unit.
+std::pair<double, const char*> role_limit(Role r) {
+  if (is_angle(r)) return {RowDecoder::kMaxAngleRad, "rad"};
+  if (is_current(r)) return {RowDecoder::kMaxCurrentA, "A"};
+  return {RowDecoder::kMaxSinCos, "(the export's unit)"};
 }
 
 }  // namespace
@@ -140,6 +150,14 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
                                      text.substr(0, 40), decimal_hint(text, decimal))};
     }
     raw[r] = (*v * role.scale + role.offset) * role.to_role_unit;
+    const auto [limit, unit] = role_limit(static_cast<Role>(r));
+    if (!(std::abs(raw[r]) <= limit)) {  // also catches inf and nan
+      return TextProblem{"absurd_value", row.columns[roles_[r]->field],
+                         fmt::format("{} ({}): '{}' is {:g} {}, past the {:g} {} any bench measures; the row is not read "
+                                     "(a wrong unit, scale or column?)",
+                                     role.column.describe(), role_name(static_cast<Role>(r)), text.substr(0, 40), raw[r],
+                                     unit, limit, unit)};
+    }
   }
   // Only a whole row moves the unwrapping state.
   for (std::size_t r = 0; r < kRoleCount; ++r) {

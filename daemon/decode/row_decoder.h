@@ -14,12 +14,14 @@
 //   sin, cos  raw * scale + offset, any consistent unit
 //
 // Every row yields a sample or a problem (bad_number, missing_column,
-// extra_fields) naming the column; rows with odd times are the
+// extra_fields, absurd_value) naming the column; rows with odd times are the
 // sample clock's business (it counts and re-anchors them, sample_clock.h).
 // A row with more fields than the column-name line (or, without one, than the
 // first data row) is refused whole: its fields do not line up with the names,
 // most often because a decimal comma was split at a ',' delimiter ("1,5,2,3"
 // for 1.5 and 2.3), which would otherwise read as other, wrong numbers.
+// A value past what any bench measures (RowDecoder::kMaxAngleRad, ...) is
+// refused as absurd_value: far past that a double keeps no angle at all.
 // Pure: no I/O.
 #pragma once
 
@@ -68,6 +70,15 @@ struct RowMap {
 
 class RowDecoder {
  public:
+  /// Largest |angle| [rad] a row may give (after scale and offset, before
+  /// wrapping; 1.6e7 revolutions of a multi-turn count): a double still
+  /// resolves it to 1.5e-8 rad. Past it the wrapped angle is noise.
+  static constexpr double kMaxAngleRad = 1e8;
+  /// Largest |current| [A] a row may give.
+  static constexpr double kMaxCurrentA = 1e6;
+  /// Largest |sin| or |cos| in the export's unit (ADC counts of a 32-bit converter fit).
+  static constexpr double kMaxSinCos = 1e12;
+
   explicit RowDecoder(RowMap map) : map_(std::move(map)) {}
 
   /// Resolves column names against the export's column-name line (`names`,
@@ -76,7 +87,7 @@ class RowDecoder {
   [[nodiscard]] std::optional<std::string> bind(const std::vector<std::string>& names);
 
   /// Decodes one data row (after bind()). A problem names the column (reason
-  /// bad_number or missing_column) or the field count
+  /// bad_number, missing_column or absurd_value) or the field count
   /// (extra_fields); the row still counts as one in the sequence. `delimiter`
   /// only words the extra_fields message. Never throws except std::bad_alloc.
   std::optional<TextProblem> decode(const CsvRow& row, char decimal, RowSample& out,

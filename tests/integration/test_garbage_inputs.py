@@ -8,6 +8,8 @@ now are refused or counted with a message naming the file, line, column or optio
                   nothing rejected; now refused up front (exit 2, file:line:column)
                   when the first row does not line up with the column names, and a
                   later row that does not is counted as extra_fields
+  AbsurdValues    1e300 deg in a CSV angle column was wrapped into a "valid" angle;
+                  now counted as absurd_value naming file:line:column
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -118,6 +120,34 @@ class DecimalCommas(unittest.TestCase):
         report, _ = replay(self.semicolon, self.right, "semicolon_right")
         self.assertEqual(report["rejects"], {})
         self.assertEqual(report["samples_complete"], self.rows)
+
+
+class AbsurdValues(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        names, rows = sweep_rows()
+        cls.rows = len(rows)
+        cls.config = write("absurd.toml", SWEEP_TOML % 'delimiter = ";"\ndecimal = ","')
+        bad = list(rows)
+        for k in (100, 200):  # data rows 100 and 200: lines 102 and 202
+            t, _, enc = bad[k].split(";")
+            bad[k] = ";".join([t, "1e300", enc])
+        t, rd, _ = bad[300].split(";")
+        bad[300] = ";".join([t, rd, "-1,5e40"])
+        cls.csv = write("absurd.csv", "\n".join([names] + bad) + "\n")
+
+    def test_counted_naming_file_line_column(self):
+        report, err = replay(self.csv, self.config, "absurd")
+        self.assertEqual(report["rejects"].get("absurd_value"), 3, report["rejects"])
+        self.assertEqual(report["samples_complete"], self.rows - 3)
+        self.assertIn("absurd.csv:102:8: column 'R/D angle [deg]' (rd_angle): '1e300'", err)
+        self.assertIn("absurd.csv:302:", err)
+        self.assertIn("(ref_angle): '-1,5e40'", err)
+
+    def test_resolver_model_skips_them(self):
+        proc = model("fit", self.csv, "--config", self.config)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("3 malformed log lines skipped", proc.stdout)
 
 
 if __name__ == "__main__":

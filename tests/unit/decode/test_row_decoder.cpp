@@ -216,6 +216,33 @@ TEST(RowDecoder, ADecimalCommaWhereAPointIsExpectedSaysSo) {
   EXPECT_NE(p->message.find("set [input.csv] decimal = \",\""), std::string::npos) << p->message;
 }
 
+// Issue 25: 1e300 deg is a finite double, yet no angle at all once wrapped.
+TEST(RowDecoder, AbsurdValuesAreRefusedNamingTheColumn) {
+  RowDecoder d(degree_map());
+  ASSERT_FALSE(d.bind({"Time", "Resolver", "Encoder"}));
+  RowSample s;
+  const auto p = d.decode(row_of("133485408000000000;1e300;2"), ',', s);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "absurd_value");
+  EXPECT_EQ(p->column, 20U);
+  EXPECT_NE(p->message.find("column 'Resolver' (rd_angle): '1e300'"), std::string::npos) << p->message;
+  EXPECT_EQ(s.roles, 0U);
+  const auto q = d.decode(row_of("133485408000000000;1;-1e20"), ',', s);
+  ASSERT_TRUE(q);
+  EXPECT_EQ(q->reason, "absurd_value");
+  EXPECT_NE(q->message.find("column 3 (ref_angle)"), std::string::npos) << q->message;
+  // A scale that overflows to inf is caught too.
+  RowMap m = degree_map();
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)]->scale = 1e300;
+  RowDecoder big(m);
+  ASSERT_FALSE(big.bind({"Time", "Resolver", "Encoder"}));
+  const auto r = big.decode(row_of("133485408000000000;1e10;2"), ',', s);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->reason, "absurd_value");
+  // Control: a large but real multi-turn angle (1e6 revolutions) reads.
+  ASSERT_FALSE(d.decode(row_of("133485408000000000;360000000;2"), ',', s));
+}
+
 TEST(RowDecoder, AColumnTheExportLacksIsNamed) {
   RowDecoder d(degree_map());
   const auto msg = d.bind({"time", "resolver"});
