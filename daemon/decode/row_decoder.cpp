@@ -135,6 +135,24 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     }
     out.has_time = true;
     out.time_us = map_.time_unit == TimeUnit::kFiletime ? *t - kFiletimeToUnixUs : *t;
+    if (!time_checked_ && time_steps_ < kTimeCheckSteps) {
+      if (have_last_time_) {
+        const std::int64_t step = out.time_us - last_time_us_;
+        ++time_steps_;
+        if (step == 0) ++repeated_times_;
+        if (step > 0) {
+          if (min_time_step_us_ == 0 || step < min_time_step_us_) min_time_step_us_ = step;
+          if (first_change_row_ < 0) {
+            first_change_row_ = out.sequence;
+            first_change_us_ = out.time_us;
+          }
+          last_change_row_ = out.sequence;
+          last_change_us_ = out.time_us;
+        }
+      }
+      have_last_time_ = true;
+      last_time_us_ = out.time_us;
+    }
   }
   std::array<double, kRoleCount> raw{};
   for (std::size_t r = 0; r < kRoleCount; ++r) {
@@ -171,6 +189,27 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     out.roles = static_cast<std::uint16_t>(out.roles | role_bit(static_cast<Role>(r)));
   }
   return std::nullopt;
+}
+
+std::optional<std::string> RowDecoder::check_time_resolution(bool at_end) {
+  if (time_checked_ || !map_.time) return std::nullopt;
+  if (time_steps_ < kTimeCheckSteps && !(at_end && time_steps_ >= 16)) return std::nullopt;
+  time_checked_ = true;
+  if (static_cast<double>(repeated_times_) < kMaxRepeatedTimeShare * time_steps_) return std::nullopt;
+  std::string rate;
+  if (last_change_row_ > first_change_row_ && last_change_us_ > first_change_us_) {
+    const double hz = static_cast<double>(last_change_row_ - first_change_row_) * 1e6 /
+                      static_cast<double>(last_change_us_ - first_change_us_);
+    rate = fmt::format(" (the rows between its changes come at about {:.4g} Hz)", hz);
+  }
+  const std::string resolution =
+      min_time_step_us_ > 0 ? fmt::format("resolves only {:g} s", static_cast<double>(min_time_step_us_) / 1e6)
+                            : std::string("never changes");
+  return fmt::format(
+      "{} (time): {} of the first {} rows repeat the previous row's time: the column {}, coarser than the rows "
+      "come{}; rows sharing a time have no time between them (the rotor would seem not to move). Export the time "
+      "with more digits, or, if the rows are evenly spaced, drop [input.csv] time_column and set row_rate_hz",
+      map_.time->describe(), repeated_times_, time_steps_ + 1, resolution, rate);
 }
 
 }  // namespace resolver

@@ -95,6 +95,17 @@ class RowDecoder {
 
   [[nodiscard]] const RowMap& map() const { return map_; }
 
+  /// Rows whose time steps decide whether the time column resolves the rows.
+  static constexpr int kTimeCheckSteps = 200;
+  /// A time column is too coarse when this share of its steps or more are 0
+  /// (the same time as the row before): 0.01 s at 1 kHz repeats 9 times in 10.
+  static constexpr double kMaxRepeatedTimeShare = 0.25;
+  /// Once kTimeCheckSteps rows with a time were decoded (or at the end, `at_end`,
+  /// after at least 16): a message when the time column repeats too often to
+  /// time the rows (naming the column, its resolution and the row rate the
+  /// rows between its changes suggest), else nullopt. Says it once.
+  [[nodiscard]] std::optional<std::string> check_time_resolution(bool at_end);
+
  private:
   struct Bound {
     std::size_t field = 0;  ///< 0-based field index
@@ -107,6 +118,15 @@ class RowDecoder {
   /// Fields a row may have: the column-name line's (bind), else the first row's; 0 = not known yet.
   std::size_t expected_fields_ = 0;
   bool fields_from_names_ = false;
+  // The time column's first kTimeCheckSteps steps (check_time_resolution).
+  bool time_checked_ = false;
+  bool have_last_time_ = false;
+  std::int64_t last_time_us_ = 0;
+  int time_steps_ = 0;
+  int repeated_times_ = 0;
+  std::int64_t min_time_step_us_ = 0;  ///< smallest positive step
+  std::int64_t first_change_row_ = -1, last_change_row_ = -1;  ///< sequence where the time changed
+  std::int64_t first_change_us_ = 0, last_change_us_ = 0;
 };
 
 }  // namespace resolver

@@ -10,6 +10,10 @@ now are refused or counted with a message naming the file, line, column or optio
                   later row that does not is counted as extra_fields
   AbsurdValues    1e300 deg in a CSV angle column was wrapped into a "valid" angle;
                   now counted as absurd_value naming file:line:column
+  CoarseTime      a 1 kHz export whose time column is rounded to 0.01 s: ten rows
+                  per time, "0 moving, 5500 at standstill"; now refused (exit 2)
+                  naming the column, its resolution and the row rate, and the fix
+                  it suggests (row_rate_hz) gives the unrounded export's fit
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -148,6 +152,41 @@ class AbsurdValues(unittest.TestCase):
         proc = model("fit", self.csv, "--config", self.config)
         self.assertEqual(proc.returncode, 0, proc.stderr)
         self.assertIn("3 malformed log lines skipped", proc.stdout)
+
+
+class CoarseTime(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        names, rows = sweep_rows()
+        rounded = []
+        for r in rows:
+            t, rd, enc = r.split(";")
+            rounded.append(";".join([("%.2f" % float(t.replace(",", "."))).replace(".", ","), rd, enc]))
+        cls.csv = write("rounded.csv", "\n".join([names] + rounded) + "\n")
+        cls.exact = write("exact.csv", "\n".join([names] + rows) + "\n")
+        cls.config = write("coarse.toml", SWEEP_TOML % 'delimiter = ";"\ndecimal = ","')
+        cls.by_rate = write("by_rate.toml", (SWEEP_TOML % 'delimiter = ";"\ndecimal = ","\nrow_rate_hz = 1000')
+                            .replace('time_column = "Time [s]"\ntime_unit = "s"\n', ""))
+
+    def test_refused_naming_the_column_its_resolution_and_the_rate(self):
+        for prog in ([os.path.join(ARGS.bin, "resolverd"), "--replay", self.csv, "--once", "--fast"],
+                     [os.path.join(ARGS.bin, "resolver-model"), "explain", self.csv]):
+            proc = run(prog + ["--config", self.config])
+            self.assertEqual(proc.returncode, USAGE, proc.stderr)
+            self.assertIn("rounded.csv:2-202: column 'Time [s]' (time): 180 of the first 201 rows repeat the previous "
+                          "row's time: the column resolves only 0.01 s", proc.stderr)
+            self.assertIn("about 1000 Hz", proc.stderr)
+            self.assertIn("row_rate_hz", proc.stderr)
+            self.assertNotIn("0 moving", proc.stderr)
+
+    def test_the_suggested_row_rate_fits_like_the_exact_times(self):
+        by_rate = model("fit", self.csv, "--config", self.by_rate, "--json")
+        exact = model("fit", self.exact, "--config", self.config, "--json")
+        self.assertEqual(by_rate.returncode, 0, by_rate.stderr)
+        self.assertEqual(exact.returncode, 0, exact.stderr)
+        a, b = json.loads(by_rate.stdout), json.loads(exact.stdout)
+        self.assertEqual(a["verdict"], b["verdict"])
+        self.assertEqual(a["params"], b["params"])
 
 
 if __name__ == "__main__":

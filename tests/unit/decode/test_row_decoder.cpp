@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <optional>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -241,6 +242,46 @@ TEST(RowDecoder, AbsurdValuesAreRefusedNamingTheColumn) {
   EXPECT_EQ(r->reason, "absurd_value");
   // Control: a large but real multi-turn angle (1e6 revolutions) reads.
   ASSERT_FALSE(d.decode(row_of("133485408000000000;360000000;2"), ',', s));
+}
+
+// Issue 25: a time column rounded to 0.01 s at 1 kHz gives ten rows one time;
+// read as it is, the rotor never moves ("0 moving"). It must be named.
+std::optional<std::string> time_check_of(double rate_hz, const char* time_format, int rows, bool at_end) {
+  RowMap m;
+  m.time = ColumnRef{"t", 0};
+  RowRole rd;
+  rd.column = ColumnRef{"rd", 0};
+  rd.unit = "rad";
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  RowDecoder d(m);
+  EXPECT_FALSE(d.bind({"t", "rd"}));
+  RowSample s;
+  for (int k = 0; k < rows; ++k) {
+    char line[64];
+    std::snprintf(line, sizeof line, time_format, k / rate_hz);
+    const std::string text = std::string(line) + ";1";
+    CsvRow row;
+    split_csv_line(text, CsvFormat::Delimiter::kSemicolon, row);
+    EXPECT_FALSE(d.decode(row, '.', s));
+    if (auto why = d.check_time_resolution(false)) return why;
+  }
+  return d.check_time_resolution(at_end);
+}
+
+TEST(RowDecoder, ATimeColumnCoarserThanTheRowsIsNamed) {
+  const auto why = time_check_of(1000.0, "%.2f", 1000, false);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("column 't' (time): 180 of the first 201 rows repeat the previous row's time"), std::string::npos)
+      << *why;
+  EXPECT_NE(why->find("resolves only 0.01 s"), std::string::npos) << *why;
+  EXPECT_NE(why->find("about 1000 Hz"), std::string::npos) << *why;
+  EXPECT_NE(why->find("row_rate_hz"), std::string::npos) << *why;
+  // A short export is checked at its end.
+  EXPECT_TRUE(time_check_of(1000.0, "%.2f", 50, true));
+  EXPECT_FALSE(time_check_of(1000.0, "%.2f", 50, false));
+  // Controls: the same rows timed to 1 us, and 0.01 s at 50 Hz, are fine.
+  EXPECT_FALSE(time_check_of(1000.0, "%.6f", 1000, true));
+  EXPECT_FALSE(time_check_of(50.0, "%.2f", 1000, true));
 }
 
 TEST(RowDecoder, AColumnTheExportLacksIsNamed) {
