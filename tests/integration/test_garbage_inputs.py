@@ -14,6 +14,9 @@ now are refused or counted with a message naming the file, line, column or optio
                   per time, "0 moving, 5500 at standstill"; now refused (exit 2)
                   naming the column, its resolution and the row rate, and the fix
                   it suggests (row_rate_hz) gives the unrounded export's fit
+  ConfigRanges    [estimator] max_order = 2000 replayed for minutes, 2147483647 ended
+                  in "std::bad_alloc"; now exit 2 naming the file, line, option and
+                  its range
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -187,6 +190,48 @@ class CoarseTime(unittest.TestCase):
         a, b = json.loads(by_rate.stdout), json.loads(exact.stdout)
         self.assertEqual(a["verdict"], b["verdict"])
         self.assertEqual(a["params"], b["params"])
+
+
+_SIM = None
+
+
+def sim_log():
+    """A 2 s resolver-sim log of the default bench, made once."""
+    global _SIM
+    if _SIM is None:
+        _SIM = work("sim.log")
+        proc = run([os.path.join(ARGS.bin, "resolver-sim"), "--out", _SIM, "--duration", "2"])
+        if proc.returncode != 0:
+            raise AssertionError(proc.stderr)
+    return _SIM
+
+
+def refused(test, config_text, name, *fragments):
+    """resolverd and resolver-model refuse `config_text` with exit 2 within 30 s, saying every fragment."""
+    config = write(name + ".toml", config_text)
+    for prog in ([os.path.join(ARGS.bin, "resolverd"), "--replay", sim_log(), "--once", "--fast",
+                  "--lcm", "file://" + work(name + ".lcmlog") + "?mode=w"],
+                 [os.path.join(ARGS.bin, "resolver-model"), "fit", sim_log()]):
+        try:
+            proc = run(prog + ["--config", config], timeout=30)
+        except subprocess.TimeoutExpired:
+            test.fail(f"{os.path.basename(prog[0])} still running after 30 s with {config_text!r}")
+        test.assertEqual(proc.returncode, USAGE, f"{prog[0]}: {proc.stderr[-2000:]}")
+        for fragment in fragments:
+            test.assertIn(fragment, proc.stderr)
+
+
+class ConfigRanges(unittest.TestCase):
+    def test_max_order_beyond_its_range(self):
+        for v in ("2000", "2147483647", "0"):
+            refused(self, '[estimator]\nmethod = "fourier_reference"\nmax_order = %s\n' % v, "max_order_" + v,
+                    ":3: [estimator] max_order must be 1..64", "got " + v)
+
+    def test_control_max_order_at_its_limit_runs(self):
+        config = write("max_order_64.toml", '[estimator]\nmethod = "fourier_reference"\nmax_order = 64\n')
+        proc = run([os.path.join(ARGS.bin, "resolverd"), "--replay", sim_log(), "--once", "--fast", "--config", config,
+                    "--lcm", "file://" + work("max_order_64.lcmlog") + "?mode=w"], timeout=60)
+        self.assertEqual(proc.returncode, 0, proc.stderr[-2000:])
 
 
 if __name__ == "__main__":
