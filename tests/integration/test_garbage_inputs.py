@@ -16,7 +16,8 @@ now are refused or counted with a message naming the file, line, column or optio
                   it suggests (row_rate_hz) gives the unrounded export's fit
   ConfigRanges    [estimator] max_order = 2000 replayed for minutes, 2147483647 ended
                   in "std::bad_alloc"; now exit 2 naming the file, line, option and
-                  its range
+                  its range; likewise [bench] sample_rate_hz = 1e-300 (was taken:
+                  "0 moving over 3.2e+303 s"), 0.001, 1e300, -5, inf
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -226,6 +227,11 @@ class ConfigRanges(unittest.TestCase):
         for v in ("2000", "2147483647", "0"):
             refused(self, '[estimator]\nmethod = "fourier_reference"\nmax_order = %s\n' % v, "max_order_" + v,
                     ":3: [estimator] max_order must be 1..64", "got " + v)
+
+    def test_absurd_sample_rates(self):
+        for v in ("1e-300", "0.001", "1e300", "-5", "inf"):
+            refused(self, "[bench]\np_r = 3\nsample_rate_hz = %s\n" % v, "rate_" + v,
+                    ":3: [bench] sample_rate_hz must be 1 .. 1e6 Hz (0 = take it from BENCH_INFO), got ")
 
     def test_control_max_order_at_its_limit_runs(self):
         config = write("max_order_64.toml", '[estimator]\nmethod = "fourier_reference"\nmax_order = 64\n')

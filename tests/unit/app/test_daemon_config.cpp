@@ -105,6 +105,22 @@ TEST(DaemonConfig, MaxOrderOutsideItsRangeIsNamedWithTheRange) {
   EXPECT_EQ(parse_daemon_config("[estimator]\nmax_order = 1\n", "ok.toml").fourier.max_order, 1);
 }
 
+// Issue 25: sample_rate_hz = 1e-300 was taken (every period 1e300 s: "0 moving
+// over 3.2e+303 s"), 0.001 made a 2 s log 4e6 s long.
+TEST(DaemonConfig, AbsurdRatesAreNamedWithTheRange) {
+  for (const char* v : {"1e-300", "0.001", "1e300", "2e6", "-5", "inf", "nan"}) {
+    const std::string e = error_of(std::string("[bench]\np = 2\nsample_rate_hz = ") + v + "\n");
+    EXPECT_NE(e.find("test.toml:3: [bench] sample_rate_hz must be 1 .. 1e6 Hz (0 = take it from BENCH_INFO), got "),
+              std::string::npos)
+        << v << ": " << e;
+    const std::string r = error_of(std::string("[input.csv]\nrow_rate_hz = ") + v + "\n");
+    EXPECT_NE(r.find("test.toml:2: [input.csv] row_rate_hz must be 1 .. 1e6 Hz"), std::string::npos) << v << ": " << r;
+  }
+  EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 0\n", "ok.toml").bench.sample_rate_hz, 0.0);
+  EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 1\n", "ok.toml").bench.sample_rate_hz, 1.0);
+  EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 1e6\n", "ok.toml").bench.sample_rate_hz, 1e6);
+}
+
 TEST(DaemonConfig, WakeIdsAreAutoOrCanIds) {
   const DaemonConfig d = parse_daemon_config("", "t.toml");
   EXPECT_TRUE(d.can.wake_auto);
