@@ -18,6 +18,10 @@ now are refused or counted with a message naming the file, line, column or optio
                   in "std::bad_alloc"; now exit 2 naming the file, line, option and
                   its range; likewise [bench] sample_rate_hz = 1e-300 (was taken:
                   "0 moving over 3.2e+303 s"), 0.001, 1e300, -5, inf
+  CoarseTable     resolver-model export --points 8 of a 10 % imbalance: a table with
+                  0.065 rad interpolation error (2160x the noise floor) written with
+                  no warning; now a stderr warning with the error, the floor and the
+                  --points that reaches it (the export still succeeds)
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -238,6 +242,33 @@ class ConfigRanges(unittest.TestCase):
         proc = run([os.path.join(ARGS.bin, "resolverd"), "--replay", sim_log(), "--once", "--fast", "--config", config,
                     "--lcm", "file://" + work("max_order_64.lcmlog") + "?mode=w"], timeout=60)
         self.assertEqual(proc.returncode, 0, proc.stderr[-2000:])
+
+
+class CoarseTable(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.log = work("alpha10.log")
+        proc = run([os.path.join(ARGS.bin, "resolver-sim"), "--out", cls.log, "--duration", "3",
+                    "-e", "amplitude_imbalance:alpha=0.1"])
+        if proc.returncode != 0:
+            raise AssertionError(proc.stderr)
+
+    def export(self, points):
+        out = work("table_%d.csv" % points)
+        proc = model("export", self.log, "--points", str(points), "--out", out)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertTrue(os.path.getsize(out) > 0)
+        return proc.stderr
+
+    def test_warns_with_the_error_the_floor_and_the_points_that_reach_it(self):
+        err = self.export(8)
+        self.assertIn("resolver-model: warning: --points 8: the table's interpolation error 0.065 rad is ", err)
+        self.assertIn("the model's noise floor", err)
+        suggested = int(err.split("; --points ")[1].split()[0])
+        self.assertNotIn("warning", self.export(suggested))
+
+    def test_control_the_default_points_do_not_warn(self):
+        self.assertNotIn("warning", self.export(1024))
 
 
 if __name__ == "__main__":
