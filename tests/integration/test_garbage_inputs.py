@@ -22,6 +22,10 @@ now are refused or counted with a message naming the file, line, column or optio
                   0.065 rad interpolation error (2160x the noise floor) written with
                   no warning; now a stderr warning with the error, the floor and the
                   --points that reaches it (the export still succeeds)
+  CustomTerms     a [[model.custom]] term 1/(theta-theta) was reported as "not
+                  separable"; now refused at load (exit 2) naming the file, block and
+                  term and that it is inf everywhere; a term non-finite on this log's
+                  motion only (sqrt(-omega) turning forward) is named at the fit
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -269,6 +273,36 @@ class CoarseTable(unittest.TestCase):
 
     def test_control_the_default_points_do_not_warn(self):
         self.assertNotIn("warning", self.export(1024))
+
+
+CUSTOM = """[model]
+effects = ["amplitude_imbalance", "broken"]
+[[model.custom]]
+name = "broken"
+signal = "position_error"
+terms = ["%s"]
+"""
+
+
+class CustomTerms(unittest.TestCase):
+    def test_a_term_infinite_everywhere_is_refused_at_load(self):
+        refused(self, CUSTOM % "1/(theta-theta)", "div0",
+                "div0.toml:3 [[model.custom]] #1 custom effect 'broken', term 1 \"1/(theta-theta)\": evaluates to inf "
+                "at every angle, speed and time tried", "division by zero")
+
+    def test_a_term_not_finite_on_this_motion_is_named_at_the_fit(self):
+        config = write("sqrt.toml", CUSTOM % "sqrt(-omega)")
+        proc = model("fit", sim_log(), "--config", config)
+        self.assertEqual(proc.returncode, 1, proc.stderr)  # 1: nothing in this log to fit it with
+        self.assertIn("sqrt.toml:3 [[model.custom]] #1 custom effect 'broken', term 1 \"sqrt(-omega)\" is not finite "
+                      "on 4000 of this log's 4000 rows (e.g. nan at theta = ", proc.stderr)
+        self.assertNotIn("not separable", proc.stderr)
+
+    def test_control_a_finite_term_fits(self):
+        config = write("finite.toml", CUSTOM % "t*cos(theta)")
+        proc = model("fit", sim_log(), "--config", config)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("broken.c1", proc.stdout)
 
 
 if __name__ == "__main__":
