@@ -170,6 +170,9 @@ class AbsurdValues(unittest.TestCase):
         proc = model("fit", self.csv, "--config", self.config)
         self.assertEqual(proc.returncode, 0, proc.stderr)
         self.assertIn("3 malformed log lines skipped", proc.stdout)
+        # By reason, with the first line, as resolverd prints them.
+        self.assertIn("note: absurd_value: 3 line(s) not read, the first: " + work("absurd.csv") +
+                      ":102:8: column 'R/D angle [deg]' (rd_angle): '1e300'", proc.stdout)
 
 
 class CoarseTime(unittest.TestCase):
