@@ -503,8 +503,16 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     read(*t, "rd_bits", c.bench.rd_bits, s, "bench");
     read(*t, "use_bench_info", c.bench.use_bench_info, s, "bench");
     read(*t, "reference_aligned", c.bench.reference_aligned, s, "bench");
-    require_positive(c.bench.p_r, "[bench] p_r", s);
-    require_positive(c.bench.p, "[bench] p", s);
+    // 1..255, as BENCH_INFO and resolver-sim carry them: p_r = 2147483647 on a real
+    // log gave "model: converged over 2856153251 revolutions".
+    for (const auto& [key, value] : {std::pair<const char*, int>{"p_r", c.bench.p_r}, {"p", c.bench.p}}) {
+      if (value < 1 || value > 255) {
+        const toml::node* node = t->get(key);
+        throw ConfigError((node != nullptr ? where(s, *node) : s) + ": [bench] " + key + " must be 1..255 (" +
+                          (std::string_view(key) == "p_r" ? "resolver" : "motor") +
+                          " pole pairs, as BENCH_INFO carries them), got " + std::to_string(value));
+      }
+    }
     if (c.bench.rd_bits < 1 || c.bench.rd_bits > 16) {
       throw ConfigError(s + ": [bench] rd_bits must be 1..16 (the rd_angle signal is 16 bits), got " +
                         std::to_string(c.bench.rd_bits));

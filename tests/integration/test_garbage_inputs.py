@@ -17,7 +17,8 @@ now are refused or counted with a message naming the file, line, column or optio
   ConfigRanges    [estimator] max_order = 2000 replayed for minutes, 2147483647 ended
                   in "std::bad_alloc"; now exit 2 naming the file, line, option and
                   its range; likewise [bench] sample_rate_hz = 1e-300 (was taken:
-                  "0 moving over 3.2e+303 s"), 0.001, 1e300, -5, inf
+                  "0 moving over 3.2e+303 s"), 0.001, 1e300, -5, inf; and [bench]
+                  p_r = 2147483647 (was: "converged over 2856153251 revolutions")
   CoarseTable     resolver-model export --points 8 of a 10 % imbalance: a table with
                   0.065 rad interpolation error (2160x the noise floor) written with
                   no warning; now a stderr warning with the error, the floor and the
@@ -249,6 +250,11 @@ class ConfigRanges(unittest.TestCase):
         for v in ("1e-300", "0.001", "1e300", "-5", "inf"):
             refused(self, "[bench]\np_r = 3\nsample_rate_hz = %s\n" % v, "rate_" + v,
                     ":3: [bench] sample_rate_hz must be 1 .. 1e6 Hz (0 = take it from BENCH_INFO), got ")
+
+    def test_absurd_pole_pairs(self):
+        refused(self, "[bench]\np_r = 2147483647\n", "p_r_huge",
+                ":2: [bench] p_r must be 1..255 (resolver pole pairs, as BENCH_INFO carries them), got 2147483647")
+        refused(self, "[bench]\np = 1000\n", "p_huge", ":2: [bench] p must be 1..255 (motor pole pairs")
 
     def test_control_max_order_at_its_limit_runs(self):
         config = write("max_order_64.toml", '[estimator]\nmethod = "fourier_reference"\nmax_order = 64\n')

@@ -121,6 +121,20 @@ TEST(DaemonConfig, AbsurdRatesAreNamedWithTheRange) {
   EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 1e6\n", "ok.toml").bench.sample_rate_hz, 1e6);
 }
 
+// Issue 25: p_r = 2147483647 was taken, and a replay "converged over 2856153251 revolutions".
+TEST(DaemonConfig, PolePairsBeyondWhatABenchHasAreNamed) {
+  EXPECT_NE(error_of("[bench]\np_r = 2147483647\n").find("test.toml:2: [bench] p_r must be 1..255 (resolver pole "
+                                                           "pairs, as BENCH_INFO carries them), got 2147483647"),
+            std::string::npos)
+      << error_of("[bench]\np_r = 2147483647\n");
+  EXPECT_NE(error_of("[bench]\np_r = 3\np = 256\n").find("test.toml:3: [bench] p must be 1..255 (motor"),
+            std::string::npos);
+  EXPECT_NE(error_of("[bench]\np = 0\n").find("[bench] p must be 1..255"), std::string::npos);
+  const DaemonConfig c = parse_daemon_config("[bench]\np_r = 255\np = 1\n", "ok.toml");
+  EXPECT_EQ(c.bench.p_r, 255);
+  EXPECT_EQ(c.bench.p, 1);
+}
+
 TEST(DaemonConfig, WakeIdsAreAutoOrCanIds) {
   const DaemonConfig d = parse_daemon_config("", "t.toml");
   EXPECT_TRUE(d.can.wake_auto);
