@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "daemon/core/discovery/model_discovery.h"
@@ -23,10 +24,28 @@ std::string default_dbc_path() { return "proto/resolver_bench.dbc (built into re
 namespace {
 
 constexpr std::int64_t kMaxExtendedCanId = 0x1FFFFFFF;
+/// [estimator] max_order's largest value: at 64 (129 parameters) a 2 s log of the
+/// default bench replays at 54k frames/s on the project's machine, 9 times its
+/// frame rate; at 128 at 24k, at 512 at 870 frames/s (slower than the bench).
+constexpr int kMaxFourierOrder = 64;
+/// [Hz] Sample and row rates: above 1 MHz two samples share a microsecond stamp;
+/// below 1 Hz no bench samples a resolver (1e-300 made every period 1e300 s, and
+/// every window "0 moving" over 3.2e+303 s).
+constexpr double kMinRateHz = 1.0;
+constexpr double kMaxRateHz = 1e6;
 
 std::string where(const std::string& source, const toml::node& node) {
   const auto& src = node.source();
   return source + ":" + std::to_string(src.begin.line);
+}
+
+/// A rate option: 0 (unset) or kMinRateHz..kMaxRateHz, NaN and inf refused too.
+void check_rate(const toml::table& t, std::string_view key, double value, const std::string& section,
+                const std::string& zero_means, const std::string& s) {
+  if (value == 0.0 || (value >= kMinRateHz && value <= kMaxRateHz)) return;
+  const toml::node* node = t.get(key);
+  throw ConfigError((node != nullptr ? where(s, *node) : s) + ": [" + section + "] " + std::string(key) +
+                    " must be 1 .. 1e6 Hz (" + zero_means + "), got " + fmt::format("{:g}", value));
 }
 
 /// Rejects keys of `table` that are not in `allowed` (typos must not be silent).
@@ -346,9 +365,7 @@ void read_csv_section(const toml::table& t, CsvInputConfig& c, const std::string
   else if (unit == "filetime") c.map.time_unit = TimeUnit::kFiletime;
   else throw ConfigError(s + ": [input.csv] time_unit must be \"s\", \"ms\", \"us\" or \"filetime\", got \"" + unit + "\"");
   read(t, "row_rate_hz", c.map.row_rate_hz, s, "input.csv");
-  if (!(c.map.row_rate_hz >= 0.0) || !std::isfinite(c.map.row_rate_hz)) {
-    throw ConfigError(s + ": [input.csv] row_rate_hz must be a finite number >= 0");
-  }
+  check_rate(t, "row_rate_hz", c.map.row_rate_hz, "input.csv", "rows per second of an export without a time column", s);
   if (c.map.time && c.map.row_rate_hz > 0.0) {
     throw ConfigError(s + ": [input.csv] row_rate_hz is for exports without a time column; this one names time_column");
   }
@@ -474,9 +491,7 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source", "reference_aligned"}, s);
     read(*t, "sample_rate_hz", c.bench.sample_rate_hz, s, "bench");
     // Written so NaN fails too (found by fuzzing: NaN < 0 is false).
-    if (!(c.bench.sample_rate_hz >= 0.0) || !std::isfinite(c.bench.sample_rate_hz)) {
-      throw ConfigError(s + ": [bench] sample_rate_hz must be a finite number >= 0 (0 = take it from BENCH_INFO)");
-    }
+    check_rate(*t, "sample_rate_hz", c.bench.sample_rate_hz, "bench", "0 = take it from BENCH_INFO", s);
     std::string time_source = "counter";
     read(*t, "time_source", time_source, s, "bench");
     if (time_source != "counter" && time_source != "frame") {
@@ -488,8 +503,16 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     read(*t, "rd_bits", c.bench.rd_bits, s, "bench");
     read(*t, "use_bench_info", c.bench.use_bench_info, s, "bench");
     read(*t, "reference_aligned", c.bench.reference_aligned, s, "bench");
-    require_positive(c.bench.p_r, "[bench] p_r", s);
-    require_positive(c.bench.p, "[bench] p", s);
+    // 1..255, as BENCH_INFO and resolver-sim carry them: p_r = 2147483647 on a real
+    // log gave "model: converged over 2856153251 revolutions".
+    for (const auto& [key, value] : {std::pair<const char*, int>{"p_r", c.bench.p_r}, {"p", c.bench.p}}) {
+      if (value < 1 || value > 255) {
+        const toml::node* node = t->get(key);
+        throw ConfigError((node != nullptr ? where(s, *node) : s) + ": [bench] " + key + " must be 1..255 (" +
+                          (std::string_view(key) == "p_r" ? "resolver" : "motor") +
+                          " pole pairs, as BENCH_INFO carries them), got " + std::to_string(value));
+      }
+    }
     if (c.bench.rd_bits < 1 || c.bench.rd_bits > 16) {
       throw ConfigError(s + ": [bench] rd_bits must be 1..16 (the rd_angle signal is 16 bits), got " +
                         std::to_string(c.bench.rd_bits));
@@ -551,7 +574,13 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
     c.sincos.forgetting = forgetting;
     c.fourier.forgetting = forgetting;
     read(*t, "max_order", c.fourier.max_order, s, "estimator");
-    require_positive(c.fourier.max_order, "[estimator] max_order", s);
+    // The fit has 2 max_order + 1 parameters, updated every sample at a cost of
+    // their square: 2000 ran for minutes on a 2 s log, 2^31 - 1 ended in bad_alloc.
+    if (c.fourier.max_order < 1 || c.fourier.max_order > kMaxFourierOrder) {
+      throw ConfigError(where(s, *t->get("max_order")) + ": [estimator] max_order must be 1.." +
+                        std::to_string(kMaxFourierOrder) + " (the highest harmonic fourier_reference fits; each order "
+                        "adds two parameters, updated every sample), got " + std::to_string(c.fourier.max_order));
+    }
     if (const toml::node* h = t->get("harmonics")) {
       const toml::array* arr = h->as_array();
       if (arr == nullptr) throw ConfigError(where(s, *h) + ": [estimator] harmonics must be an array of orders, e.g. [3]");

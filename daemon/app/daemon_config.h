@@ -41,7 +41,7 @@
 //   max_speed_change = 0.02    # hwang_integral
 //   forgetting = 1.0           # sincos_least_squares / fourier_reference: 1 = all data
 //   harmonics = [3]            # sincos_least_squares with a reference angle: K_n fitted
-//   max_order = 4              # fourier_reference: highest harmonic
+//   max_order = 4              # fourier_reference: highest harmonic, 1..64
 //   [compensation]
 //   enabled = true
 //   domain = "angle"           # or "signal" (sincos_least_squares: correct sin/cos, then atan2)

@@ -71,7 +71,7 @@ class AscInput final : public ReaderInput<AscReader> {
 class CsvInput final : public ReaderInput<CsvReader> {
  public:
   CsvInput(const std::string& path, const CsvInputConfig& config)
-      : ReaderInput(LogFormat::kCsv, path, config.format), decoder_(config.map), decimal_(config.format.decimal),
+      : ReaderInput(LogFormat::kCsv, path, config.format), path_(path), decoder_(config.map), decimal_(config.format.decimal),
         row_rate_hz_(config.map.row_rate_hz) {
     // Read up to the first row so the column names are known and bound now:
     // a column the export lacks is a config error before anything runs.
@@ -80,25 +80,50 @@ class CsvInput final : public ReaderInput<CsvReader> {
       throw ConfigError(path + (reader_.names_line() > 0 ? ":" + std::to_string(reader_.names_line()) : std::string()) +
                         ": [input.csv.columns] " + *missing);
     }
+    // The first row decides whether the columns line up at all: a first row
+    // with more fields than the names (decimal commas split at a ',') would be
+    // read, row after row, as other numbers. Refused before anything runs.
+    if (first_ == CsvReader::Status::kRow) {
+      first_line_ = reader_.line_number();
+      first_problem_ = decoder_.decode(row_, decimal_, first_row_, reader_.delimiter());
+      if (first_problem_ && first_problem_->reason == "extra_fields") {
+        throw ConfigError(path + ":" + std::to_string(reader_.line_number()) + ":" +
+                          std::to_string(first_problem_->column) + ": the first data row does not match [input.csv]: " +
+                          first_problem_->message);
+      }
+    }
   }
   Status next(LogRecord& record) override {
     record.is_row = true;
     CsvReader::Status st = CsvReader::Status::kEnd;
+    const bool decoded = first_ == CsvReader::Status::kRow;
     if (first_) {
       st = *first_;
       first_.reset();
     } else {
       st = reader_.next(row_);
     }
-    if (st == CsvReader::Status::kEnd) return Status::kEnd;
+    if (st == CsvReader::Status::kEnd) {
+      check_time_resolution(true);
+      return Status::kEnd;
+    }
     if (st == CsvReader::Status::kBadLine) {
       problem_ = reader_.problem();
       return Status::kBadLine;
     }
-    if (auto p = decoder_.decode(row_, decimal_, record.row)) {
+    std::optional<TextProblem> p;
+    if (decoded) {
+      record.row = first_row_;
+      p = std::move(first_problem_);
+      first_problem_.reset();
+    } else {
+      p = decoder_.decode(row_, decimal_, record.row, reader_.delimiter());
+    }
+    if (p) {
       problem_ = std::move(*p);
       return Status::kBadLine;
     }
+    check_time_resolution(false);
     record.timestamp_us =
         record.row.has_time ? record.row.time_us
                             : std::llround(static_cast<double>(record.row.sequence) * 1e6 / row_rate_hz_);
@@ -106,11 +131,23 @@ class CsvInput final : public ReaderInput<CsvReader> {
   }
 
  private:
+  std::string path_;
   RowDecoder decoder_;
   char decimal_;
   double row_rate_hz_;
   CsvRow row_;
   std::optional<CsvReader::Status> first_;
+  /// A time column coarser than the rows (0.01 s at 1 kHz) times no row: refused.
+  void check_time_resolution(bool at_end) {
+    if (auto why = decoder_.check_time_resolution(at_end)) {
+      throw ConfigError(path_ + ":" + std::to_string(first_line_) + "-" + std::to_string(reader_.line_number()) +
+                        ": " + *why);
+    }
+  }
+
+  std::uint64_t first_line_ = 0;             ///< line of the first data row
+  RowSample first_row_;                       ///< the first row, decoded in the constructor
+  std::optional<TextProblem> first_problem_;  ///< and its problem
 };
 
 /// The extension of `path`, lower case, without the dot ("" when none).

@@ -97,8 +97,12 @@ class Pipeline {
   void count_problem(std::string_view reason, const std::string& message);
   /// End of input: emit the open sample, publish a final health_t.
   void finish();
-  /// Log loop: counters and joins restart, estimates and statistics stay.
-  void restart_sequence() { stream_.restart_sequence(); }
+  /// Log loop: counters and joins restart, estimates and statistics stay; the
+  /// signal health does not read the joint between passes as a fault.
+  void restart_sequence() {
+    stream_.restart_sequence();
+    signal_health_.new_pass();
+  }
   /// Live idle time: publishes health_t when a second has passed since the
   /// last one even if no frame arrived. now_us [us] on the frames' clock.
   void tick(std::int64_t now_us);

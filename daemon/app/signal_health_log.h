@@ -27,6 +27,8 @@ class SignalHealthLog {
 
   void add(const Sample& s);
   void finish();
+  /// A looped log's next pass begins (SignalHealthMonitor::new_pass).
+  void new_pass() { monitor_.new_pass(); }
   void set_pole_pairs(int p_r) { monitor_.set_pole_pairs(p_r); }
   void set_sample_rate(double hz) { monitor_.set_sample_rate(hz); }
   void set_full_scale(double full_scale, double clip_margin) { monitor_.set_full_scale(full_scale, clip_margin); }

@@ -1,6 +1,8 @@
 #include "daemon/decode/row_decoder.h"
 
 #include <algorithm>
+#include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -25,6 +27,28 @@ int time_scale_exp10(TimeUnit unit) {
 }
 
 bool is_angle(Role r) { return r == Role::kRdAngle || r == Role::kRefAngle; }
+bool is_current(Role r) { return r == Role::kIA || r == Role::kIB || r == Role::kIC; }
+
+/// Fields without the empty ones at the end (a trailing delimiter).
+std::size_t used_fields(const std::vector<std::string_view>& fields) {
+  std::size_t n = fields.size();
+  while (n > 0 && fields[n - 1].empty()) --n;
+  return n;
+}
+
+/// When `text` is a number with the other decimal mark: a hint naming the setting.
+std::string decimal_hint(std::string_view text, char decimal) {
+  const char other = decimal == ',' ? '.' : ',';
+  if (!parse_csv_number(text, other)) return {};
+  return fmt::format(" (a '{}' decimal mark: set [input.csv] decimal = \"{}\")", other, other);
+}
+
+/// The largest magnitude a value of role `r` may have, in the role's unit, and that unit.
+std::pair<double, const char*> role_limit(Role r) {
+  if (is_angle(r)) return {RowDecoder::kMaxAngleRad, "rad"};
+  if (is_current(r)) return {RowDecoder::kMaxCurrentA, "A"};
+  return {RowDecoder::kMaxSinCos, "(the export's unit)"};
+}
 
 }  // namespace
 
@@ -60,6 +84,9 @@ std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& name
   for (std::size_t r = 0; r < kRoleCount; ++r) {
     if (map_.roles[r]) roles_[r] = resolve(map_.roles[r]->column, std::string(role_name(static_cast<Role>(r))));
   }
+  std::vector<std::string_view> views(names.begin(), names.end());
+  expected_fields_ = used_fields(views);
+  fields_from_names_ = expected_fields_ > 0;
   if (missing.empty()) return std::nullopt;
   std::string have;
   for (const std::string& n : names) have += (have.empty() ? "'" : ", '") + n + "'";
@@ -68,9 +95,26 @@ std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& name
                                   : " (the columns are " + have + ")");
 }
 
-std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, RowSample& out) {
+std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, RowSample& out,
+                                              CsvFormat::Delimiter delimiter) {
   out = RowSample{};
   out.sequence = sequence_++;
+  const std::size_t fields = used_fields(row.fields);
+  if (expected_fields_ == 0) expected_fields_ = fields;
+  if (fields > expected_fields_) {
+    std::string why = fields_from_names_
+                          ? fmt::format("the row has {} fields, the column-name line has {}", fields, expected_fields_)
+                          : fmt::format("the row has {} fields, the first data row has {}", fields, expected_fields_);
+    why += ": its fields do not line up with the columns, so the row is not read";
+    if (delimiter == CsvFormat::Delimiter::kComma) {
+      why += fmt::format(
+          "; the delimiter is ',' and a decimal comma splits a number in two (\"1,5,2,3\" for 1.5 and 2.3 reads as 4 "
+          "fields): if the export writes decimal commas, its delimiter is ';' or a tab and [input.csv] needs "
+          "decimal = \",\" (with delimiter = \";\" or \"tab\")");
+    }
+    const std::size_t at = expected_fields_ < row.columns.size() ? row.columns[expected_fields_] : row.end_column;
+    return TextProblem{"extra_fields", at, why};
+  }
   auto field = [&](const Bound& b, const ColumnRef& ref, std::string_view& text) -> std::optional<TextProblem> {
     if (b.field >= row.fields.size()) {
       return TextProblem{"missing_column", row.end_column,
@@ -86,11 +130,29 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     const auto t = parse_csv_scaled_integer(text, decimal, time_scale_exp10(map_.time_unit));
     if (!t || (map_.time_unit == TimeUnit::kFiletime && *t < 0)) {
       return TextProblem{"bad_number", row.columns[time_->field],
-                         fmt::format("{} (time): expected a number with '{}' as decimal mark, found '{}'",
-                                     map_.time->describe(), decimal, text.substr(0, 40))};
+                         fmt::format("{} (time): expected a number with '{}' as decimal mark, found '{}'{}",
+                                     map_.time->describe(), decimal, text.substr(0, 40), decimal_hint(text, decimal))};
     }
     out.has_time = true;
     out.time_us = map_.time_unit == TimeUnit::kFiletime ? *t - kFiletimeToUnixUs : *t;
+    if (!time_checked_ && time_steps_ < kTimeCheckSteps) {
+      if (have_last_time_) {
+        const std::int64_t step = out.time_us - last_time_us_;
+        ++time_steps_;
+        if (step == 0) ++repeated_times_;
+        if (step > 0) {
+          if (min_time_step_us_ == 0 || step < min_time_step_us_) min_time_step_us_ = step;
+          if (first_change_row_ < 0) {
+            first_change_row_ = out.sequence;
+            first_change_us_ = out.time_us;
+          }
+          last_change_row_ = out.sequence;
+          last_change_us_ = out.time_us;
+        }
+      }
+      have_last_time_ = true;
+      last_time_us_ = out.time_us;
+    }
   }
   std::array<double, kRoleCount> raw{};
   for (std::size_t r = 0; r < kRoleCount; ++r) {
@@ -101,11 +163,19 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     const auto v = parse_csv_number(text, decimal);
     if (!v) {
       return TextProblem{"bad_number", row.columns[roles_[r]->field],
-                         fmt::format("{} ({}): expected a number with '{}' as decimal mark, found '{}'",
+                         fmt::format("{} ({}): expected a number with '{}' as decimal mark, found '{}'{}",
                                      role.column.describe(), role_name(static_cast<Role>(r)), decimal,
-                                     text.substr(0, 40))};
+                                     text.substr(0, 40), decimal_hint(text, decimal))};
     }
     raw[r] = (*v * role.scale + role.offset) * role.to_role_unit;
+    const auto [limit, unit] = role_limit(static_cast<Role>(r));
+    if (!(std::abs(raw[r]) <= limit)) {  // also catches inf and nan
+      return TextProblem{"absurd_value", row.columns[roles_[r]->field],
+                         fmt::format("{} ({}): '{}' is {:g} {}, past the {:g} {} any bench measures; the row is not read "
+                                     "(a wrong unit, scale or column?)",
+                                     role.column.describe(), role_name(static_cast<Role>(r)), text.substr(0, 40), raw[r],
+                                     unit, limit, unit)};
+    }
   }
   // Only a whole row moves the unwrapping state.
   for (std::size_t r = 0; r < kRoleCount; ++r) {
@@ -119,6 +189,27 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
     out.roles = static_cast<std::uint16_t>(out.roles | role_bit(static_cast<Role>(r)));
   }
   return std::nullopt;
+}
+
+std::optional<std::string> RowDecoder::check_time_resolution(bool at_end) {
+  if (time_checked_ || !map_.time) return std::nullopt;
+  if (time_steps_ < kTimeCheckSteps && !(at_end && time_steps_ >= 16)) return std::nullopt;
+  time_checked_ = true;
+  if (static_cast<double>(repeated_times_) < kMaxRepeatedTimeShare * time_steps_) return std::nullopt;
+  std::string rate;
+  if (last_change_row_ > first_change_row_ && last_change_us_ > first_change_us_) {
+    const double hz = static_cast<double>(last_change_row_ - first_change_row_) * 1e6 /
+                      static_cast<double>(last_change_us_ - first_change_us_);
+    rate = fmt::format(" (the rows between its changes come at about {:.4g} Hz)", hz);
+  }
+  const std::string resolution =
+      min_time_step_us_ > 0 ? fmt::format("resolves only {:g} s", static_cast<double>(min_time_step_us_) / 1e6)
+                            : std::string("never changes");
+  return fmt::format(
+      "{} (time): {} of the first {} rows repeat the previous row's time: the column {}, coarser than the rows "
+      "come{}; rows sharing a time have no time between them (the rotor would seem not to move). Export the time "
+      "with more digits, or, if the rows are evenly spaced, drop [input.csv] time_column and set row_rate_hz",
+      map_.time->describe(), repeated_times_, time_steps_ + 1, resolution, rate);
 }
 
 }  // namespace resolver

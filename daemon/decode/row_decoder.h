@@ -13,9 +13,16 @@
 //   currents  "A" or "mA", after scale and offset
 //   sin, cos  raw * scale + offset, any consistent unit
 //
-// Every row yields a sample or a problem (bad_number, missing_column) naming
-// the column; rows with odd times are the sample clock's business (it counts
-// and re-anchors them, sample_clock.h). Pure: no I/O.
+// Every row yields a sample or a problem (bad_number, missing_column,
+// extra_fields, absurd_value) naming the column; rows with odd times are the
+// sample clock's business (it counts and re-anchors them, sample_clock.h).
+// A row with more fields than the column-name line (or, without one, than the
+// first data row) is refused whole: its fields do not line up with the names,
+// most often because a decimal comma was split at a ',' delimiter ("1,5,2,3"
+// for 1.5 and 2.3), which would otherwise read as other, wrong numbers.
+// A value past what any bench measures (RowDecoder::kMaxAngleRad, ...) is
+// refused as absurd_value: far past that a double keeps no angle at all.
+// Pure: no I/O.
 #pragma once
 
 #include <array>
@@ -63,6 +70,15 @@ struct RowMap {
 
 class RowDecoder {
  public:
+  /// Largest |angle| [rad] a row may give (after scale and offset, before
+  /// wrapping; 1.6e7 revolutions of a multi-turn count): a double still
+  /// resolves it to 1.5e-8 rad. Past it the wrapped angle is noise.
+  static constexpr double kMaxAngleRad = 1e8;
+  /// Largest |current| [A] a row may give.
+  static constexpr double kMaxCurrentA = 1e6;
+  /// Largest |sin| or |cos| in the export's unit (ADC counts of a 32-bit converter fit).
+  static constexpr double kMaxSinCos = 1e12;
+
   explicit RowDecoder(RowMap map) : map_(std::move(map)) {}
 
   /// Resolves column names against the export's column-name line (`names`,
@@ -71,11 +87,24 @@ class RowDecoder {
   [[nodiscard]] std::optional<std::string> bind(const std::vector<std::string>& names);
 
   /// Decodes one data row (after bind()). A problem names the column (reason
-  /// bad_number or missing_column); the row still counts as one in the
-  /// sequence. Never throws except std::bad_alloc.
-  std::optional<TextProblem> decode(const CsvRow& row, char decimal, RowSample& out);
+  /// bad_number, missing_column or absurd_value) or the field count
+  /// (extra_fields); the row still counts as one in the sequence. `delimiter`
+  /// only words the extra_fields message. Never throws except std::bad_alloc.
+  std::optional<TextProblem> decode(const CsvRow& row, char decimal, RowSample& out,
+                                    CsvFormat::Delimiter delimiter = CsvFormat::Delimiter::kAuto);
 
   [[nodiscard]] const RowMap& map() const { return map_; }
+
+  /// Rows whose time steps decide whether the time column resolves the rows.
+  static constexpr int kTimeCheckSteps = 200;
+  /// A time column is too coarse when this share of its steps or more are 0
+  /// (the same time as the row before): 0.01 s at 1 kHz repeats 9 times in 10.
+  static constexpr double kMaxRepeatedTimeShare = 0.25;
+  /// Once kTimeCheckSteps rows with a time were decoded (or at the end, `at_end`,
+  /// after at least 16): a message when the time column repeats too often to
+  /// time the rows (naming the column, its resolution and the row rate the
+  /// rows between its changes suggest), else nullopt. Says it once.
+  [[nodiscard]] std::optional<std::string> check_time_resolution(bool at_end);
 
  private:
   struct Bound {
@@ -86,6 +115,18 @@ class RowDecoder {
   std::array<std::optional<Bound>, kRoleCount> roles_;
   std::array<AngleUnwrapper, kRoleCount> unwrap_{};
   std::int64_t sequence_ = 0;
+  /// Fields a row may have: the column-name line's (bind), else the first row's; 0 = not known yet.
+  std::size_t expected_fields_ = 0;
+  bool fields_from_names_ = false;
+  // The time column's first kTimeCheckSteps steps (check_time_resolution).
+  bool time_checked_ = false;
+  bool have_last_time_ = false;
+  std::int64_t last_time_us_ = 0;
+  int time_steps_ = 0;
+  int repeated_times_ = 0;
+  std::int64_t min_time_step_us_ = 0;  ///< smallest positive step
+  std::int64_t first_change_row_ = -1, last_change_row_ = -1;  ///< sequence where the time changed
+  std::int64_t first_change_us_ = 0, last_change_us_ = 0;
 };
 
 }  // namespace resolver

@@ -46,6 +46,7 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
                             ++out.problems;
                             ++problem_counts[std::string(reason)];
                           }});
+  std::map<std::string, std::pair<std::int64_t, std::string>, std::less<>> bad_line_reasons;  ///< count, first
   LogRecord record;
   std::int64_t since_progress = 0;
   bool at_end = false;  // the end of the file, not of --to
@@ -57,6 +58,11 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
     }
     if (st == LogInput::Status::kBadLine) {
       ++out.bad_lines;
+      // By reason, with the first line of each: resolverd prints them; here they are notes.
+      const TextProblem& p = reader->problem();
+      auto [it, first] = bad_line_reasons.try_emplace(p.reason, 0, std::string());
+      if (first) it->second.second = fmt::format("{}:{}:{}: {}", path, reader->line_number(), p.column, p.message);
+      ++it->second.first;
       continue;
     }
     ++out.frames;
@@ -122,6 +128,9 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
     if (it != problem_counts.end()) {
       out.notes.push_back(fmt::format("{}: {} (the sample clock re-anchored; every sample after it used)", odd, it->second));
     }
+  }
+  for (const auto& [reason, seen] : bad_line_reasons) {
+    out.notes.push_back(fmt::format("{}: {} line(s) not read, the first: {}", reason, seen.first, seen.second));
   }
   if (const auto it = problem_counts.find("sample_gap"); it != problem_counts.end()) {
     out.notes.push_back(fmt::format("sample_gap: {} (samples missing from the recording, found from time)", it->second));

@@ -29,6 +29,7 @@
 
 #include "daemon/app/exit_codes.h"
 #include "daemon/app/progress_meter.h"
+#include "daemon/core/angles.h"
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
 #include "daemon/core/model/model_spec.h"
@@ -77,6 +78,33 @@ int write_report(const resolver::LogSamples& samples, const std::string& log, co
 }
 
 /// `export`: fit, tabulate, write; one summary line on stderr.
+/// A table whose interpolation error exceeds the model's noise floor corrects
+/// the drive worse than the model does: says so on stderr, with the --points that
+/// brings it under the floor (linear interpolation's error falls as 1/N^2).
+void warn_if_coarse(const resolver::ModelFit& fit, const resolver::CalibrationTable& table, int points) {
+  // Without a noise floor from the log: a 16-bit R/D converter's quantization floor.
+  const bool have_floor = std::isfinite(fit.noise_floor_rad) && fit.noise_floor_rad > 0.0;
+  const double floor = have_floor ? fit.noise_floor_rad : resolver::kTwoPi / 65536.0 / std::sqrt(12.0);
+  if (!(table.interpolation_error > floor)) return;
+  std::string better;
+  constexpr int kMaxPoints = 1 << 20;  // --points' range
+  int n = points;
+  while (n < kMaxPoints && static_cast<double>(n) < points * std::sqrt(table.interpolation_error / floor)) n *= 2;
+  for (; n <= kMaxPoints; n *= 2) {
+    const double e = resolver::tabulate(fit.model, n).interpolation_error;
+    if (e <= floor) {
+      better = fmt::format("; --points {} gives {:.3g} rad", n, e);
+      break;
+    }
+  }
+  std::cerr << fmt::format(
+      "resolver-model: warning: --points {}: the table's interpolation error {:.3g} rad is {:.3g}x {} ({:.3g} rad): "
+      "the drive would correct worse than the model fits{}\n",
+      points, table.interpolation_error, table.interpolation_error / floor,
+      have_floor ? "the model's noise floor" : "a 16-bit R/D converter's quantization floor (the log gives no floor)",
+      floor, better);
+}
+
 int write_export(const resolver::LogSamples& samples, const std::string& log, const std::vector<std::string>& effects,
                  const resolver::DiscoveryOptions& options, const std::string& format, int points,
                  const std::string& out) {
@@ -95,6 +123,7 @@ int write_export(const resolver::LogSamples& samples, const std::string& log, co
             << " (position-error residual " << fit.residual_rms_rad << " rad, " << fit.residual_rms_rad / fit.noise_floor_rad
             << "x floor; interpolation error " << table.interpolation_error << " rad)" << (out.empty() ? "" : " to " + out)
             << "\n";
+  warn_if_coarse(fit, table, points);
   return 0;
 }
 

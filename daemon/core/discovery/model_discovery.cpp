@@ -12,6 +12,7 @@
 #include "daemon/core/discovery/narration.h"
 #include "daemon/core/discovery/ranking.h"
 #include "daemon/core/effects/registry.h"
+#include "daemon/core/model/custom_effect.h"
 #include "daemon/core/model/least_squares.h"
 
 namespace resolver {
@@ -94,6 +95,40 @@ void fill_params(ModelFit& f, const Design& d, const Eigen::MatrixXd& cov) {
     }
   }
   f.model.set_standard_errors(ses);
+}
+
+/// A custom term that is inf or nan on most of this log's rows leaves its
+/// coefficient nothing to fit: says so, naming the block and the term, instead of
+/// "not separable". (A term inf or nan everywhere is refused at load, custom_effect.h.)
+void throw_if_custom_term_not_finite(const std::vector<std::string>& effects, const PreparedLog& log,
+                                     const DiscoveryOptions& options) {
+  if (options.customs == nullptr || log.rows.empty()) return;
+  for (const auto& e : options.customs->all()) {
+    const std::string name(e->name());
+    const bool used = std::any_of(effects.begin(), effects.end(),
+                                  [&](const std::string& r) { return r == name || r.starts_with(name + "("); });
+    if (!used) continue;
+    for (std::size_t i = 0; i < e->term_count(); ++i) {
+      std::size_t bad = 0;
+      const FitRow* first = nullptr;
+      double value = 0.0;
+      for (const FitRow& r : log.rows) {
+        const double v = e->term_value(i, r.sig);
+        if (std::isfinite(v)) continue;
+        if (bad++ == 0) {
+          first = &r;
+          value = v;
+        }
+      }
+      if (2 * bad < log.rows.size()) continue;
+      throw std::invalid_argument(fmt::format(
+          "{} custom effect '{}', term {} \"{}\" is not finite on {} of this log's {} rows (e.g. {} at theta = {:.4g}, "
+          "omega = {:.4g} rad/s, t = {:.4g} s): its coefficient has nothing to fit; a division by zero, or a function "
+          "outside its domain for this motion",
+          e->spec().origin, name, i + 1, e->spec().terms[i], bad, log.rows.size(),
+          std::isnan(value) ? "nan" : (value > 0 ? "inf" : "-inf"), first->sig.theta, first->sig.omega, first->sig.t));
+    }
+  }
 }
 
 }  // namespace
@@ -249,6 +284,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
     if (options.progress) options.progress(0.1);
   });
   if (!fr.ok) {
+    throw_if_custom_term_not_finite(f.effects, log, options);
     throw std::invalid_argument(fmt::format(
         "the model's effects ({}) are not separable with the signals in this log (e.g. harmonics(k3) and "
         "amplitude_imbalance both land on 2 theta without sin/cos)",

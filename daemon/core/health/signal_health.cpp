@@ -274,6 +274,16 @@ void SignalHealthMonitor::finish() {
   if (block_.n > 0) evaluate_block();
 }
 
+void SignalHealthMonitor::new_pass() {
+  // The angle test predicts from the pass's own first samples: the joint is a jump
+  // in angle and in speed (a log ending at 1000 r/min starts again at 200).
+  have_good_angle_ = false;
+  step_.clear();
+  angle_residual_.clear();
+  outlier_run_ = 0;
+  have_angle_ = false;  // no speed step across the joint
+}
+
 void SignalHealthMonitor::set_fault(SignalFault f, bool present, std::int64_t samples, double t, std::int64_t index,
                                     const std::string& detail) {
   SignalFaultState& st = faults_[static_cast<std::size_t>(f)];
@@ -347,9 +357,13 @@ void SignalHealthMonitor::evaluate_block() {
     set_fault(SignalFault::kLossOfTracking, false, 0, t0, i0, {});  // nothing to track: LOS says it
   }
   if (b.r_all.n > 0) {
-    set_fault(SignalFault::kClipping, b.clipped > 0, b.clipped, b.clipped_t, b.clipped_index,
+    // Started at the first offending sample; ended at the first block without one
+    // (its first_t and index are 0 there: the block's start says when).
+    set_fault(SignalFault::kClipping, b.clipped > 0, b.clipped, b.clipped > 0 ? b.clipped_t : t0,
+              b.clipped > 0 ? b.clipped_index : i0,
               fmt::format("{} sample(s) with |sin| or |cos| at full scale {:.0f}: the ADC clips", b.clipped, fs));
-    set_fault(SignalFault::kOutliers, b.outliers > 0, b.outliers, b.outlier_t, b.outlier_index,
+    set_fault(SignalFault::kOutliers, b.outliers > 0, b.outliers, b.outliers > 0 ? b.outlier_t : t0,
+              b.outliers > 0 ? b.outlier_index : i0,
               fmt::format("{} impulsive sample(s): radius or angle beyond {:g} robust sigmas of the running median",
                           b.outliers, config_.outlier_sigmas));
   }

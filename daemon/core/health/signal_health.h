@@ -201,6 +201,11 @@ class SignalHealthMonitor {
   void add(const Sample& s);
   /// End of input: evaluates the open block. Active faults stay active (the log ended in them).
   void finish();
+  /// The next sample starts a new pass of a looped log: it does not follow the
+  /// last one (the angle jumps where the log's end meets its start), so the speed
+  /// and the outlier test start over from it instead of reading the joint as an
+  /// impulse or a step. Counts, faults and the open block stay.
+  void new_pass();
   /// Starts and ends since the last call, oldest first.
   [[nodiscard]] std::vector<SignalFaultEvent> take_events();
 

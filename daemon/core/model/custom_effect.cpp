@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "daemon/core/angles.h"
 #include "daemon/core/effects/registry.h"
 
 namespace resolver {
@@ -76,6 +77,7 @@ CustomEffect::CustomEffect(CustomEffectSpec spec) : spec_(std::move(spec)) {
           "functions such as sin, cos, sign, abs)",
           spec_.origin, spec_.name, i + 1, expr, e.GetMsg(), e.GetPos() + 1));
     }
+    check_finite_somewhere(*p, i);
     const std::string& vars = expr;
     if (vars.find("theta_m") != std::string::npos || vars.find("theta_e") != std::string::npos) needs_reference_ = true;
     parsers_.push_back(std::move(p));
@@ -97,6 +99,45 @@ CustomEffect::CustomEffect(CustomEffectSpec spec) : spec_(std::move(spec)) {
 }
 
 CustomEffect::~CustomEffect() = default;
+
+void CustomEffect::check_finite_somewhere(mu::Parser& p, std::size_t i) {
+  // A term that is inf or nan wherever it is evaluated (1/(theta-theta)) makes every
+  // row unusable, and the fit then reported "not separable". Probed over angles,
+  // both directions and a few times; one finite value anywhere lets it through (a
+  // pole at one angle, 1/sin(theta), is the data's business, not the config's).
+  double bad = 0.0;
+  bool finite = false;
+  try {
+    for (int k = 0; k < 16 && !finite; ++k) {
+      for (const double w : {100.0, -100.0, 1.0, -1.0}) {
+        for (const double t : {0.0, 1.0, 10.0}) {
+          theta_ = kTwoPi * (k + 0.25) / 16.0;
+          theta_m_ = theta_ / 3.0;
+          theta_e_ = theta_m_ * 4.0;
+          omega_ = w;
+          t_ = t;
+          const double v = p.Eval();
+          if (std::isfinite(v)) {
+            finite = true;
+            break;
+          }
+          bad = v;
+        }
+        if (finite) break;
+      }
+    }
+  } catch (const mu::Parser::exception_type&) {
+    bad = std::nan("");
+  }
+  theta_ = theta_m_ = theta_e_ = omega_ = t_ = 0.0;
+  if (!finite) {
+    throw std::invalid_argument(fmt::format(
+        "{} custom effect '{}', term {} \"{}\": evaluates to {} at every angle, speed and time tried (theta "
+        "0 .. 2 pi, omega +-1 and +-100 rad/s, t 0 .. 10 s), not a number a coefficient can multiply: a division by "
+        "zero, or a function outside its domain; every row would be unusable",
+        spec_.origin, spec_.name, i + 1, spec_.terms[i], std::isnan(bad) ? "nan" : (bad > 0 ? "inf" : "-inf")));
+  }
+}
 
 EffectStage CustomEffect::stage() const {
   switch (signal_) {
@@ -138,6 +179,20 @@ void CustomEffect::signature(const SignatureRow& row, const AngleBasis& b, Value
       case CustomSignal::kId: c.d = x; break;
       case CustomSignal::kIq: c.q = x; break;
     }
+  }
+}
+
+double CustomEffect::term_value(std::size_t i, const SignatureRow& row) const {
+  const std::lock_guard lock(mutex_);
+  theta_ = row.theta;
+  theta_m_ = row.theta_m;
+  theta_e_ = row.theta_e;
+  omega_ = row.omega;
+  t_ = row.t;
+  try {
+    return parsers_.at(i)->Eval();
+  } catch (const mu::Parser::exception_type&) {
+    return std::nan("");
   }
 }
 

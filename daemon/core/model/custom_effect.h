@@ -70,8 +70,14 @@ class CustomEffect final : public Effect {
   [[nodiscard]] bool compensable() const;
 
   void signature(const SignatureRow& row, const AngleBasis& basis, Values v, SignatureColumns& out) const override;
+  /// Term `i`'s value at `row` (nan when muparser fails there).
+  [[nodiscard]] double term_value(std::size_t i, const SignatureRow& row) const;
+  [[nodiscard]] std::size_t term_count() const { return parsers_.size(); }
 
  private:
+  /// Throws std::invalid_argument naming term `i` when it is not finite anywhere.
+  void check_finite_somewhere(mu::Parser& p, std::size_t i);
+
   CustomEffectSpec spec_;
   CustomSignal signal_ = CustomSignal::kPositionError;
   std::string description_, physics_;

@@ -95,6 +95,48 @@ TEST(DaemonConfig, BadValuesAreRejectedWithTheRule) {
             std::string::npos);
 }
 
+// Issue 25: max_order = 2000 ran for minutes (a fit of 4001 parameters updated
+// every sample), 2147483647 ended in std::bad_alloc.
+TEST(DaemonConfig, MaxOrderOutsideItsRangeIsNamedWithTheRange) {
+  for (const char* v : {"2000", "2147483647", "65", "0", "-3"}) {
+    const std::string e = error_of(std::string("[estimator]\nmethod = \"fourier_reference\"\nmax_order = ") + v + "\n");
+    EXPECT_NE(e.find("test.toml:3: [estimator] max_order must be 1..64"), std::string::npos) << v << ": " << e;
+    EXPECT_NE(e.find(std::string("got ") + v), std::string::npos) << e;
+  }
+  EXPECT_EQ(parse_daemon_config("[estimator]\nmax_order = 64\n", "ok.toml").fourier.max_order, 64);
+  EXPECT_EQ(parse_daemon_config("[estimator]\nmax_order = 1\n", "ok.toml").fourier.max_order, 1);
+}
+
+// Issue 25: sample_rate_hz = 1e-300 was taken (every period 1e300 s: "0 moving
+// over 3.2e+303 s"), 0.001 made a 2 s log 4e6 s long.
+TEST(DaemonConfig, AbsurdRatesAreNamedWithTheRange) {
+  for (const char* v : {"1e-300", "0.001", "1e300", "2e6", "-5", "inf", "nan"}) {
+    const std::string e = error_of(std::string("[bench]\np = 2\nsample_rate_hz = ") + v + "\n");
+    EXPECT_NE(e.find("test.toml:3: [bench] sample_rate_hz must be 1 .. 1e6 Hz (0 = take it from BENCH_INFO), got "),
+              std::string::npos)
+        << v << ": " << e;
+    const std::string r = error_of(std::string("[input.csv]\nrow_rate_hz = ") + v + "\n");
+    EXPECT_NE(r.find("test.toml:2: [input.csv] row_rate_hz must be 1 .. 1e6 Hz"), std::string::npos) << v << ": " << r;
+  }
+  EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 0\n", "ok.toml").bench.sample_rate_hz, 0.0);
+  EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 1\n", "ok.toml").bench.sample_rate_hz, 1.0);
+  EXPECT_EQ(parse_daemon_config("[bench]\nsample_rate_hz = 1e6\n", "ok.toml").bench.sample_rate_hz, 1e6);
+}
+
+// Issue 25: p_r = 2147483647 was taken, and a replay "converged over 2856153251 revolutions".
+TEST(DaemonConfig, PolePairsBeyondWhatABenchHasAreNamed) {
+  EXPECT_NE(error_of("[bench]\np_r = 2147483647\n").find("test.toml:2: [bench] p_r must be 1..255 (resolver pole "
+                                                           "pairs, as BENCH_INFO carries them), got 2147483647"),
+            std::string::npos)
+      << error_of("[bench]\np_r = 2147483647\n");
+  EXPECT_NE(error_of("[bench]\np_r = 3\np = 256\n").find("test.toml:3: [bench] p must be 1..255 (motor"),
+            std::string::npos);
+  EXPECT_NE(error_of("[bench]\np = 0\n").find("[bench] p must be 1..255"), std::string::npos);
+  const DaemonConfig c = parse_daemon_config("[bench]\np_r = 255\np = 1\n", "ok.toml");
+  EXPECT_EQ(c.bench.p_r, 255);
+  EXPECT_EQ(c.bench.p, 1);
+}
+
 TEST(DaemonConfig, WakeIdsAreAutoOrCanIds) {
   const DaemonConfig d = parse_daemon_config("", "t.toml");
   EXPECT_TRUE(d.can.wake_auto);

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <optional>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -152,6 +153,135 @@ TEST(RowDecoder, BadRowsNameTheColumnAndKeepTheSequence) {
   EXPECT_NE(missing->message.find("column 3"), std::string::npos) << missing->message;
   ASSERT_FALSE(d.decode(row_of("133485408000100000;1;2"), ',', s));
   EXPECT_EQ(s.sequence, 2);  // the two bad rows still count
+}
+
+// Issue 25: a European export's decimal commas split at a ',' delimiter read as
+// other numbers ("0,001,359,9" as 0 s, 1 deg, 359 deg); the row must be refused.
+TEST(RowDecoder, DecimalCommasSplitAtACommaAreRefusedNotMisread) {
+  RowMap m;
+  m.time = ColumnRef{"t", 0};
+  RowRole rd;
+  rd.column = ColumnRef{"rd", 0};
+  rd.unit = "deg";
+  rd.to_role_unit = kPi / 180.0;
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  RowRole ref = rd;
+  ref.column = ColumnRef{"ref", 0};
+  m.roles[static_cast<std::size_t>(Role::kRefAngle)] = ref;
+  RowDecoder d(m);
+  ASSERT_FALSE(d.bind({"t", "rd", "ref"}));
+  RowSample s;
+  CsvRow row;
+  split_csv_line("0,001,359,9451,0,5", CsvFormat::Delimiter::kComma, row);
+  const auto p = d.decode(row, '.', s, CsvFormat::Delimiter::kComma);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "extra_fields");
+  EXPECT_EQ(p->column, 11U);  // where the fourth field, "9451", starts
+  EXPECT_NE(p->message.find("the row has 6 fields, the column-name line has 3"), std::string::npos) << p->message;
+  EXPECT_NE(p->message.find("decimal comma"), std::string::npos) << p->message;
+  EXPECT_EQ(s.roles, 0U);
+  // Control: the same values with '.' decimals, and a trailing delimiter, read.
+  split_csv_line("0.001,359.9451,0.5,", CsvFormat::Delimiter::kComma, row);
+  ASSERT_FALSE(d.decode(row, '.', s, CsvFormat::Delimiter::kComma));
+  EXPECT_EQ(s.time_us, 1000);
+  EXPECT_NEAR(s.values[static_cast<std::size_t>(Role::kRefAngle)], 0.5 * kPi / 180.0, 1e-12);
+}
+
+TEST(RowDecoder, WithoutNamesTheFirstRowSetsTheFieldCount) {
+  RowMap m;
+  RowRole rd;
+  rd.column = ColumnRef{"", 2};
+  rd.unit = "rad";
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  m.row_rate_hz = 1000.0;
+  RowDecoder d(m);
+  ASSERT_FALSE(d.bind({}));
+  RowSample s;
+  CsvRow row;
+  split_csv_line("0,1", CsvFormat::Delimiter::kComma, row);
+  ASSERT_FALSE(d.decode(row, '.', s, CsvFormat::Delimiter::kComma));
+  split_csv_line("0,1,5", CsvFormat::Delimiter::kComma, row);  // 1,5 meant 1.5
+  const auto p = d.decode(row, '.', s, CsvFormat::Delimiter::kComma);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "extra_fields");
+  EXPECT_NE(p->message.find("the first data row has 2"), std::string::npos) << p->message;
+}
+
+TEST(RowDecoder, ADecimalCommaWhereAPointIsExpectedSaysSo) {
+  RowDecoder d(degree_map());
+  ASSERT_FALSE(d.bind({"Time", "Resolver", "Encoder"}));
+  RowSample s;
+  const auto p = d.decode(row_of("133485408000000000;1,5;2"), '.', s);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "bad_number");
+  EXPECT_NE(p->message.find("set [input.csv] decimal = \",\""), std::string::npos) << p->message;
+}
+
+// Issue 25: 1e300 deg is a finite double, yet no angle at all once wrapped.
+TEST(RowDecoder, AbsurdValuesAreRefusedNamingTheColumn) {
+  RowDecoder d(degree_map());
+  ASSERT_FALSE(d.bind({"Time", "Resolver", "Encoder"}));
+  RowSample s;
+  const auto p = d.decode(row_of("133485408000000000;1e300;2"), ',', s);
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->reason, "absurd_value");
+  EXPECT_EQ(p->column, 20U);
+  EXPECT_NE(p->message.find("column 'Resolver' (rd_angle): '1e300'"), std::string::npos) << p->message;
+  EXPECT_EQ(s.roles, 0U);
+  const auto q = d.decode(row_of("133485408000000000;1;-1e20"), ',', s);
+  ASSERT_TRUE(q);
+  EXPECT_EQ(q->reason, "absurd_value");
+  EXPECT_NE(q->message.find("column 3 (ref_angle)"), std::string::npos) << q->message;
+  // A scale that overflows to inf is caught too.
+  RowMap m = degree_map();
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)]->scale = 1e300;
+  RowDecoder big(m);
+  ASSERT_FALSE(big.bind({"Time", "Resolver", "Encoder"}));
+  const auto r = big.decode(row_of("133485408000000000;1e10;2"), ',', s);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->reason, "absurd_value");
+  // Control: a large but real multi-turn angle (1e6 revolutions) reads.
+  ASSERT_FALSE(d.decode(row_of("133485408000000000;360000000;2"), ',', s));
+}
+
+// Issue 25: a time column rounded to 0.01 s at 1 kHz gives ten rows one time;
+// read as it is, the rotor never moves ("0 moving"). It must be named.
+std::optional<std::string> time_check_of(double rate_hz, const char* time_format, int rows, bool at_end) {
+  RowMap m;
+  m.time = ColumnRef{"t", 0};
+  RowRole rd;
+  rd.column = ColumnRef{"rd", 0};
+  rd.unit = "rad";
+  m.roles[static_cast<std::size_t>(Role::kRdAngle)] = rd;
+  RowDecoder d(m);
+  EXPECT_FALSE(d.bind({"t", "rd"}));
+  RowSample s;
+  for (int k = 0; k < rows; ++k) {
+    char line[64];
+    std::snprintf(line, sizeof line, time_format, k / rate_hz);
+    const std::string text = std::string(line) + ";1";
+    CsvRow row;
+    split_csv_line(text, CsvFormat::Delimiter::kSemicolon, row);
+    EXPECT_FALSE(d.decode(row, '.', s));
+    if (auto why = d.check_time_resolution(false)) return why;
+  }
+  return d.check_time_resolution(at_end);
+}
+
+TEST(RowDecoder, ATimeColumnCoarserThanTheRowsIsNamed) {
+  const auto why = time_check_of(1000.0, "%.2f", 1000, false);
+  ASSERT_TRUE(why);
+  EXPECT_NE(why->find("column 't' (time): 180 of the first 201 rows repeat the previous row's time"), std::string::npos)
+      << *why;
+  EXPECT_NE(why->find("resolves only 0.01 s"), std::string::npos) << *why;
+  EXPECT_NE(why->find("about 1000 Hz"), std::string::npos) << *why;
+  EXPECT_NE(why->find("row_rate_hz"), std::string::npos) << *why;
+  // A short export is checked at its end.
+  EXPECT_TRUE(time_check_of(1000.0, "%.2f", 50, true));
+  EXPECT_FALSE(time_check_of(1000.0, "%.2f", 50, false));
+  // Controls: the same rows timed to 1 us, and 0.01 s at 50 Hz, are fine.
+  EXPECT_FALSE(time_check_of(1000.0, "%.6f", 1000, true));
+  EXPECT_FALSE(time_check_of(50.0, "%.2f", 1000, true));
 }
 
 TEST(RowDecoder, AColumnTheExportLacksIsNamed) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/core/model/custom_effect.h"
 #include "daemon/core/model/model_spec.h"
 
 namespace resolver {
@@ -62,6 +63,42 @@ TEST(ModelSpecParse, UnknownParameterNamesTheClosest) {
   const std::string e = parse_error("harmonics(k3,k55)");
   EXPECT_NE(e.find("harmonics has no parameter 'k55' (did you mean"), std::string::npos) << e;
   EXPECT_EQ(parse_error("amplitude_imbalance"), "(accepted)");
+}
+
+}  // namespace
+}  // namespace resolver
+
+namespace resolver {
+namespace {
+
+// Issue 25: a term that is inf or nan everywhere, 1/(theta-theta), was taken and the
+// fit then said "not separable"; it is refused at load, naming the block and the term.
+std::string custom_error(const std::string& term) {
+  try {
+    CustomEffectSpec spec;
+    spec.name = "broken";
+    spec.terms = {"t", term};
+    spec.origin = "x.toml [[model.custom]] #1";
+    const CustomEffect effect(spec);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(CustomEffect, ATermThatIsNotFiniteAnywhereIsRefusedNamingIt) {
+  const std::string e = custom_error("1/(theta-theta)");
+  EXPECT_NE(e.find("x.toml [[model.custom]] #1 custom effect 'broken', term 2 \"1/(theta-theta)\": evaluates to inf at "
+                   "every angle, speed and time tried"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("division by zero"), std::string::npos) << e;
+  EXPECT_NE(custom_error("sqrt(-1-abs(omega))").find("evaluates to nan"), std::string::npos);
+  EXPECT_NE(custom_error("-1/(t-t)").find("evaluates to -inf"), std::string::npos);
+  // Controls: a pole at one angle, a root of the speed, a log of the time are finite somewhere.
+  EXPECT_EQ(custom_error("1/sin(theta)"), "");
+  EXPECT_EQ(custom_error("sqrt(omega)"), "");
+  EXPECT_EQ(custom_error("ln(t)"), "");
 }
 
 }  // namespace

@@ -325,6 +325,53 @@ TEST(SignalHealth, OutliersCountedExactlyAndNotInTheNoise) {
   EXPECT_LE(run(step).fault(SignalFault::kOutliers).samples, 8) << "a level change costs at most one run of 8";
 }
 
+// Issue 25: a looped replay joins the log's end to its start; the angle jumps
+// there, and every pass raised "outliers started ... 7 impulsive sample(s)" and
+// "outliers ended 0.000 s into the input (sample 0)" on a clean log.
+TEST(SignalHealth, ALoopJointIsNoFaultAndAnEndSaysWhen) {
+  Bench b;
+  b.rpm = 207.0;  // 20.7 electrical turns in 2 s: the end is 0.3 turn from the start
+  std::vector<Sample> pass = make_samples(b);
+  // A ramp 200 -> 1000 r/min, as resolver-sim --profile "200-1000:2": the joint is a
+  // speed step too.
+  double theta_m = 0.3;
+  for (Sample& x : pass) {
+    theta_m += (200.0 + 400.0 * x.t) / 60.0 * kTwoPi / kRate;
+    x.sin = std::round(kAmplitude * std::sin(kPr * theta_m));
+    x.cos = std::round(kAmplitude * std::cos(kPr * theta_m));
+    x.theta_rd = wrap_2pi(kPr * theta_m);
+    x.theta_m_ref = wrap_2pi(theta_m);
+  }
+  auto looped = [&](bool tell) {
+    SignalHealthMonitor m({}, kPr, kRate);
+    std::vector<SignalFaultEvent> events;
+    for (int k = 0; k < 3; ++k) {
+      if (k > 0 && tell) m.new_pass();
+      for (Sample s : pass) {
+        s.index += k * static_cast<std::int64_t>(pass.size());  // index and time go on across passes
+        s.t += k * b.seconds;
+        m.add(s);
+        for (const auto& e : m.take_events()) events.push_back(e);
+      }
+    }
+    m.finish();
+    for (const auto& e : m.take_events()) events.push_back(e);
+    return std::make_pair(m.fault(SignalFault::kOutliers).samples, events);
+  };
+  const auto [told, told_events] = looped(true);
+  EXPECT_EQ(told, 0);
+  EXPECT_TRUE(told_events.empty()) << fault_name(told_events.front().fault);
+  // Control: without new_pass() the joints read as impulses, and each end of the
+  // outlier fault is placed at the block's start, not at 0 s / sample 0.
+  const auto [blind, blind_events] = looped(false);
+  EXPECT_GT(blind, 0);
+  ASSERT_FALSE(blind_events.empty());
+  for (const auto& e : blind_events) {
+    EXPECT_GT(e.t, 1.9) << (e.started ? "start" : "end");
+    EXPECT_GT(e.index, 3000) << (e.started ? "start" : "end");
+  }
+}
+
 TEST(SignalHealth, AmplitudeWindowIsSinceTheLastTake) {
   SignalHealthMonitor m({}, kPr, kRate);
   Bench b;
