@@ -44,11 +44,14 @@ def main():
         except (OSError, UnicodeDecodeError):
             continue
         for lineno, line in enumerate(text.split("\n"), 1):
-            for n in re.findall(r"ARCHITECTURE\.md`?\)?:? \(?((?:§\d+(?:, )?)+)", line):
-                for number in re.findall(r"§(\d+)", n):
-                    if number not in sections:
-                        problems.append("%s:%d: cites docs/ARCHITECTURE.md §%s, which has no section \"## %s.\""
-                                        % (path, lineno, number, number))
+            cited = [number for n in re.findall(r"ARCHITECTURE\.md`?\)?:? \(?((?:§\d+(?:, )?)+)", line)
+                     for number in re.findall(r"§(\d+)", n)]
+            # Program output (effect sources, help texts) spells it in ASCII.
+            cited += re.findall(r"ARCHITECTURE\.md section (\d+)", line)
+            for number in cited:
+                if number not in sections:
+                    problems.append("%s:%d: cites docs/ARCHITECTURE.md §%s, which has no section \"## %s.\""
+                                    % (path, lineno, number, number))
 
     with open(os.path.join(src, "README.md"), encoding="utf-8") as f:
         readme = f.read()

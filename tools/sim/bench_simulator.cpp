@@ -26,7 +26,7 @@ ChainValues default_sim_chain() {
 
 namespace {
 
-constexpr std::int64_t kBenchInfoPeriodUs = 100000;  // 10 Hz (docs/ARCHITECTURE.md §4)
+constexpr std::int64_t kBenchInfoPeriodUs = 100000;  // 10 Hz (docs/ARCHITECTURE.md section 4)
 constexpr double kCurrentFullScale = 32767.0 * bench::kCurrentAmpsPerBit;  // [A] i16 at 1 mA/bit
 
 void require(bool ok, const std::string& message) {
@@ -74,7 +74,7 @@ SimConfig validated(SimConfig c) {
   i_peak += 5.0 * chain.impairments().sigma_i;
   require(i_peak <= kCurrentFullScale,
           fmt::format("SimConfig i_d_cmd/i_q_cmd (--id/--iq): peak phase current {:.3f} A (incl. current-sensor effects, dead "
-                      "time and 5 sigma noise) exceeds the PHASE_CURRENTS range +-32.767 A (1 mA/bit, DESIGN 4); lower --iq/--id",
+                      "time and 5 sigma noise) exceeds the PHASE_CURRENTS range +-32.767 A (1 mA/bit, docs/ARCHITECTURE.md section 4); lower --iq/--id",
                       i_peak));
   require(std::isfinite(c.theta_m0), "SimConfig theta_m0 must be finite [rad]");
   if (c.alpha_drift_per_s != 0.0) {

@@ -210,7 +210,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
 int run(int argc, char** argv) {
   CLI::App app{
       "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
-      "and write its CAN traffic (DESIGN 4 layout) as a candump -l log, with chosen sensor-chain effects.",
+      "and write its CAN traffic (the default layout, docs/ARCHITECTURE.md section 4) as a candump -l log, with chosen sensor-chain effects.",
       "resolver-sim"};  // the name in the usage line, not argv[0] (a build path)
   app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText + "\n\n" +
              resolver::format_effect_catalog());

@@ -28,6 +28,7 @@ constexpr std::array kParams{
     ParamInfo{.name = "alpha", .unit = "[1]", .description = "relative gain error of the cos channel", .min = -0.5,
               .max = 0.5},
 };
+constexpr std::size_t kAlpha = param_index(kParams, "alpha");
 
 /// The R/D angle's error for a gain (1 + alpha) on the cos channel is exactly
 ///   eps = -sum_n (-r)^n / n sin(2 n theta),  r = alpha / (2 + alpha)
@@ -45,13 +46,13 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
                      "independent of speed, and a cos-envelope amplitude off by alpha"},
                     kParams, EffectStage::kWindings) {}
   void validate(Values v) const override {
-    if (!(v[0] > -1.0)) throw std::invalid_argument("amplitude_imbalance.alpha must be > -1 (a cos gain 1 + alpha > 0)");
+    if (!(v[kAlpha] > -1.0)) throw std::invalid_argument("amplitude_imbalance.alpha must be > -1 (a cos gain 1 + alpha > 0)");
   }
   void windings(Values v, WindingStage stage, double /*theta*/, SinCos& env) const override {
-    if (stage == WindingStage::kGain) env = apply_amplitude_imbalance(AmplitudeImbalance{v[0]}, env);
+    if (stage == WindingStage::kGain) env = apply_amplitude_imbalance(AmplitudeImbalance{v[kAlpha]}, env);
   }
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignatureColumns& out) const override {
-    const double a = v[0];
+    const double a = v[kAlpha];
     const double r = a / (2.0 + a);
     const double dr = 2.0 / ((2.0 + a) * (2.0 + a));
     // d/dr of -sum (-r)^n / n sin(2n theta) = sum (-r)^(n-1) sin(2n theta).
@@ -65,7 +66,7 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
   [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
-    const double a = v[0];
+    const double a = v[kAlpha];
     const double r = a / (2.0 + a);
     double pw = -r;
     for (int n = 1; n <= kSeriesTerms; ++n) {

@@ -12,6 +12,7 @@ constexpr std::array kParams{
               .description = "delay of the analog cos path against sin, before the converter", .min = -1e-3,
               .max = 1e-3},
 };
+constexpr std::size_t kTau = param_index(kParams, "tau");
 
 class ChannelDelayEffect final : public BasicEffect {
  public:
@@ -25,8 +26,8 @@ class ChannelDelayEffect final : public BasicEffect {
                     kParams, EffectStage::kChannels) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   void channel_timing(Values v, ChannelTiming& timing) const override {
-    timing.converter_cos_dt -= v[0];
-    timing.dsp_cos_dt -= v[0];
+    timing.converter_cos_dt -= v[kTau];
+    timing.dsp_cos_dt -= v[kTau];
   }
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
     out.col(0) = envelope_column(b, 0.5 * row.omega * (1.0 - b.rd_cos(2)), 0.0, row.omega * b.env_sin(1));

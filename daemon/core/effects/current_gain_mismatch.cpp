@@ -13,7 +13,7 @@ PhaseCurrents apply_current_gain_mismatch(const CurrentGainMismatch& p, const Ph
 }
 
 DqCurrents current_gain_mismatch_dq_error(const CurrentGainMismatch& p, double i_d, double i_q, double theta_e) {
-  // The Clarke error of the extra a and b parts, then Park (docs/ARCHITECTURE.md §3).
+  // The Clarke error of the extra a and b parts, then Park (docs/ARCHITECTURE.md section 3).
   const PhaseCurrents i = ideal_phase_currents(i_d, i_q, theta_e);
   const double d_alpha = p.gain_a * i.a;
   const double d_beta = p.gain_b * i.b / std::numbers::sqrt3;
@@ -43,6 +43,8 @@ constexpr std::array kParams{
     ParamInfo{.name = "gain_b", .unit = "[1]", .description = "relative gain error of the phase b current sensor",
               .min = -0.5, .max = 0.5},
 };
+constexpr std::size_t kGainA = param_index(kParams, "gain_a");
+constexpr std::size_t kGainB = param_index(kParams, "gain_b");
 
 class CurrentGainMismatchEffect final : public BasicEffect {
  public:
@@ -50,14 +52,14 @@ class CurrentGainMismatchEffect final : public BasicEffect {
       : BasicEffect({"current_gain_mismatch",
                      "i_a (1+gain_a), i_b (1+gain_b): dq ripple at 2x theta_e of amplitude |I|/2 sqrt((gain_a - "
                      "gain_b/2)^2 + gain_b^2/12)",
-                     "DESIGN 6; current_gain_mismatch.h",
+                     "docs/ARCHITECTURE.md section 7; current_gain_mismatch.h",
                      "the phase current sensors differ in gain: i_d and i_q ripple at 2x theta_e proportional to the "
                      "current, while the resolver signals are clean (so it is not the resolver's amplitude imbalance)"},
                     kParams, EffectStage::kCurrents) {}
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_e = 2}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
   void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
-    if (stage == CurrentStage::kSensorGain) i = apply_current_gain_mismatch(CurrentGainMismatch{v[0], v[1]}, i);
+    if (stage == CurrentStage::kSensorGain) i = apply_current_gain_mismatch(CurrentGainMismatch{v[kGainA], v[kGainB]}, i);
   }
   // Taken at the operating point (i_d0, i_q0): products of a gain error with its own
   // DC shift are second order (current_gain_mismatch.h).

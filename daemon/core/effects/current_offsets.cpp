@@ -38,19 +38,21 @@ constexpr std::array kParams{
     ParamInfo{.name = "off_b", .unit = "[A]", .description = "offset of the phase b current sensor", .min = -1000.0,
               .max = 1000.0},
 };
+constexpr std::size_t kOffA = param_index(kParams, "off_a");
+constexpr std::size_t kOffB = param_index(kParams, "off_b");
 
 class CurrentOffsetsEffect final : public BasicEffect {
  public:
   CurrentOffsetsEffect()
       : BasicEffect({"current_offsets",
                      "i_a + off_a, i_b + off_b: dq ripple at 1x theta_e of amplitude hypot(off_a, off_b/sqrt3)",
-                     "DESIGN 6; current_offsets.h",
+                     "docs/ARCHITECTURE.md section 7; current_offsets.h",
                      "DC offsets of the phase current sensors: i_d and i_q ripple at 1x theta_e, a quarter period "
                      "apart, independent of load and speed; the resolver signals are clean"},
                     kParams, EffectStage::kCurrents) {}
   [[nodiscard]] bool needs_reference() const override { return true; }
   void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
-    if (stage == CurrentStage::kSensorOffset) i = apply_current_offsets(CurrentOffsets{v[0], v[1]}, i);
+    if (stage == CurrentStage::kSensorOffset) i = apply_current_offsets(CurrentOffsets{v[kOffA], v[kOffB]}, i);
   }
   void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
     const DqCurrents a = current_offsets_dq_error(CurrentOffsets{1.0, 0.0}, row.theta_e);

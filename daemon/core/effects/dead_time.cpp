@@ -19,7 +19,7 @@ double phase_distortion(double k, double magnitude, double psi) {
 
 PhaseCurrents apply_dead_time(const DeadTime& p, const PhaseCurrents& fundamental) {
   if (!p.active()) return fundamental;
-  // Clarke (docs/ARCHITECTURE.md §3) gives the fundamental's vector |I| e^{j psi}; phase x has psi_x = psi - x 2pi/3.
+  // Clarke (docs/ARCHITECTURE.md section 3) gives the fundamental's vector |I| e^{j psi}; phase x has psi_x = psi - x 2pi/3.
   const double alpha = fundamental.a;
   const double beta = (fundamental.b - fundamental.c) / std::numbers::sqrt3;
   const double magnitude = std::hypot(alpha, beta);
@@ -54,20 +54,21 @@ constexpr std::array kParams{
     ParamInfo{.name = "t_d", .unit = "[s]", .description = "inverter dead time (5th/7th current harmonics k_dt = t_d / 100 us)",
               .min = 0.0, .max = 2e-5},
 };
+constexpr std::size_t kTD = param_index(kParams, "t_d");
 
 class DeadTimeEffect final : public BasicEffect {
  public:
   DeadTimeEffect()
       : BasicEffect({"dead_time",
                      "signature model: 5th/7th current harmonics k_dt |I|, dq ripple at 6x theta_e (2 k_dt i_q on i_d)",
-                     "DESIGN 6; dead_time.h",
+                     "docs/ARCHITECTURE.md section 7; dead_time.h",
                      "inverter dead time: 5th and 7th harmonics of the phase currents, i.e. a 6x theta_e ripple on i_d "
                      "and i_q perpendicular to the current vector"},
                     kParams, EffectStage::kCurrents) {}
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_e = 6}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
   void currents(Values v, CurrentStage stage, double /*theta_e*/, PhaseCurrents& i) const override {
-    if (stage == CurrentStage::kInverter) i = apply_dead_time(DeadTime{v[0]}, i);
+    if (stage == CurrentStage::kInverter) i = apply_dead_time(DeadTime{v[kTD]}, i);
   }
   void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
     const DqCurrents a = dead_time_dq_error(DeadTime{1.0}, row.i_d0, row.i_q0, row.theta_e);  // per second of t_d

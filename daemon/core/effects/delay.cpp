@@ -12,6 +12,7 @@ constexpr std::array kParams{
     ParamInfo{.name = "d", .unit = "[s]", .description = "delay of the resolver signals behind the reference",
               .min = -1.0, .max = 1.0, .nonlinear = true},
 };
+constexpr std::size_t kD = param_index(kParams, "d");
 
 class DelayEffect final : public BasicEffect {
  public:
@@ -25,17 +26,17 @@ class DelayEffect final : public BasicEffect {
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChangeOrReversal; }
-  [[nodiscard]] double resolver_time_shift(Values v) const override { return v[0]; }
+  [[nodiscard]] double resolver_time_shift(Values v) const override { return v[kD]; }
   // eps = omega d at steady speed (delay.h).
   [[nodiscard]] bool has_motion_terms() const override { return true; }
-  [[nodiscard]] MotionTerms motion_terms(Values v, int /*p_r*/) const override { return {.per_speed_s = v[0]}; }
-  void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override { t.delay = v[0]; }
+  [[nodiscard]] MotionTerms motion_terms(Values v, int /*p_r*/) const override { return {.per_speed_s = v[kD]}; }
+  void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override { t.delay = v[kD]; }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
     // theta(t) - theta(t - d): from the fit's rows when it has them (exact across a
     // speed step), else omega d - accel d^2 / 2.
-    const double d = v[0];
+    const double d = v[kD];
     out.rd += d != 0.0 ? row.theta - row.theta_at(row.t - d) : 0.0;
     // The envelopes carry the late angle exactly: a rotation, radius unchanged.
     out.sa += d != 0.0 ? row.theta - row.theta_at(row.t - d) : 0.0;

@@ -40,27 +40,29 @@ constexpr std::array kParams{
     ParamInfo{.name = "phase", .unit = "[rad]", .description = "phase of the 1x angle error (mechanical rad)",
               .min = -10.0, .max = 10.0, .polar = Polar::kPhase},
 };
+constexpr std::size_t kE = param_index(kParams, "e");
+constexpr std::size_t kPhase = param_index(kParams, "phase");
 
 class EccentricityEffect final : public BasicEffect {
  public:
   EccentricityEffect()
       : BasicEffect({"eccentricity",
                      "resolver sees theta_m + e sin(theta_m + phase): eps = -p_r e sin(theta_m + phase), 1x mechanical",
-                     "DESIGN 6; eccentricity.h",
+                     "docs/ARCHITECTURE.md section 7; eccentricity.h",
                      "the rotor is not concentric: a 1x mechanical harmonic of the position error (order 1/p_r of "
                      "theta), only visible against the reference encoder"},
                     kParams, EffectStage::kMotion) {}
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_m = 1}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
-  [[nodiscard]] bool active(Values v) const override { return v[0] != 0.0; }
+  [[nodiscard]] bool active(Values v) const override { return v[kE] != 0.0; }
   void validate(Values v) const override {
-    if (!(std::abs(v[0]) < 1.0)) {
+    if (!(std::abs(v[kE]) < 1.0)) {
       throw std::invalid_argument("eccentricity.e must be in (-1, 1) mechanical rad so the resolver keeps turning one way");
     }
   }
   [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double /*omega_m*/, MotionState& /*state*/,
                                        bool /*commit*/) const override {
-    return eccentric_angle(Eccentricity{v[0], v[1]}, theta_m);
+    return eccentric_angle(Eccentricity{v[kE], v[kPhase]}, theta_m);
   }
   // Columns for x = e cos(phase), y = e sin(phase): e sin(theta_m + phase) = x sin theta_m + y cos theta_m.
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
@@ -71,10 +73,10 @@ class EccentricityEffect final : public BasicEffect {
   [[nodiscard]] bool linear_in_params() const override { return false; }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
-    t.shift += static_cast<double>(row.p_r) * v[0] * std::sin(row.theta_m + v[1]);
+    t.shift += static_cast<double>(row.p_r) * v[kE] * std::sin(row.theta_m + v[kPhase]);
   }
   void contribution(const SignatureRow& row, const AngleBasis& b, Values v, SignalValues& out) const override {
-    const double x = v[0] * std::cos(v[1]), y = v[0] * std::sin(v[1]);
+    const double x = v[kE] * std::cos(v[kPhase]), y = v[kE] * std::sin(v[kPhase]);
     const double pr = row.p_r;
     out += shift_column(-pr * (x * b.rd_mech_sin(1) + y * b.rd_mech_cos(1)),
                         pr * (x * b.env_mech_sin(1) + y * b.env_mech_cos(1)));

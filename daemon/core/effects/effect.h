@@ -33,6 +33,8 @@
 // amplitude (sin_cos.h). Conventions: daemon/core/angles.h (docs/ARCHITECTURE.md §3).
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -79,6 +81,17 @@ struct ParamInfo {
   /// "harmonics" fits k3; "harmonics(k5,k3_opp)" chooses others).
   bool default_fit = true;
 };
+
+/// The index of parameter `name` in an effect's ParamInfo list, at compile time:
+/// effects read their values by name (v[param_index(kParams, "beta")]), so a value
+/// cannot be read from the wrong slot and a name the list lacks does not compile.
+template <std::size_t N>
+consteval std::size_t param_index(const std::array<ParamInfo, N>& params, std::string_view name) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (params[i].name == name) return i;
+  }
+  throw "param_index: the effect has no parameter of this name";  // not a constant expression: fails to compile
+}
 
 /// Where in the chain an effect acts (for the catalog and for which signals it can change).
 enum class EffectStage : std::uint8_t {

@@ -99,10 +99,11 @@ constexpr std::array<ParamInfo, kParamCount> make_params() {
   return out;
 }
 constexpr auto kParams = make_params();
+constexpr std::size_t kK0 = param_index(kParams, "k0");
 
 Harmonics from_values(Values v) {
   Harmonics h;
-  h.k0 = v[0];
+  h.k0 = v[kK0];
   for (int i = 0; i < kOrders; ++i) {
     const auto n = static_cast<std::size_t>(i + 2);
     h.k[n] = v[static_cast<std::size_t>(kFirstSame + i)];

@@ -44,6 +44,7 @@ constexpr std::array kParams{
               .description = "drive (resolver) zero ahead of the rotor d axis (motor electrical rad)", .min = -kPi,
               .max = kPi},
 };
+constexpr std::size_t kTheta0 = param_index(kParams, "theta_0");
 
 class MountingOffsetEffect final : public BasicEffect {
  public:
@@ -51,20 +52,20 @@ class MountingOffsetEffect final : public BasicEffect {
       : BasicEffect({"mounting_offset",
                      "drive angle = theta_e + theta_0: eps = -(p_r/p) theta_0; steady i_d = -i_q sin theta_0 in the "
                      "reference frame",
-                     "DESIGN 6; mounting_offset.h",
+                     "docs/ARCHITECTURE.md section 7; mounting_offset.h",
                      "the resolver is mounted at an angle: a constant position error against the reference, the same "
                      "at every speed and in both directions"},
                     kParams, EffectStage::kMotion) {}
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool needs_aligned_reference() const override { return true; }
   [[nodiscard]] double resolver_angle_shift(Values v, int p_r, int p) const override {
-    return mounting_offset_resolver_shift(MountingOffset{v[0]}, p_r, p);
+    return mounting_offset_resolver_shift(MountingOffset{v[kTheta0]}, p_r, p);
   }
-  [[nodiscard]] double drive_frame_offset(Values v) const override { return v[0]; }
+  [[nodiscard]] double drive_frame_offset(Values v) const override { return v[kTheta0]; }
   // The windings' errors turn with the seen angle (signature.h's BasisTransform::shift).
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
-    t.shift += static_cast<double>(row.p_r) / static_cast<double>(row.p) * v[0];
+    t.shift += static_cast<double>(row.p_r) / static_cast<double>(row.p) * v[kTheta0];
   }
   // The dq currents against the reference show the offset only as a steady
   // current, which the operating point (the fit's DC i_d, i_q) absorbs: no dq column.

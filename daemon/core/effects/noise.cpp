@@ -21,17 +21,19 @@ constexpr std::array kParams{
     ParamInfo{.name = "sigma_i", .unit = "[A]", .description = "white noise on each phase current sample",
               .min = 0.0, .max = 1000.0},
 };
+constexpr std::size_t kSigmaSc = param_index(kParams, "sigma_sc");
+constexpr std::size_t kSigmaI = param_index(kParams, "sigma_i");
 
 class NoiseEffect final : public BasicEffect {
  public:
   NoiseEffect()
-      : BasicEffect({"noise", "white noise on sin/cos samples and phase currents; sets the floor", "DESIGN 6",
+      : BasicEffect({"noise", "white noise on sin/cos samples and phase currents; sets the floor", "docs/ARCHITECTURE.md section 7",
                      "measurement noise: the floor every residual is compared with"},
                     kParams, EffectStage::kNoise) {}
   [[nodiscard]] bool fittable() const override { return false; }
   void impairments(Values v, Impairments& imp) const override {
-    imp.sigma_sc += v[0];
-    imp.sigma_i += v[1];
+    imp.sigma_sc += v[kSigmaSc];
+    imp.sigma_i += v[kSigmaI];
   }
 };
 
@@ -41,6 +43,8 @@ constexpr std::array kOutlierParams{
     ParamInfo{.name = "size", .unit = "[counts]", .description = "size of each spike (random sign)", .min = 0.0,
               .max = 65535.0},
 };
+constexpr std::size_t kRate = param_index(kOutlierParams, "rate");
+constexpr std::size_t kSize = param_index(kOutlierParams, "size");
 
 class OutliersEffect final : public BasicEffect {
  public:
@@ -50,8 +54,8 @@ class OutliersEffect final : public BasicEffect {
                     kOutlierParams, EffectStage::kNoise) {}
   [[nodiscard]] bool fittable() const override { return false; }
   void impairments(Values v, Impairments& imp) const override {
-    imp.outlier_rate += v[0];
-    imp.outlier_size = v[1];
+    imp.outlier_rate += v[kRate];
+    imp.outlier_size = v[kSize];
   }
 };
 

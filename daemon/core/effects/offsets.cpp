@@ -22,6 +22,8 @@ constexpr std::array kParams{
     ParamInfo{.name = "o_c", .unit = "[fraction of amplitude]", .description = "DC offset of the cos channel",
               .min = -0.5, .max = 0.5},
 };
+constexpr std::size_t kOS = param_index(kParams, "o_s");
+constexpr std::size_t kOC = param_index(kParams, "o_c");
 
 class OffsetsEffect final : public BasicEffect {
  public:
@@ -33,7 +35,7 @@ class OffsetsEffect final : public BasicEffect {
   [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta = 1}; }
   void windings(Values v, WindingStage stage, double /*theta*/, SinCos& env) const override {
-    if (stage == WindingStage::kOffset) env = apply_offsets(Offsets{v[0], v[1]}, env);
+    if (stage == WindingStage::kOffset) env = apply_offsets(Offsets{v[kOS], v[kOC]}, env);
   }
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values /*v*/,
                  SignatureColumns& out) const override {

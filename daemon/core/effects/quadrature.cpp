@@ -23,6 +23,7 @@ constexpr std::array kParams{
     ParamInfo{.name = "beta", .unit = "[rad]", .description = "misalignment of the cos winding", .min = -0.5,
               .max = 0.5},
 };
+constexpr std::size_t kBeta = param_index(kParams, "beta");
 
 class QuadratureEffect final : public BasicEffect {
  public:
@@ -33,21 +34,21 @@ class QuadratureEffect final : public BasicEffect {
                      "a constant, independent of speed, seen by the R/D angle and the sin/cos signals alike"},
                     kParams, EffectStage::kWindings) {}
   void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {
-    if (stage == WindingStage::kFundamental) env = quadrature_fundamental(Quadrature{v[0]}, theta);
+    if (stage == WindingStage::kFundamental) env = quadrature_fundamental(Quadrature{v[kBeta]}, theta);
   }
   // rd: -(1/2)(1 - cos 2theta) per unit beta, through the converter (first order;
   // the omitted terms are O(beta^2)). c: the exact derivative of cos(theta + beta).
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignatureColumns& out) const override {
     const double th = b.env_angle();
-    out.col(0) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + v[0]));
+    out.col(0) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + v[kBeta]));
   }
   [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double th = b.env_angle();
-    out.rd += -0.5 * v[0] * (1.0 - b.rd_cos(2));
+    out.rd += -0.5 * v[kBeta] * (1.0 - b.rd_cos(2));
     // The pair (sin th, cos(th + beta)) exactly.
-    const double sn = b.env_sin(1), cq = std::cos(th + v[0]);
+    const double sn = b.env_sin(1), cq = std::cos(th + v[kBeta]);
     out.sa += wrap_pi(th - std::atan2(sn, cq));
     out.sr += std::hypot(sn, cq) - 1.0;
   }

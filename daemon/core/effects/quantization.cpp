@@ -28,6 +28,7 @@ constexpr std::array kParams{
               .min = Quantization::kMinBits, .max = Quantization::kMaxBits, .neutral = Quantization::kMaxBits,
               .integer = true},
 };
+constexpr std::size_t kRdBits = param_index(kParams, "rd_bits");
 
 class QuantizationEffect final : public BasicEffect {
  public:
@@ -36,7 +37,7 @@ class QuantizationEffect final : public BasicEffect {
                      "the converter's resolution: a uniform error of +-1/2 LSB that sets part of the floor"},
                     kParams, EffectStage::kConverter) {}
   [[nodiscard]] bool fittable() const override { return false; }
-  void converter(Values v, ConverterSpec& spec) const override { spec.rd_bits = static_cast<int>(v[0]); }
+  void converter(Values v, ConverterSpec& spec) const override { spec.rd_bits = static_cast<int>(v[kRdBits]); }
 };
 
 }  // namespace

@@ -28,7 +28,7 @@ namespace resolver {
 namespace {
 
 const std::vector<const Effect*>& registry() {
-  // One line per effect. The order is the catalog's (docs/ARCHITECTURE.md §7: resolver side
+  // One line per effect. The order is the catalog's (docs/ARCHITECTURE.md section 7: resolver side
   // first; converter; motion against the reference; currents; impairments) and
   // the forward chain's within a stage: the play (backlash) acts on the shaft
   // before the resolver's own geometry (eccentricity, mechanical harmonics).
@@ -153,7 +153,7 @@ std::string effects_markdown() {
       "# Effect catalog\n\n"
       "Generated from the effect registry (`daemon/core/effects/registry.cpp`) by `resolver-sim "
       "--effects-markdown`; do not edit by hand. Conventions: eps = theta_true - theta_measured, "
-      "theta = p_r theta_m (DESIGN 3).\n\n"
+      "theta = p_r theta_m (docs/ARCHITECTURE.md section 3).\n\n"
       "Spec (resolver-sim `--effect`): `effect:param=value[,param=value...]`. Model (`--effects`, `[model] "
       "effects`): `effect` (its default parameters) or `effect(param,param,...)`.\n";
   for (const Effect* e : registry()) {

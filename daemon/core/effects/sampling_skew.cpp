@@ -26,6 +26,7 @@ constexpr std::array kParams{
     ParamInfo{.name = "tau", .unit = "[s]", .description = "delay of the DSP's cos sample after the sin sample",
               .min = -1e-3, .max = 1e-3},
 };
+constexpr std::size_t kTau = param_index(kParams, "tau");
 
 class SamplingSkewEffect final : public BasicEffect {
  public:
@@ -33,12 +34,12 @@ class SamplingSkewEffect final : public BasicEffect {
       : BasicEffect({"sampling_skew",
                      "cos sampled tau after sin: like quadrature with beta = omega tau on the sampled sin/cos "
                      "(not the R/D angle); grows with speed",
-                     "DESIGN 6, Hanselman eq. 6-7 via beta = omega tau",
+                     "docs/ARCHITECTURE.md section 7, Hanselman eq. 6-7 via beta = omega tau",
                      "the cos channel is sampled after the sin channel: a quadrature-like error of the sin/cos pair "
                      "that grows with speed and that the R/D angle does not show"},
                     kParams, EffectStage::kChannels) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
-  void channel_timing(Values v, ChannelTiming& timing) const override { timing.dsp_cos_dt += v[0]; }
+  void channel_timing(Values v, ChannelTiming& timing) const override { timing.dsp_cos_dt += v[kTau]; }
   // c = C(theta(t + tau)) = cos(theta + omega tau): dc/dtau = -omega sin theta (first order).
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
     out.col(0) = envelope_column(b, 0.0, 0.0, -row.omega * b.env_sin(1));

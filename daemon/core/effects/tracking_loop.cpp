@@ -68,6 +68,8 @@ constexpr std::array kParams{
     ParamInfo{.name = "zeta", .unit = "[1]", .description = "closed-loop damping ratio", .min = 0.01, .max = 10.0,
               .neutral = 0.7, .nonlinear = true, .default_fit = false},
 };
+constexpr std::size_t kOmegaN = param_index(kParams, "omega_n");
+constexpr std::size_t kZeta = param_index(kParams, "zeta");
 
 class TrackingLoopEffect final : public BasicEffect {
  public:
@@ -79,25 +81,25 @@ class TrackingLoopEffect final : public BasicEffect {
                     kParams, EffectStage::kConverter) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChange; }
-  [[nodiscard]] bool active(Values v) const override { return v[0] > 0.0; }
+  [[nodiscard]] bool active(Values v) const override { return v[kOmegaN] > 0.0; }
   void validate(Values v) const override {
-    if (v[0] > 0.0 && !(v[1] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
+    if (v[kOmegaN] > 0.0 && !(v[kZeta] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
   }
   void converter(Values v, ConverterSpec& spec) const override {
-    spec.omega_n = v[0];
-    spec.zeta = v[1];
+    spec.omega_n = v[kOmegaN];
+    spec.zeta = v[kZeta];
   }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override {
-    t.omega_n = v[0];
-    t.zeta = v[1];
+    t.omega_n = v[kOmegaN];
+    t.zeta = v[kZeta];
   }
   // Both parameters act through the basis (every other effect's rd harmonics),
   // so they have no columns of their own; the fit differentiates numerically.
   // The loop's own term: a type-II loop lags a constant acceleration a by a / omega_n^2.
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
-    if (v[0] > 0.0) out.rd += row.accel / (v[0] * v[0]);
+    if (v[kOmegaN] > 0.0) out.rd += row.accel / (v[kOmegaN] * v[kOmegaN]);
   }
 };
 
