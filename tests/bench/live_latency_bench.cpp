@@ -91,6 +91,15 @@ double cpu_clock_s(clockid_t clock) {
 
 double thread_cpu_s() { return cpu_clock_s(CLOCK_THREAD_CPUTIME_ID); }
 
+/// The interface's rx_dropped counter (frames the kernel dropped before any
+/// socket), 0 where sysfs cannot be read.
+std::uint64_t rx_dropped(const std::string& iface) {
+  std::ifstream in("/sys/class/net/" + iface + "/statistics/rx_dropped");
+  std::uint64_t n = 0;
+  in >> n;
+  return n;
+}
+
 /// [s] CPU of every thread of this process except the sender: the reader and
 /// the threads the pipeline starts (the live model fit).
 double daemon_cpu_s(clockid_t sender_clock) {
@@ -223,11 +232,14 @@ RunResult run_once(const Options& o) {
   Clock::time_point last_frame{};
   clockid_t sender_clock{};
   if (::pthread_getcpuclockid(writer.native_handle(), &sender_clock) != 0) sender_clock = CLOCK_THREAD_CPUTIME_ID;
+  const std::uint64_t rx_dropped_start = o.iface.empty() ? 0 : rx_dropped(o.iface);
   double cpu_start = thread_cpu_s();
   double daemon_cpu_start = daemon_cpu_s(sender_clock);
   rusage ru_start{};
   getrusage(RUSAGE_THREAD, &ru_start);
   resolver::CanFrame frame;
+  constexpr int kQuietReadsAtEnd = 5;
+  int quiet_after_end = 0;
   for (;;) {
     const resolver::ReadStatus status = ends.reader.read(frame);
     if (status == resolver::ReadStatus::kFrame) {
@@ -259,10 +271,15 @@ RunResult run_once(const Options& o) {
           r.publish_read_us.push_back(static_cast<float>(static_cast<double>(sink.last_return_ns() - read_ns) * 1e-3));
         }
       }
-    } else if (status == resolver::ReadStatus::kDeviceGone ||  // socket pair closed by the writer
-               (status == resolver::ReadStatus::kTimeout && writer_done.load())) {  // vcan: quiet after the end
+    } else if (status == resolver::ReadStatus::kDeviceGone) {  // socket pair closed by the writer
       break;
+    } else if (status == resolver::ReadStatus::kTimeout && writer_done.load()) {
+      // vcan: quiet after the end. Frames the sender handed over may still sit in
+      // the interface's transmit queue (txqueuelen) of a starved guest: the end is
+      // several read timeouts of quiet in a row, not the first.
+      if (++quiet_after_end >= kQuietReadsAtEnd) break;
     }
+    if (status != resolver::ReadStatus::kTimeout) quiet_after_end = 0;
     pipeline.set_kernel_drops(static_cast<std::int64_t>(ends.reader.stats().kernel_drops));
     pipeline.tick(realtime_ns() / 1000);
   }
@@ -282,6 +299,7 @@ RunResult run_once(const Options& o) {
   r.daemon_cpu_s = daemon_cpu_end - daemon_cpu_start;
   r.ctx_switches = (ru_end.ru_nvcsw - ru_start.ru_nvcsw) + (ru_end.ru_nivcsw - ru_start.ru_nivcsw);
   r.kernel_drops = ends.reader.stats().kernel_drops;
+  if (!o.iface.empty()) r.iface_drops = rx_dropped(o.iface) - rx_dropped_start;
   r.frames_seen = o.read_only ? r.frames_seen_read_only : pipeline.intake().stats().frames_seen;
   r.frames_decoded = pipeline.intake().stats().frames_decoded;
   r.rejects = pipeline.intake().rejects().total();

@@ -103,7 +103,8 @@ void print_table(std::ostream& out, const Setup& s, std::vector<RunResult>& runs
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const RunResult& r = runs[i];
     out << "run " << i + 1 << ": sent " << r.sent.sent << " (failed " << r.sent.failed_down + r.sent.failed_other
-        << "), read " << r.frames_read << ", kernel drops " << r.kernel_drops << ", frames_seen " << r.frames_seen
+        << "), read " << r.frames_read << ", kernel drops " << r.kernel_drops << " (+ " << r.iface_drops
+        << " before any socket, rx_dropped), frames_seen " << r.frames_seen
         << ", decoded " << r.frames_decoded << ", rejects " << r.rejects << ", LCM publish failures " << r.lcm_failures
         << ", CPU " << fmt("%.3f", r.cpu_s) << " s over " << fmt("%.2f", r.wall_s) << " s\n";
   }
@@ -118,7 +119,7 @@ void print_table(std::ostream& out, const Setup& s, std::vector<RunResult>& runs
         << fmt("%.2f", m.cpu_percent) << " %)\n";
   }
   out << "frames: " << (all_frames_accounted(runs) ? "every frame sent was read (or counted as a kernel drop)"
-                                                   : "LOST FRAMES: sent != read + kernel drops")
+                                                   : "LOST FRAMES: sent != read + kernel drops + rx_dropped")
       << "\n";
 }
 
@@ -143,7 +144,7 @@ void write_json(std::ostream& out, const Setup& s, std::vector<RunResult>& runs)
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const RunResult& r = runs[i];
     out << (i ? ", " : "") << "{\"row\": " << row_json(rows[i]) << ", \"sent\": " << r.sent.sent
-        << ", \"read\": " << r.frames_read << ", \"kernel_drops\": " << r.kernel_drops
+        << ", \"read\": " << r.frames_read << ", \"kernel_drops\": " << r.kernel_drops << ", \"iface_drops\": " << r.iface_drops
         << ", \"frames_seen\": " << r.frames_seen << ", \"rejects\": " << r.rejects << "}";
   }
   out << "], \"median\": " << row_json(median_row(rows))
@@ -152,7 +153,8 @@ void write_json(std::ostream& out, const Setup& s, std::vector<RunResult>& runs)
 
 bool all_frames_accounted(const std::vector<RunResult>& runs) {
   return std::all_of(runs.begin(), runs.end(), [](const RunResult& r) {
-    return r.frames_read + r.kernel_drops == r.sent.sent && r.frames_seen == static_cast<std::int64_t>(r.frames_read);
+    return r.frames_read + r.kernel_drops + r.iface_drops == r.sent.sent &&
+           r.frames_seen == static_cast<std::int64_t>(r.frames_read);
   });
 }
 

@@ -28,6 +28,9 @@ struct RunResult {
   double daemon_cpu_s = 0.0;
   long ctx_switches = 0;                 ///< reader thread, voluntary + involuntary, over the window
   std::uint64_t kernel_drops = 0;
+  /// Frames the kernel dropped before any socket (the interface's rx_dropped:
+  /// netif backlog full in a starved guest); 0 on a socket pair.
+  std::uint64_t iface_drops = 0;
   std::int64_t frames_seen = 0;
   std::int64_t frames_seen_read_only = 0;  ///< --read-only: frames read and dropped on purpose
   std::int64_t frames_decoded = 0;
