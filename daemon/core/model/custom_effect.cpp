@@ -155,20 +155,27 @@ bool CustomEffect::compensable() const {
   return signal_ == CustomSignal::kPositionError || signal_ == CustomSignal::kRdAngle;
 }
 
-void CustomEffect::signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const {
-  const std::lock_guard lock(mutex_);
+void CustomEffect::bind(const SignatureRow& row) const {
   theta_ = row.theta;
   theta_m_ = row.theta_m;
   theta_e_ = row.theta_e;
   omega_ = row.omega;
   t_ = row.t;
+}
+
+double CustomEffect::evaluate(std::size_t i) const {
+  try {
+    return parsers_.at(i)->Eval();
+  } catch (const mu::Parser::exception_type&) {
+    return std::nan("");  // checked at construction; a run-time failure makes the row unusable
+  }
+}
+
+void CustomEffect::signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const {
+  const std::lock_guard lock(mutex_);
+  bind(row);
   for (std::size_t i = 0; i < parsers_.size(); ++i) {
-    double x = 0.0;
-    try {
-      x = parsers_[i]->Eval();
-    } catch (const mu::Parser::exception_type&) {
-      x = std::nan("");  // checked at construction; a run-time failure makes the row unusable
-    }
+    const double x = evaluate(i);
     SignalValues& c = out.col(i);
     c = SignalValues{};
     switch (signal_) {
@@ -184,16 +191,8 @@ void CustomEffect::signature(const SignatureRow& row, const AngleBasis& b, Value
 
 double CustomEffect::term_value(std::size_t i, const SignatureRow& row) const {
   const std::lock_guard lock(mutex_);
-  theta_ = row.theta;
-  theta_m_ = row.theta_m;
-  theta_e_ = row.theta_e;
-  omega_ = row.omega;
-  t_ = row.t;
-  try {
-    return parsers_.at(i)->Eval();
-  } catch (const mu::Parser::exception_type&) {
-    return std::nan("");
-  }
+  bind(row);
+  return evaluate(i);
 }
 
 CustomEffects::CustomEffects(const std::vector<CustomEffectSpec>& specs) {

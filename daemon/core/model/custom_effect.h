@@ -75,6 +75,10 @@ class CustomEffect final : public Effect {
   [[nodiscard]] std::size_t term_count() const { return parsers_.size(); }
 
  private:
+  /// The parser variables from a row (the caller holds mutex_).
+  void bind(const SignatureRow& row) const;
+  /// Term i at the bound variables; NaN where the parser fails (the caller holds mutex_).
+  [[nodiscard]] double evaluate(std::size_t i) const;
   /// Throws std::invalid_argument naming term `i` when it is not finite anywhere.
   void check_finite_somewhere(mu::Parser& p, std::size_t i);
 
