@@ -60,6 +60,7 @@ class LiveModelFit {
   /// window is fitted too when it covers at least two revolutions.
   void finish();
   [[nodiscard]] const Counters& counters() const { return counters_; }
+  [[nodiscard]] double window_revolutions() const { return options_.window_revolutions; }
   /// A config reload replaced `previous` (finished) by this one: its window counts
   /// and last message carry on, so the run report covers the whole run.
   void continue_from(const LiveModelFit& previous) {
