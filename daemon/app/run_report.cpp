@@ -78,6 +78,23 @@ std::string signal_health_json(const SignalHealthSummary& h, const SignalHealthC
   return j + "}}";
 }
 
+/// What the printed estimate's standard errors are from (hwang_integral's text line says
+/// it itself; the JSON's std_error_basis has it for every method).
+std::string estimate_std_error_basis(const Pipeline& p) {
+  const ModelEstimate model = p.processor().estimate();
+  if (p.processor().config().method == EstimatorMethod::kHwangIntegral) {
+    return fmt::format("robust: revolution-to-revolution spread of {} revolutions (the whole run)",
+                       p.processor().estimator().revolutions());
+  }
+  if (p.processor().config().method == EstimatorMethod::kModel) {
+    const LiveModelFit* mf = p.model_fit();
+    const std::string basis = mf != nullptr ? mf->taken_std_error_basis() : std::string();
+    return fmt::format("the last model window's fit alone ({:.0f} revolutions), not the whole run; {}", model.revolutions,
+                       basis.empty() ? std::string("its basis not recorded (a model loaded, not fitted in this run)") : basis);
+  }
+  return fmt::format("formal: residual variance of the least squares over the {:.0f} revolutions above", model.revolutions);
+}
+
 /// Why nothing was published compensated, naming the key that changes it.
 std::string not_compensated_reason(const Pipeline& p) {
   const ProcessorConfig& pc = p.processor().config();
@@ -137,6 +154,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     for (const ModelParameter& prm : model.params) {
       out << fmt::format("             {:<28} = {:+.6e} +- {:.2e}\n", prm.name, prm.value, prm.std_error);
     }
+    if (!model.params.empty()) out << "             +- standard error: " << estimate_std_error_basis(p) << "\n";
   }
   out << fmt::format("  samples    {} with an angle over {:.3f} s, {} moving, {} at standstill, {} with a reference\n",
                      s.samples, s.t_last - s.t_first, s.moving, s.samples - s.moving, s.with_reference);
@@ -246,7 +264,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
     j += fmt::format("{}{}:{{\"value\":{},\"stderr\":{}}}", i ? "," : "", json_string(model.params[i].name),
                      json_number(model.params[i].value), json_number(model.params[i].std_error));
   }
-  j += "},";
+  j += "},\"std_error_basis\":" + json_string(estimate_std_error_basis(p)) + ",";
   auto stats_json = [&](const ErrorStats& e) {
     return fmt::format("{{\"samples\":{},\"t_first_s\":{},\"t_last_s\":{},\"rms_rad\":{},\"mean_rad\":{},"
                        "\"std_rad\":{}}}",

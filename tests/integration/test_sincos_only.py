@@ -87,6 +87,17 @@ class SinCosOnly(unittest.TestCase):
                 self.assertIsNone(rep["compensation"]["reason"])
                 self.assertRegex(out, r"compensated from \d\.\d{3} s: \d+ of 30000 samples published compensated")
 
+    def test_standard_errors_name_their_basis(self):
+        # The final estimate is the last model window's fit, not the whole run's: said once,
+        # in the text and the JSON alike.
+        out, rep = replay(self.long)
+        basis = rep["std_error_basis"]
+        self.assertRegex(basis, r"^the last model window's fit alone \(\d+ revolutions\), not the whole run; "
+                                r"(robust: revolution-to-revolution spread of |formal: residual variance \()\d+ revolutions")
+        self.assertIn("             +- standard error: " + basis + "\n", out)
+        _, rep = replay(self.long, '[estimator]\nmethod = "hwang_integral"\n')
+        self.assertRegex(rep["std_error_basis"], r"^robust: revolution-to-revolution spread of \d+ revolutions \(the whole run\)$")
+
     def test_long_log_is_compensated_by_default(self):
         out, rep = replay(self.long)
         self.assertEqual(rep["method"], "model")

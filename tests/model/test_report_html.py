@@ -318,6 +318,21 @@ class ReportHtml(unittest.TestCase):
         self.assertNotIn("One direction", html)
         self.assertIn("<th>direction</th>", html)
 
+    def test_standard_errors_name_their_basis_alike_in_text_json_and_html(self):
+        # One story of uncertainty (issue 26): the text header, the JSON and the page's note
+        # say the same basis; the 5 s, 200 r/min log has enough revolutions for the spread.
+        text = run([self.model, "explain", self.log]).stdout
+        basis = json.loads(run([self.model, "explain", self.log, "--json"]).stdout)["standard_errors"]
+        self.assertRegex(basis, r"^robust: revolution-to-revolution spread of \d+ revolutions$")
+        self.assertIn(f"parameters (value +- standard error, {basis}):", text)
+        self.assertIn("Standard errors, robust: revolution-to-revolution spread of ", self.html)
+        # Too few revolutions: formal, saying so the same way.
+        short = os.path.join(ARGS.work, "short.log")
+        run([os.path.join(ARGS.bin, "resolver-sim"), "-o", short, "--duration", "0.4", "--seed", "5"])
+        basis = json.loads(run([self.model, "explain", short, "--json"]).stdout)["standard_errors"]
+        self.assertRegex(basis, r"^formal: residual variance \(\d revolutions, the spread needs 8\)$")
+        self.assertIn(f"parameters (value +- standard error, {basis}):", run([self.model, "explain", short]).stdout)
+
     def test_unwritable_output_names_the_file(self):
         bad = os.path.join(ARGS.work, "no-such-dir", "x.html")
         p = run([self.model, "report", self.log, "--html", bad], expect_rc=3)  # an I/O error

@@ -179,10 +179,8 @@ std::string params_table(const ModelFit& f) {
   }
   if (rows.empty()) return "<p>The model has no fitted parameters (nuisance terms only).</p>\n";
   return table("params", {"parameter", "value", "standard error", "unit"}, rows) +
-         fmt::format("<p class=\"small\">Standard errors {}.</p>\n",
-                     f.robust_errors ? "from the revolution-to-revolution spread of the fit's scores (robust to "
-                                       "correlated residuals)"
-                                     : "formal (too few revolutions for the revolution-to-revolution spread)");
+         fmt::format("<p class=\"small\">Standard errors, {}{}.</p>\n", escape(std_error_basis(f)),
+                     f.robust_errors ? " (of the fit's scores: honest with correlated residuals)" : "");
 }
 
 std::string signals_table(const ModelFit& f, double explained_ratio) {
