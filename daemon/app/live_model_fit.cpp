@@ -129,7 +129,8 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp, std::vector<
       if (opt.candidates) ex = explain_model(w, opt.effects, dopt);
       else ex.fit = fit_model(w, opt.effects, dopt);
       m = make_model_fit_message(&ex, opt.candidates, opt.effects);
-      r.fitted = FittedModel{ex.fit.model, ex.fit.account.fitted, ex.fit.account.revolutions_electrical};
+      r.fitted = FittedModel{ex.fit.model, ex.fit.account.fitted, ex.fit.account.revolutions_electrical,
+                             std_error_basis(ex.fit)};
       r.fitted->model.keep(opt.customs);
     } catch (const std::exception& e) {
       // Too few revolutions, no R/D angle, no currents for a current-side effect:
@@ -168,6 +169,7 @@ void LiveModelFit::publish_ready(bool wait) {
 std::optional<LiveModelFit::FittedModel> LiveModelFit::take_model() {
   std::optional<FittedModel> out = std::move(pending_model_);
   pending_model_.reset();
+  if (out) taken_std_error_basis_ = out->std_error_basis;
   return out;
 }
 

@@ -60,11 +60,13 @@ class LiveModelFit {
   /// window is fitted too when it covers at least two revolutions.
   void finish();
   [[nodiscard]] const Counters& counters() const { return counters_; }
+  [[nodiscard]] double window_revolutions() const { return options_.window_revolutions; }
   /// A config reload replaced `previous` (finished) by this one: its window counts
   /// and last message carry on, so the run report covers the whole run.
   void continue_from(const LiveModelFit& previous) {
     counters_ = previous.counters_;
     last_ = previous.last_;
+    taken_std_error_basis_ = previous.taken_std_error_basis_;
   }
   /// The last published message (verdict empty before the first window).
   [[nodiscard]] const model_fit_t& last() const { return last_; }
@@ -75,8 +77,11 @@ class LiveModelFit {
     Model model;
     std::int64_t samples = 0;
     double revolutions = 0.0;
+    std::string std_error_basis;  ///< std_error_basis(ModelFit): what its standard errors are from
   };
   [[nodiscard]] std::optional<FittedModel> take_model();
+  /// std_error_basis of the last model take_model() handed out ("" before the first).
+  [[nodiscard]] const std::string& taken_std_error_basis() const { return taken_std_error_basis_; }
 
  private:
   struct Result {
@@ -102,6 +107,7 @@ class LiveModelFit {
   model_fit_t last_{};
   std::uint32_t since_poll_ = 0;
   Counters counters_;
+  std::string taken_std_error_basis_;
   std::optional<FittedModel> pending_model_;
 };
 

@@ -78,6 +78,41 @@ std::string signal_health_json(const SignalHealthSummary& h, const SignalHealthC
   return j + "}}";
 }
 
+/// What the printed estimate's standard errors are from (hwang_integral's text line says
+/// it itself; the JSON's std_error_basis has it for every method).
+std::string estimate_std_error_basis(const Pipeline& p) {
+  const ModelEstimate model = p.processor().estimate();
+  if (p.processor().config().method == EstimatorMethod::kHwangIntegral) {
+    return fmt::format("robust: revolution-to-revolution spread of {} revolutions (the whole run)",
+                       p.processor().estimator().revolutions());
+  }
+  if (p.processor().config().method == EstimatorMethod::kModel) {
+    const LiveModelFit* mf = p.model_fit();
+    const std::string basis = mf != nullptr ? mf->taken_std_error_basis() : std::string();
+    return fmt::format("the last model window's fit alone ({:.0f} revolutions), not the whole run; {}", model.revolutions,
+                       basis.empty() ? std::string("its basis not recorded (a model loaded, not fitted in this run)") : basis);
+  }
+  return fmt::format("formal: residual variance of the least squares over the {:.0f} revolutions above", model.revolutions);
+}
+
+/// Why nothing was published compensated, naming the key that changes it.
+std::string not_compensated_reason(const Pipeline& p) {
+  const ProcessorConfig& pc = p.processor().config();
+  if (!pc.compensate) return "compensation disabled ([compensation] enabled = false)";
+  if (pc.method != EstimatorMethod::kModel) {
+    return fmt::format("the {} estimate never converged", p.processor().estimate().method);
+  }
+  const LiveModelFit* mf = p.model_fit();
+  if (mf == nullptr) return "[model] enabled = false: method \"model\" compensates with the live model fit";
+  // The fit of the last, partial window comes at the end of the input, when no sample
+  // is left to compensate: a log shorter than one window is never compensated.
+  return fmt::format("no model window was fitted before the input ended (the first needs [model] "
+                     "window_revolutions = {:g} resolver revolutions, the input turned {:.0f}): set "
+                     "window_revolutions lower (>= 2), replay without --once, or use [estimator] method = "
+                     "\"sincos_least_squares\" (converges within a revolution)",
+                     mf->window_revolutions(), p.processor().estimate().revolutions);
+}
+
 }  // namespace
 
 void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info) {
@@ -119,6 +154,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     for (const ModelParameter& prm : model.params) {
       out << fmt::format("             {:<28} = {:+.6e} +- {:.2e}\n", prm.name, prm.value, prm.std_error);
     }
+    if (!model.params.empty()) out << "             +- standard error: " << estimate_std_error_basis(p) << "\n";
   }
   out << fmt::format("  samples    {} with an angle over {:.3f} s, {} moving, {} at standstill, {} with a reference\n",
                      s.samples, s.t_last - s.t_first, s.moving, s.samples - s.moving, s.with_reference);
@@ -140,10 +176,16 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
                          rad_to_arcmin(s.compared_raw.rms()), rad_to_arcmin(s.compared_comp.rms()),
                          ratio_db(s.compared_raw.rms(), s.compared_comp.rms()));
     } else {
-      out << "             not compensated: no model fitted yet (or compensation disabled)\n";
+      out << "             not compensated: " << not_compensated_reason(p) << "\n";
     }
   } else {
     out << "  position   no reference angle in the log: error vs reference not measured\n";
+    if (s.compensated > 0) {
+      out << fmt::format("             compensated from {:.3f} s: {} of {} samples published compensated\n",
+                         s.t_compensation_start - s.t_first, s.compensated, s.samples);
+    } else {
+      out << "             not compensated: " << not_compensated_reason(p) << "\n";
+    }
   }
   if (s.have_ripple) {
     const RippleSet& r = s.ripple;
@@ -222,7 +264,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
     j += fmt::format("{}{}:{{\"value\":{},\"stderr\":{}}}", i ? "," : "", json_string(model.params[i].name),
                      json_number(model.params[i].value), json_number(model.params[i].std_error));
   }
-  j += "},";
+  j += "},\"std_error_basis\":" + json_string(estimate_std_error_basis(p)) + ",";
   auto stats_json = [&](const ErrorStats& e) {
     return fmt::format("{{\"samples\":{},\"t_first_s\":{},\"t_last_s\":{},\"rms_rad\":{},\"mean_rad\":{},"
                        "\"std_rad\":{}}}",
@@ -237,6 +279,9 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   // The compensated figure against the raw one over the same samples (RMS including the mean).
   j += fmt::format("\"eps_rms_raw_rad\":{},\"eps_rms_comp_rad\":{},", json_number(s.compared_raw.rms()),
                    json_number(s.compared_comp.rms()));
+  j += fmt::format("\"compensation\":{{\"samples\":{},\"started_s\":{},\"reason\":{}}},", s.compensated,
+                   json_number(s.compensated > 0 ? s.t_compensation_start - s.t_first : std::nan("")),
+                   s.compensated > 0 ? "null" : json_string(not_compensated_reason(p)));
   const RippleSet& r = s.ripple;
   auto arr = [&s](const std::array<double, 3>& a, bool valid) {
     if (!s.have_ripple || !valid) return std::string("null");

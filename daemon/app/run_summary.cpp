@@ -8,6 +8,10 @@ void RunSummary::add(const SampleOutput& out, const SampleProcessor& proc, doubl
   t_last = t;
   ++samples;
   moving += out.moving ? 1 : 0;
+  if (proc.compensating()) {
+    if (compensated == 0) t_compensation_start = t;
+    ++compensated;
+  }
   if (!std::isnan(out.eps_ref)) {
     ++with_reference;
     raw_all.add(out.eps_ref, t);

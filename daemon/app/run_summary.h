@@ -56,6 +56,10 @@ struct RunSummary {
   ErrorStats compared_raw, compared_comp;  ///< moving samples since compensation started
   std::int64_t samples = 0, moving = 0, with_reference = 0;
   double t_first = 0.0, t_last = 0.0;
+  // Samples with an angle published compensated, with or without a reference to
+  // measure them against, and when the first was (NaN: never).
+  std::int64_t compensated = 0;
+  double t_compensation_start = std::numeric_limits<double>::quiet_NaN();
   // Ripple amplitudes [A] at the end of the run (coherent average over the
   // processor's last ripple_revolutions electrical revolutions), taken only
   // once the estimator has converged, so "compensated" is compensated.

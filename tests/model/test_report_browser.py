@@ -151,7 +151,8 @@ class Screenshot(unittest.TestCase):
                     e["method"] == "Runtime.consoleAPICalled" and e["params"].get("type") in ("error", "assert"))]
             self.assertEqual(errors, [], name)
             self.assertEqual(drawn, len(plots), f"{name}: every plot has its chart")
-            self.assertGreaterEqual(len(plots), 5, name)
+            # A one-speed log draws no residual-vs-speed plot (one dot; the page says so instead).
+            self.assertGreaterEqual(len(plots), 4, name)
 
     def test_page_renders_with_the_step_colours(self):
         with Chromium(ARGS.work, width=1200, height=900) as b:

@@ -272,6 +272,67 @@ class ReportHtml(unittest.TestCase):
         self.assertTrue(block.group(1).startswith("[[model.custom]]\nname = &quot;"), block.group(1)[:80])
         self.assertIn("t*sin(2*theta)", block.group(1))  # the residual changes with time at 2 theta
 
+    def plot_ids_and_page(self, name, sim_args, report_args=()):
+        log = os.path.join(ARGS.work, name + ".log")
+        out = os.path.join(ARGS.work, name + ".html")
+        run([os.path.join(ARGS.bin, "resolver-sim"), "-o", log, "--seed", "5"] + list(sim_args))
+        p = run([self.model, "report", log, "--html", out] + list(report_args))
+        page = Page()
+        with open(out, encoding="utf-8") as f:
+            html = f.read()
+        page.feed(html)
+        return p, json.loads(page.data_json)["plots"], html
+
+    def test_failing_signal_leads_the_plots(self):
+        # Dead time (6 theta_e in i_d, i_q) left out of a one-step run: i_dq is 16x its floor,
+        # the position error at it; the page opens with the dq residual by harmonic, saying why.
+        p, plots, html = self.plot_ids_and_page("dead_time_one_step", ["-e", "dead_time:t_d=3e-6"],
+                                                ["--max-steps", "1"])
+        self.assertTrue(p.stdout.startswith("missing_effect after 1 step"), p.stdout)
+        self.assertEqual(plots[0]["id"], "specdq")
+        self.assertFalse(plots[0]["half"])
+        self.assertEqual(plots[1]["id"], "pe")
+        first = re.search(r'<figure class="plot" id="fig-([a-z0-9]+)">.*?<figcaption>(.*?)</figcaption>', html)
+        self.assertEqual(first.group(1), "specdq")
+        self.assertTrue(first.group(2).startswith("Shown first: i_dq is the signal furthest above its floor ("),
+                        first.group(2)[:120])
+        # Explained: the position error leads as always, with no such sentence.
+        plots = json.loads(self.page.data_json)["plots"]
+        self.assertEqual(plots[0]["id"], "pe")
+        self.assertNotIn("Shown first", self.html)
+
+    def test_single_speed_and_direction_say_so(self):
+        # The setUpClass log runs at one speed, forward only: no one-dot speed plot, no one-row table.
+        ids = [p["id"] for p in json.loads(self.page.data_json)["plots"]]
+        self.assertNotIn("speed", ids)
+        self.assertIn("One speed: the speed breakdown has one bin (200 r/min", self.html)
+        self.assertIn("One direction: every fitted sample turned forward", self.html)
+        self.assertFalse(any(t[0][:1] == ["direction"] for t in self.page.tables), "no one-row direction table")
+        # Control: a ramp and an out-and-back have the speed plot and the direction table.
+        _, plots, html = self.plot_ids_and_page("ramp_out_and_back",
+                                                ["--profile", "200:1.5,200-600:1.5,-200:2", "-e",
+                                                 "amplitude_imbalance:alpha=0.003"])
+        speed = next(p for p in plots if p["id"] == "speed")
+        self.assertGreater(len(speed["series"][0]["x"]), 1)
+        self.assertNotIn("One speed", html)
+        self.assertNotIn("One direction", html)
+        self.assertIn("<th>direction</th>", html)
+
+    def test_standard_errors_name_their_basis_alike_in_text_json_and_html(self):
+        # One story of uncertainty (issue 26): the text header, the JSON and the page's note
+        # say the same basis; the 5 s, 200 r/min log has enough revolutions for the spread.
+        text = run([self.model, "explain", self.log]).stdout
+        basis = json.loads(run([self.model, "explain", self.log, "--json"]).stdout)["standard_errors"]
+        self.assertRegex(basis, r"^robust: revolution-to-revolution spread of \d+ revolutions$")
+        self.assertIn(f"parameters (value +- standard error, {basis}):", text)
+        self.assertIn("Standard errors, robust: revolution-to-revolution spread of ", self.html)
+        # Too few revolutions: formal, saying so the same way.
+        short = os.path.join(ARGS.work, "short.log")
+        run([os.path.join(ARGS.bin, "resolver-sim"), "-o", short, "--duration", "0.4", "--seed", "5"])
+        basis = json.loads(run([self.model, "explain", short, "--json"]).stdout)["standard_errors"]
+        self.assertRegex(basis, r"^formal: residual variance \(\d revolutions, the spread needs 8\)$")
+        self.assertIn(f"parameters (value +- standard error, {basis}):", run([self.model, "explain", short]).stdout)
+
     def test_unwritable_output_names_the_file(self):
         bad = os.path.join(ARGS.work, "no-such-dir", "x.html")
         p = run([self.model, "report", self.log, "--html", bad], expect_rc=3)  # an I/O error

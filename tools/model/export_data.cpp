@@ -244,7 +244,7 @@ ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, co
       {"residual_rms_rad", fit.residual_rms_rad},
       {"noise_floor_rad", fit.noise_floor_rad},
       {"fold_rule", log.fold_rule},
-      {"standard_errors", fit.robust_errors ? "revolution-to-revolution spread" : "formal"},
+      {"standard_errors", std_error_basis(fit)},
       {"prediction", "the model's effects at the fitted values plus the constants fitted beside them (the dq "
                      "operating point, the envelopes' gain, an angle offset without a reference)"},
   };

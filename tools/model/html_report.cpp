@@ -179,10 +179,8 @@ std::string params_table(const ModelFit& f) {
   }
   if (rows.empty()) return "<p>The model has no fitted parameters (nuisance terms only).</p>\n";
   return table("params", {"parameter", "value", "standard error", "unit"}, rows) +
-         fmt::format("<p class=\"small\">Standard errors {}.</p>\n",
-                     f.robust_errors ? "from the revolution-to-revolution spread of the fit's scores (robust to "
-                                       "correlated residuals)"
-                                     : "formal (too few revolutions for the revolution-to-revolution spread)");
+         fmt::format("<p class=\"small\">Standard errors, {}{}.</p>\n", escape(std_error_basis(f)),
+                     f.robust_errors ? " (of the fit's scores: honest with correlated residuals)" : "");
 }
 
 std::string signals_table(const ModelFit& f, double explained_ratio) {
@@ -265,7 +263,11 @@ std::string whiteness_and_directions(const ModelFit& f) {
                     num_cell(escape(signal_value("position_error", d.rms))), num_cell(ratio(d.rms / f.noise_floor_rad)),
                     num_cell(escape(signal_value("position_error", d.mean)))});
   }
-  if (!rows.empty()) {
+  if (const std::string n = report::one_direction_note(f); !n.empty()) {
+    o += "<p class=\"single\">" + escape(n) + fmt::format(" Its residual: rms {}, mean {}.</p>\n",
+                                                            escape(signal_value("position_error", f.directions.front().rms)),
+                                                            escape(signal_value("position_error", f.directions.front().mean)));
+  } else if (!rows.empty()) {
     o += table("params", {"direction", "samples", "residual rms", "/ floor", "residual mean"}, rows) +
          "<p class=\"small\">An offset that flips sign with the direction is backlash or a delay.</p>\n";
   }
@@ -402,6 +404,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
        "saves the plot's data: one row per point, with its series, in the units of the axes.</p>\n"
        "<noscript><p class=\"bad\">The plots are drawn by the page's script: enable JavaScript to see them. The "
        "tables do not need it.</p></noscript>\n";
+  if (const std::string n = report::one_speed_note(f); !n.empty()) o += "<p class=\"single\">" + escape(n) + "</p>\n";
   o += figures(plots);
 
   o += "<h2 id=\"floors\">Noise floors, outliers, whiteness, directions</h2>\n" + floors_table(f.floors) +

@@ -31,8 +31,7 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
       a.units);
   for (const auto& n : notes) o += "note: " + n + "\n";
   for (const auto& n : f.notes) o += "note: " + n + "\n";
-  o += fmt::format("\nparameters (value +- standard error{}):\n",
-                   f.robust_errors ? ", from the revolution-to-revolution spread" : ", formal");
+  o += fmt::format("\nparameters (value +- standard error, {}):\n", std_error_basis(f));
   for (const auto& p : f.params) {
     o += fmt::format("  {:<36} {:>12.5g} +- {:.2g} {}\n", p.name, p.value, p.std_error, p.unit);
   }
@@ -164,6 +163,7 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
                    f.whiteness.lags, json_num(f.whiteness.band), json_num(f.whiteness.max_abs), f.whiteness.outside,
                    f.whiteness.samples);
   o += ",\"robust_standard_errors\":" + std::string(f.robust_errors ? "true" : "false");
+  o += ",\"standard_errors\":" + json_str(std_error_basis(f));
   o += ",\"passes\":" + std::to_string(f.passes);
   o += ",\"directions\":[";
   for (std::size_t i = 0; i < f.directions.size(); ++i) {

@@ -491,14 +491,19 @@ std::vector<Plot> report_plots(const DiscoveryRun& run) {
         "The dq-current residual by harmonic of the motor electrical angle: current-sensor offsets show at 1θ_e, gain "
         "mismatch at 2θ_e, dead time at 6θ_e. Order 0 is the operating point the fit takes as given, not shown.";
   }
-  plots.push_back(by_bins(run, "speed", "Position-error residual vs speed, per step",
-                          axis("speed, mechanical", "r/min", "speed_rpm"), true));
-  plots.back().caption = fmt::format(
-      "Residual rms in {} speed bin{} (empty bins dropped). A residual that grows with speed points at sampling skew or "
-      "the R/D tracking loop.",
-      last.speed_bins.size(), last.speed_bins.size() == 1 ? "" : "s");
+  // One speed bin is one dot: not a breakdown (single_breakdown_notes says so on the page).
+  const bool speeds = last.speed_bins.size() > 1;
+  if (speeds) {
+    plots.push_back(by_bins(run, "speed", "Position-error residual vs speed, per step",
+                            axis("speed, mechanical", "r/min", "speed_rpm"), true));
+    plots.back().caption = fmt::format(
+        "Residual rms in {} speed bins (empty bins dropped). A residual that grows with speed points at sampling skew "
+        "or the R/D tracking loop.",
+        last.speed_bins.size());
+  }
   plots.push_back(by_bins(run, "time", "Position-error residual vs time, per step",
                           axis("time from the log's first sample", "s", "t_s"), false));
+  plots.back().half = speeds;
   plots.back().caption = fmt::format(
       "Residual rms in {} equal windows of the log. No catalog effect changes with time: a residual that changes "
       "from window to window at the same speed is a drift outside the catalog (e.g. with temperature).",
@@ -509,7 +514,63 @@ std::vector<Plot> report_plots(const DiscoveryRun& run) {
     plots.push_back(dq_panel(last, "dqq", "i_q", b.q, b.q_model, last.series.i_q_ref));
     if (run.log->rd) plots.push_back(dq_angle_error(last, b));
   }
+  lead_with_failing_signal(run, plots);
   return plots;
+}
+
+const SignalResidual* failing_signal(const DiscoveryRun& run) {
+  const Explanation& last = run.steps.back();
+  if (last.verdict == Verdict::kExplained) return nullptr;
+  const SignalResidual* worst = nullptr;
+  for (const SignalResidual& s : last.fit.signals) {
+    if (!(s.floor > 0.0) || !std::isfinite(s.rms / s.floor)) continue;
+    if (worst == nullptr || s.rms / s.floor > worst->rms / worst->floor) worst = &s;
+  }
+  return worst;
+}
+
+void lead_with_failing_signal(const DiscoveryRun& run, std::vector<Plot>& plots) {
+  const SignalResidual* worst = failing_signal(run);
+  if (worst == nullptr) return;
+  // The position-error plot already leads; sin/cos share it (the angle they give).
+  std::vector<std::string> ids{"pe"};
+  if (worst->signal == "i_dq") ids = {"specdq", "dqd"};
+  for (const std::string& id : ids) {
+    const auto it = std::find_if(plots.begin(), plots.end(), [&id](const Plot& p) { return p.id == id; });
+    if (it == plots.end()) continue;
+    if (it == plots.begin()) return;
+    Plot lead = std::move(*it);
+    plots.erase(it);
+    if (lead.half) {
+      // Its partner (dqd's dqq) is alone now: full width.
+      lead.half = false;
+      for (Plot& p : plots) {
+        if (p.id == "dqq") p.half = false;
+      }
+    }
+    lead.caption = fmt::format("Shown first: {} is the signal furthest above its floor ({:.2f}x), where the model "
+                               "fails most. ",
+                               worst->signal, worst->rms / worst->floor) +
+                   lead.caption;
+    plots.insert(plots.begin(), std::move(lead));
+    return;
+  }
+}
+
+std::string one_speed_note(const ModelFit& f) {
+  if (f.speed_bins.size() != 1) return {};
+  return fmt::format("One speed: the speed breakdown has one bin ({:.0f} r/min, {} samples), so it shows no "
+                                "dependence on speed and residual vs speed is not drawn; effects that grow with speed "
+                                "(sampling skew, the R/D tracking loop) need a log at several speeds.",
+                                f.speed_bins.front().rpm_mid, f.speed_bins.front().samples);
+}
+
+std::string one_direction_note(const ModelFit& f) {
+  if (f.directions.size() != 1) return {};
+  return fmt::format("One direction: every fitted sample turned {}, so the direction breakdown has one row "
+                                "and cannot show backlash or a delay (an offset that flips with the direction needs "
+                                "an out-and-back).",
+                                f.directions.front().direction > 0 ? "forward" : "backward");
 }
 
 std::string plots_json(const std::vector<Plot>& plots) {

@@ -105,6 +105,17 @@ class AngleBinner {
 /// (run_discovery sets it; without it the angle plots are left out).
 [[nodiscard]] std::vector<Plot> report_plots(const DiscoveryRun& run);
 
+/// When the final verdict is not explained: the signal whose residual is furthest above
+/// its floor (report_plots puts its plot first); nullptr when explained.
+[[nodiscard]] const SignalResidual* failing_signal(const DiscoveryRun& run);
+/// Moves the failing signal's plot (i_dq: the dq spectrum, else its panel) to the front.
+void lead_with_failing_signal(const DiscoveryRun& run, std::vector<Plot>& plots);
+/// "One speed: ..." when the speed breakdown has one bin (report_plots then draws no
+/// residual-vs-speed plot); "One direction: ..." when the direction breakdown has one
+/// row. Empty otherwise.
+[[nodiscard]] std::string one_speed_note(const ModelFit& f);
+[[nodiscard]] std::string one_direction_note(const ModelFit& f);
+
 /// The plots as one JSON array (web/report_page.js reads it).
 [[nodiscard]] std::string plots_json(const std::vector<Plot>& plots);
 

@@ -133,6 +133,14 @@ void throw_if_custom_term_not_finite(const std::vector<std::string>& effects, co
 
 }  // namespace
 
+std::string std_error_basis(const ModelFit& f) {
+  if (f.robust_errors) {
+    return fmt::format("robust: revolution-to-revolution spread of {} revolutions", f.error_revolutions);
+  }
+  return fmt::format("formal: residual variance ({} revolutions, the spread needs {})", f.error_revolutions,
+                     kMinRobustBlocks);
+}
+
 std::string_view to_string(Verdict v) {
   switch (v) {
     case Verdict::kExplained: return "explained";
@@ -180,6 +188,7 @@ Eigen::MatrixXd parameter_covariance(const StepSolution& s, const ResidualPass& 
                                      ModelFit& f) {
   const double dof = static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k);
   Eigen::MatrixXd cov = s.inverse * (s.rss_w / std::max(dof, 1.0));
+  f.error_revolutions = pass.blocks;
   if (pass.blocks < kMinRobustBlocks) return cov;
   const auto k = static_cast<Eigen::Index>(cols.size());
   Eigen::MatrixXd m_inv(k, k);

@@ -189,6 +189,7 @@ struct ModelFit {
   bool explained = false;                    ///< every signal <= ratio x floor, held back too, outliers not mattering
   bool untrusted = false;                    ///< DiscoveryOptions::untrusted_input listed faulty signals: never explained
   bool robust_errors = false;                ///< standard errors from the revolution-to-revolution spread
+  int error_revolutions = 0;                 ///< revolution blocks of the fit (the spread's, when robust)
   int passes = 0;                            ///< passes over the rows
   std::vector<std::string> notes;
   ResidualSeries series;
@@ -215,6 +216,11 @@ struct Candidate {
 
 enum class Verdict : std::uint8_t { kExplained, kMissingEffect, kUnexplained };
 [[nodiscard]] std::string_view to_string(Verdict v);
+
+/// What the fit's standard errors are from, in words every program prints the same:
+/// "robust: revolution-to-revolution spread of N revolutions" or "formal: residual
+/// variance (N revolutions, the spread needs 8)".
+[[nodiscard]] std::string std_error_basis(const ModelFit& f);
 
 struct Explanation {
   ModelFit fit;

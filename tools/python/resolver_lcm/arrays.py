@@ -6,6 +6,8 @@
     angle.count, angle.type_name              # 20000, 'resolver.angle_t'
     angle["theta_comp"]                      # numpy array [rad], or a list without numpy
     angle["log_time_us"]                     # when the logger received each message [us]
+    for msg in log:                           # every decoded message, in the file's order
+        msg.channel, msg.log_time_us, msg.message.theta_comp
 
 With numpy (Debian: python3-numpy) every numeric field becomes an ndarray:
 scalars 1-D, fixed-size arrays (dq_t.ripple_order[3]) 2-D (messages x 3).
@@ -15,7 +17,7 @@ Python lists, one entry per message. Without numpy every column is a list.
 
 import os
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Union
+from typing import Dict, Iterator, List, NamedTuple, Optional, Union
 
 from .eventlog import read_events
 from .types import find_type, fields, type_name
@@ -50,16 +52,42 @@ class ChannelData:
         return list(self.columns)
 
 
+class LogMessage(NamedTuple):
+    """One decoded message of a log, as iterating a LogData yields it."""
+
+    channel: str
+    log_time_us: int  # the event's timestamp: when the logger received the message [us]
+    message: object   # the lcm-gen class instance (resolver.angle_t, ...)
+
+
 @dataclass
 class LogData:
-    """load_log's result: channels by name, plus what could not be decoded."""
+    """load_log's result: channels by name, plus what could not be decoded.
+
+    log["RESOLVER_ANGLE"] is a channel's columns; `for msg in log` yields every
+    decoded message (LogMessage) in the file's order, reading the file again
+    (so a long log is never held twice in memory); undecoded messages are skipped
+    there as in the columns (counted in `undecoded`).
+    """
 
     channels: Dict[str, ChannelData] = field(default_factory=dict)
     # channel -> number of messages with a fingerprint none of our types has
     undecoded: Dict[str, int] = field(default_factory=dict)
+    path: Optional[str] = None
+    wanted: Optional[frozenset] = None  # load_log's channel filter (None: every channel)
 
     def __getitem__(self, channel) -> ChannelData:
+        if not isinstance(channel, str):
+            raise TypeError(f"a log is indexed by channel name (one of {sorted(self.channels)}), "
+                            f"not {type(channel).__name__}; `for msg in log` iterates its messages")
         return self.channels[channel]
+
+    def __iter__(self) -> Iterator[LogMessage]:
+        if self.path is None:
+            return
+        for event, cls, message in _decoded_events(self.path, self.wanted):
+            if cls is not None:
+                yield LogMessage(event.channel, event.timestamp_us, message)
 
     def __contains__(self, channel) -> bool:
         return channel in self.channels
@@ -100,6 +128,25 @@ def _variable_length_fields(cls) -> set:
     return {name for name in fields(cls) if getattr(fresh, name) == []}
 
 
+def _decoded_events(path, wanted):
+    """(event, class, message) for each event of the wanted channels; (event, None, None)
+    when no type has the event's fingerprint. Raises ValueError for a message that does
+    not decode as its type."""
+    for event in read_events(path):
+        if wanted is not None and event.channel not in wanted:
+            continue
+        cls = find_type(event.data)
+        if cls is None:
+            yield event, None, None
+            continue
+        try:
+            message = cls.decode(event.data)
+        except Exception as e:  # generated code raises ValueError or struct.error
+            raise ValueError(f"{os.fspath(path)}: byte offset {event.offset} (event #{event.index + 1} in the file): "
+                             f"{type_name(cls)} on {event.channel} does not decode: {e}") from None
+        yield event, cls, message
+
+
 def load_log(path: Union[str, os.PathLike], channels: Optional[List[str]] = None,
              use_numpy: Optional[bool] = None) -> LogData:
     """Reads the event log at `path` into columns per channel.
@@ -112,25 +159,17 @@ def load_log(path: Union[str, os.PathLike], channels: Optional[List[str]] = None
     np = _numpy() if use_numpy in (None, True) else None
     if use_numpy and np is None:
         raise ImportError("use_numpy=True but numpy is not importable (Debian: apt-get install python3-numpy)")
-    wanted = set(channels) if channels is not None else None
+    wanted = frozenset(channels) if channels is not None else None
     rows: Dict[str, Dict[str, list]] = {}
     types = {}
-    result = LogData()
-    for event in read_events(path):
-        if wanted is not None and event.channel not in wanted:
-            continue
-        cls = find_type(event.data)
+    result = LogData(path=os.fspath(path), wanted=wanted)
+    for event, cls, message in _decoded_events(path, wanted):
         if cls is None:
             result.undecoded[event.channel] = result.undecoded.get(event.channel, 0) + 1
             continue
         if types.setdefault(event.channel, cls) is not cls:
             raise ValueError(f"{os.fspath(path)}: byte offset {event.offset} (event #{event.index + 1} in the file): channel "
                              f"{event.channel} carries {type_name(cls)} after {type_name(types[event.channel])}")
-        try:
-            message = cls.decode(event.data)
-        except Exception as e:  # generated code raises ValueError or struct.error
-            raise ValueError(f"{os.fspath(path)}: byte offset {event.offset} (event #{event.index + 1} in the file): "
-                             f"{type_name(cls)} on {event.channel} does not decode: {e}") from None
         columns = rows.get(event.channel)
         if columns is None:
             columns = rows[event.channel] = {name: [] for name in [LOG_TIME_COLUMN] + fields(cls)}

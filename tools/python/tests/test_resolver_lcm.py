@@ -7,13 +7,16 @@ generated classes; the integration test (test_lcmlog_example.py) checks the
 reader against logs resolverd wrote and against resolver-echo.
 """
 
+import contextlib
+import io
 import math
 import os
+import re
 import struct
 import tempfile
 import unittest
 
-from resolver_lcm import EventLogError, LOG_TIME_COLUMN, load_log, read_events
+from resolver_lcm import EventLogError, LOG_TIME_COLUMN, LogMessage, load_log, read_events
 from resolver_lcm.eventlog import HEADER_SIZE, SYNC_WORD, write_events
 from resolver_lcm.resolver import angle_t, dq_t, estimate_t
 
@@ -214,6 +217,67 @@ class LoadLogTest(unittest.TestCase):
         with TempLog(events) as path:
             with self.assertRaisesRegex(ValueError, rf"\(event #{len(events)} in the file\): resolver.angle_t on RESOLVER_ANGLE does not decode"):
                 load_log(path)
+
+
+class IterationTest(unittest.TestCase):
+    def test_for_msg_in_log_yields_decoded_messages_in_order(self):
+        events = standard_events()
+        with TempLog(events + [("OTHER", b"\x01" * 8 + b"payload", 3000)]) as path:
+            log = load_log(path, use_numpy=False)
+            got = list(log)
+            self.assertEqual(len(list(log)), len(events))  # iterates again, from the start
+        self.assertEqual([(m.channel, m.log_time_us) for m in got], [(c, t) for c, _, t in events])  # OTHER skipped
+        self.assertIsInstance(got[0], LogMessage)
+        self.assertIsInstance(got[0].message, angle_t)
+        self.assertEqual(got[2].message.theta_comp, 0.001 + 1e-5)
+        self.assertEqual(list(got[-1].message.param_name), ["effect.p0", "effect.p1", "effect.p2"])
+
+    def test_channel_filter_applies_to_iteration(self):
+        with TempLog(standard_events()) as path:
+            log = load_log(path, channels=["RESOLVER_DQ"])
+            self.assertEqual([m.message.sample_index for m in log], [0, 1, 2, 3, 4])
+
+    def test_integer_index_says_how_to_iterate(self):
+        with TempLog(standard_events()) as path:
+            log = load_log(path, use_numpy=False)
+        with self.assertRaisesRegex(TypeError, "indexed by channel name.*for msg in log"):
+            log[0]
+
+
+README = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "README.md")
+
+
+def readme_python_snippet():
+    """The first ```python block of the README's "Python: resolverd's logs as arrays"."""
+    with open(README, encoding="utf-8") as f:
+        text = f.read()
+    section = text.split("\n## Python: resolverd's logs as arrays\n", 1)[1].split("\n## ", 1)[0]
+    return re.search(r"^```python\n(.*?)^```$", section, re.S | re.M).group(1)
+
+
+class ReadmeSnippetTest(unittest.TestCase):
+    """The README's Python example, exactly as printed there, on a generated log."""
+
+    def run_snippet(self):
+        snippet = readme_python_snippet()
+        self.assertIn('"/tmp/demo.lcmlog"', snippet)
+        self.assertNotIn("pandas", snippet)
+        with TempLog(standard_events()) as path:
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                exec(compile(snippet.replace('"/tmp/demo.lcmlog"', repr(path)), "README.md", "exec"), {})
+        return out.getvalue()
+
+    def test_snippet_runs_with_numpy_if_installed(self):
+        self.assertIn("5 dq messages", self.run_snippet())
+
+    def test_snippet_runs_without_numpy(self):
+        os.environ["RESOLVER_LCM_NO_NUMPY"] = "1"
+        try:
+            out = self.run_snippet()
+        finally:
+            del os.environ["RESOLVER_LCM_NO_NUMPY"]
+        self.assertIn("first i_d 0.0 A at 1001 us", out)
 
 
 if __name__ == "__main__":
