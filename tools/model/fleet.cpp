@@ -158,7 +158,7 @@ bool run_unit(const std::string& unit, const std::vector<ManifestRow>& rows, con
       const LogResult& l = logs.back();
       logs_json += (logs.size() > 1 ? "," : "") + std::string("{\"log\":") + json::str(l.log);
       if (!l.error.empty()) {
-        problems.push_back(fmt::format("unit {}: {} (manifest line {}): {}", unit, l.log, r.line, l.error));
+        problems.push_back(fmt::format("{} (manifest line {}): {}", l.log, r.line, l.error));
         logs_json += ",\"status\":\"failed\",\"reason\":" + json::str(l.error) + "}";
         continue;
       }
@@ -166,7 +166,7 @@ bool run_unit(const std::string& unit, const std::vector<ManifestRow>& rows, con
     }
     for (const auto& l : logs) {
       if (l.error.empty() && !logs.empty() && logs.front().error.empty() && l.p_r != logs.front().p_r) {
-        problems.push_back(fmt::format("unit {}: {} has p_r = {}, {} has p_r = {}", unit, l.log, l.p_r,
+        problems.push_back(fmt::format("{} has p_r = {}, {} has p_r = {}", l.log, l.p_r,
                                        logs.front().log, logs.front().p_r));
       }
     }
@@ -344,8 +344,8 @@ std::string summarize_fleet(const std::string& out_dir, int& failed) {
   for (auto& u : units) {
     if (u.done && u.p_r != fleet_p_r) {
       u.done = false;
-      u.reason = fmt::format("unit {}: its log has p_r = {}, the fleet's is {} ({} units): left out of the summary",
-                             u.unit, u.p_r, fleet_p_r, most);
+      u.reason = fmt::format("its logs have p_r = {}, the fleet's is {} ({} units): left out of the summary", u.p_r,
+                             fleet_p_r, most);
     }
   }
   std::size_t logs_total = 0, logs_left_out = 0;

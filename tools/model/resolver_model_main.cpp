@@ -135,6 +135,8 @@ constexpr const char* kExamples = R"(Examples:
   resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat
   # a correction table for the drive firmware
   resolver-model export build/demo/demo.log --effects amplitude_imbalance --table-format c-header --out table.h
+  # a production line: every unit of a manifest (CSV unit,log), one folder each, and fleet.json
+  resolver-model fleet units.csv --out fleet/
 Each subcommand's --help has its options and examples: resolver-model fit --help)";
 
 constexpr const char* kFitExamples = R"(Examples:

@@ -168,8 +168,8 @@ def main(argv=None):
             try:
                 _, folder, code, err = future.result()
             except Exception as e:  # the task failed for good: said per unit, and in fleet.json
-                reason = f"unit {unit}: the Dask task failed after its retries: {e}"
-                print(f"resolver_bench.fleet: {reason}", file=sys.stderr)
+                reason = f"the Dask task failed after its retries: {e}"
+                print(f"resolver_bench.fleet: unit {unit}: {reason}", file=sys.stderr)
                 write_failed_unit(out_dir, unit, units[unit], reason)
                 continue
             install_unit(out_dir, unit, folder)
