@@ -13,6 +13,7 @@
 #                                         resolver-accuracy resolver-spy
 #   include/resolver/*.hpp                lcm-gen C++ types (need liblcm-dev)
 #   lib/python3/dist-packages/resolver_lcm   Python types + log reader (/usr/local: lib/python3.X/...)
+#   lib/python3/dist-packages/resolver_bench the fleet's Dask client (needs python3-distributed: Suggests)
 #   lib/systemd/system/resolverd*.service
 #   share/java/resolver-types.jar         lcm-gen Java types (resolver-spy)
 #   share/resolver-bench/                 resolver_bench.dbc, lcm/resolver/*.lcm, demo/*.toml,
@@ -129,6 +130,8 @@ set(RESOLVER_PYTHON_INSTALL_DIR "" CACHE STRING
     "where resolver_lcm goes, relative to the prefix; empty = lib/python3/dist-packages for /usr, else lib/python3.X/dist-packages")
 install(CODE "include(\"${PROJECT_SOURCE_DIR}/cmake/InstallForPrefix.cmake\")
   resolver_install_python_package(\"${RESOLVER_PYTHON_BUILD_DIR}/resolver_lcm\" \"${RESOLVER_PYTHON_INSTALL_DIR}\"
+                                  \"${resolver_python_minor}\")
+  resolver_install_python_package(\"${RESOLVER_PYTHON_BUILD_DIR}/resolver_bench\" \"${RESOLVER_PYTHON_INSTALL_DIR}\"
                                   \"${resolver_python_minor}\")")
 
 # --- the .deb ------------------------------------------------------------------
@@ -160,8 +163,8 @@ set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3")
 # resolver_lcm's columns arrays. Recommended (apt installs them unless
 # --no-install-recommends keeps a headless bench lean).
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "default-jre | java-runtime, liblcm-java, libjchart2d-java, python3-numpy")
-# lcm-logger/lcm-logplayer, candump/canplayer, the C++ headers' lcm_coretypes.h.
-set(CPACK_DEBIAN_PACKAGE_SUGGESTS "liblcm-bin, can-utils, liblcm-dev")
+# lcm-logger/lcm-logplayer, candump/canplayer, the C++ headers' lcm_coretypes.h.; Dask for python3 -m resolver_bench.fleet.
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "liblcm-bin, can-utils, liblcm-dev, python3-distributed")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${PROJECT_SOURCE_DIR}/cmake/deb/postinst ${PROJECT_SOURCE_DIR}/cmake/deb/prerm)
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)

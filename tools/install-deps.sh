@@ -41,6 +41,7 @@ TEST_PACKAGES=(
   default-jdk-headless default-jre liblcm-java libjchart2d-java xvfb xauth
   chromium  # headless: renders, zooms and screenshots the resolver-model HTML report (tests/model)
   python3-scipy  # tests/model/test_export_data.py reads the .mat with scipy.io.loadmat
+  python3-distributed  # Dask: resolver_bench.fleet and its test (tests skip without it)
   # packaging (cmake/Packaging.cmake, tests/install): the .deb's shared-library
   # dependencies (dpkg-shlibdeps), systemd-analyze for the installed units, /bin/kill
   # their ExecReload= names

@@ -23,7 +23,7 @@ import unittest
 
 ARGS = None
 PROGRAMS = ["resolverd", "resolver-sim", "resolver-echo", "resolver-model", "resolver-accuracy"]
-SUBCOMMANDS = ["fit", "explain", "report", "export-data", "export"]
+SUBCOMMANDS = ["fit", "explain", "report", "export-data", "export", "fleet"]
 
 
 def run_help(*argv):

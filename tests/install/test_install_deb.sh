@@ -178,6 +178,7 @@ share=$root/usr/share/resolver-bench
 for f in "$share/resolver_bench.dbc" "$share/demo/demo_bench.toml" "$root/usr/lib/systemd/system/resolverd.service" \
   "$root/usr/lib/systemd/system/resolverd@.service" "$share/systemd-network/can0.network" \
   "$root/usr/lib/python3/dist-packages/resolver_lcm/resolver/angle_t.py" \
+  "$root/usr/lib/python3/dist-packages/resolver_bench/fleet.py" \
   "$root/usr/share/doc/resolver-bench/examples/lcmlog_to_arrays.py"; do
   [[ -f $f ]] || bad "not installed: ${f#"$root"}"
 done

@@ -4,6 +4,7 @@
 //   resolver-model report LOG [--effects a,b] --html OUT.html [--max-steps N]
 //   resolver-model export-data LOG [--effects a,b] --csv OUT.csv | --mat OUT.mat
 //   resolver-model export LOG [--effects a,b] [--table-format csv|json|c-header] [--out FILE]
+//   resolver-model fleet MANIFEST --out DIR [--effects a,b] | fleet --summarize DIR  (tools/model/fleet.h)
 // All take --config FILE: a resolverd config whose [layout] (DBC, signal map),
 // [input.csv] column map, [bench] pole pairs and [model] effects apply (logs of
 // a user's own layout, scope exports), --format candump|asc|csv and --from/--to [s].
@@ -21,6 +22,7 @@
 #include <cstdlib>
 #include <string_view>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <stdexcept>
@@ -35,6 +37,7 @@
 #include "daemon/core/model/model_spec.h"
 #include "daemon/service/table_file.h"
 #include "tools/model/export_data.h"
+#include "tools/model/fleet.h"
 
 #include <ctime>
 #include <fmt/format.h>
@@ -110,13 +113,7 @@ int write_export(const resolver::LogSamples& samples, const std::string& log, co
                  const std::string& out) {
   const resolver::ModelFit fit = resolver::fit_model(samples.input, effects, options);
   const resolver::CalibrationTable table = resolver::tabulate(fit.model, points);
-  char date[32];
-  const std::time_t now = std::time(nullptr);
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  const resolver::TableOrigin origin{log, date, "resolver-model"};
-  const std::string text = format == "json"       ? resolver::format_table_json(table, origin)
-                           : format == "c-header" ? resolver::format_table_c_header(table, origin)
-                                                  : resolver::format_table_csv(table, origin);
+  const std::string text = resolver::calibration_text(table, log, format);
   if (out.empty()) std::cout << text;
   else resolver::write_text_file(out, text);
   std::cerr << "resolver-model: exported " << points << " points of " << fmt::format("{}", fmt::join(fit.effects, ", "))
@@ -138,6 +135,8 @@ constexpr const char* kExamples = R"(Examples:
   resolver-model export-data build/demo/demo.log --csv demo.csv --mat demo.mat
   # a correction table for the drive firmware
   resolver-model export build/demo/demo.log --effects amplitude_imbalance --table-format c-header --out table.h
+  # a production line: every unit of a manifest (CSV unit,log), one folder each, and fleet.json
+  resolver-model fleet units.csv --out fleet/
 Each subcommand's --help has its options and examples: resolver-model fit --help)";
 
 constexpr const char* kFitExamples = R"(Examples:
@@ -178,9 +177,73 @@ constexpr const char* kExportExamples = R"(Examples:
   # a C header for the drive firmware, 256 points per mechanical turn
   resolver-model export demo.log --table-format c-header --points 256 --out resolver_table.h)";
 
+constexpr const char* kFleetExamples = R"(Examples:
+  # units.csv: a header "unit,log", then one row per log (a unit may have several;
+  # relative paths are relative to the manifest's folder)
+  resolver-model fleet units.csv --out fleet/
+  # a richer model for every unit; only recompute fleet/fleet.json from fleet/*/unit.json
+  resolver-model fleet units.csv --out fleet/ --effects amplitude_imbalance,quadrature
+  resolver-model fleet --summarize fleet/
+  # the same units on a Dask cluster (one task per unit): python3 -m resolver_bench.fleet
+Writes OUT/UNIT/unit.json (verdict, residual vs floor, parameters with standard errors, each
+log's fit, parameters the unit's logs disagree on), OUT/UNIT/calibration.{csv,json,h} (export's
+formats, from the unit's log with the smallest residual/floor) and OUT/fleet.json (per parameter
+median, robust spread = 1.4826 MAD and quantiles; proposed effects; outlier units, robust z > 4;
+failed units with the reason). A unit fails, and the others go on, when a log is missing,
+unreadable or has no usable data, is listed twice, or has another p_r than the fleet.
+Exit 0 when every unit is done, 1 when some unit failed (fleet.json says which and why).)";
+
 /// A subcommand's footer: its examples, then the exit codes every --help ends with.
 std::string sub_footer(const char* examples) {
   return std::string(examples) + "\n\n" + resolver::exit_code::kHelpText;
+}
+
+/// `fleet`: every unit of MANIFEST into OUT, then OUT/fleet.json; or --summarize DIR alone.
+int run_fleet(const std::string& manifest, const std::string& out, const std::string& summarize_dir,
+              std::vector<std::string> effects, const std::string& config_path, int points) {
+  if (!summarize_dir.empty() && (!manifest.empty() || !out.empty())) {
+    std::cerr << "resolver-model fleet: --summarize DIR takes no MANIFEST or --out\n";
+    return resolver::exit_code::kUsage;
+  }
+  int failed = 0;
+  if (!summarize_dir.empty()) {
+    if (!std::filesystem::is_directory(summarize_dir)) {
+      std::cerr << "resolver-model fleet: --summarize " << summarize_dir << ": not a folder\n";
+      return resolver::exit_code::kIo;
+    }
+    std::cout << resolver::summarize_fleet(summarize_dir, failed);
+    return failed > 0 ? resolver::exit_code::kNoUsableData : resolver::exit_code::kDone;
+  }
+  if (manifest.empty() || out.empty()) {
+    std::cerr << "resolver-model fleet: give MANIFEST --out DIR, or --summarize DIR\n";
+    return resolver::exit_code::kUsage;
+  }
+  if (auto problem = resolver::exit_code::unreadable("MANIFEST", manifest)) {
+    std::cerr << "resolver-model: " << *problem << "\n";
+    return resolver::exit_code::kIo;
+  }
+  resolver::FleetOptions options;
+  if (!config_path.empty()) options.config = resolver::load_daemon_config(config_path);
+  if (!effects.empty()) {
+    try {
+      (void)resolver::ModelSpec::parse(effects, options.config.model.customs.get());
+    } catch (const std::invalid_argument& e) {
+      throw resolver::InputError(resolver::Fault::kUsage, e.what(), resolver::Where::at_option("--effects"));
+    }
+  } else {
+    effects = options.config.model.effects;
+  }
+  options.effects = effects;
+  options.points = points;
+  options.discovery.max_report_order = resolver::kOfflineReportOrder;
+  options.discovery.harmonic_families = true;
+  options.discovery.customs = options.config.model.customs.get();
+  options.discovery.prepare.reference_aligned = options.config.bench.reference_aligned;
+  const std::vector<resolver::ManifestRow> rows = resolver::read_manifest(manifest);
+  std::filesystem::create_directories(out);
+  (void)resolver::run_fleet_units(rows, manifest, out, options);
+  std::cout << resolver::summarize_fleet(out, failed);
+  return failed > 0 ? resolver::exit_code::kNoUsableData : resolver::exit_code::kDone;
 }
 
 int run(int argc, char** argv) {
@@ -286,7 +349,22 @@ int run(int argc, char** argv) {
   add_config(exporter);
   add_slicing(exporter);
   add_slicing(export_data);
+  CLI::App* fleet = app.add_subcommand(
+      "fleet", "a production line: explain and calibrate every unit of a manifest (CSV unit,log), one folder per "
+               "unit, and summarize the fleet (spread, outliers, failed units) in OUT/fleet.json");
+  fleet->footer(sub_footer(kFleetExamples));
+  std::string manifest, fleet_out, summarize_dir;
+  fleet->add_option("MANIFEST", manifest, "CSV with the header unit,log; one row per log");
+  fleet->add_option("--out", fleet_out, "folder for OUT/UNIT/ and OUT/fleet.json (created)");
+  fleet->add_option("--summarize", summarize_dir,
+                    "only recompute DIR/fleet.json from DIR/*/unit.json (units run elsewhere, e.g. on Dask)");
+  fleet->add_option("--effects", effects_args, "the model every log is fitted with, as for explain");
+  fleet->add_option("--points", export_points, "calibration table points per mechanical revolution (default 1024)")
+      ->check(CLI::Range(8, 1 << 20));
+  fleet->add_option("--config", config_path, "resolverd config (TOML), as for explain");
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
+  if (fleet->parsed()) return run_fleet(manifest, fleet_out, summarize_dir, split_effects(effects_args), config_path,
+                                        export_points);
   if (slice.to_s < slice.from_s) {
     std::cerr << "resolver-model: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
     return resolver::exit_code::kUsage;

@@ -1,0 +1,448 @@
+#include "tools/model/fleet.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <new>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include "daemon/service/program_errors.h"
+#include "daemon/service/table_file.h"
+#include "tools/model/html_report.h"
+#include "tools/model/json_text.h"
+#include "tools/model/json_value.h"
+#include "tools/model/log_samples.h"
+
+namespace resolver {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string trim(std::string s) {
+  const auto not_space = [](unsigned char c) { return !std::isspace(c); };
+  s.erase(s.begin(), std::find_if(s.begin(), s.end(), not_space));
+  s.erase(std::find_if(s.rbegin(), s.rend(), not_space).base(), s.end());
+  return s;
+}
+
+bool safe_unit_name(const std::string& u) {
+  if (u.empty() || u.front() == '.' || u.size() > 128) return false;
+  return std::all_of(u.begin(), u.end(), [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-' || c == '.'; });
+}
+
+// ---- one log, one unit -------------------------------------------------------------
+
+struct LogResult {
+  std::string log;
+  std::string error;  ///< empty: fitted
+  int p_r = 0, p = 0;
+  Explanation ex;
+};
+
+LogResult explain_log(const std::string& log, const FleetOptions& o) {
+  LogResult r;
+  r.log = log;
+  try {
+    if (!fs::exists(log)) throw std::system_error(std::make_error_code(std::errc::no_such_file_or_directory), log);
+    LogSamples samples = read_log_samples(log, {}, o.config);
+    DiscoveryOptions options = o.discovery;
+    const FaultCounts faults = fault_counts(samples);
+    options.untrusted_input = lasting_faults(faults, samples.health_samples, kUntrustedFaultShare);
+    r.p_r = samples.input.p_r;
+    r.p = samples.input.p;
+    r.ex = explain_model(samples.input, o.effects, options);
+  } catch (const std::bad_alloc&) {
+    throw;  // out of memory is the whole run's problem (exit 4), not one unit's
+  } catch (const std::system_error& e) {
+    r.error = std::string("cannot read the log: ") + e.what();
+  } catch (const std::exception& e) {
+    r.error = e.what();
+  }
+  return r;
+}
+
+double ratio(const ModelFit& f) { return f.residual_rms_rad / f.noise_floor_rad; }
+
+std::string params_json(const std::vector<ModelParameter>& params) {
+  std::string o = "{";
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    o += (i ? "," : "") + json::str(params[i].name) + ":{\"value\":" + json::num(params[i].value) +
+         ",\"stderr\":" + json::num(params[i].std_error) + ",\"unit\":" + json::str(params[i].unit) + "}";
+  }
+  return o + "}";
+}
+
+std::string strings_json(const std::vector<std::string>& v) {
+  std::string o = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) o += (i ? "," : "") + json::str(v[i]);
+  return o + "]";
+}
+
+std::string fit_fields(const Explanation& ex) {
+  const ModelFit& f = ex.fit;
+  std::vector<std::string> proposed;
+  for (const auto& c : ex.candidates) {
+    if (c.proposed) proposed.push_back(c.effect);
+  }
+  return fmt::format(
+      "\"verdict\":{},\"residual_rms_rad\":{},\"noise_floor_rad\":{},\"residual_over_floor\":{},\"effects\":{},"
+      "\"params\":{},\"proposed\":{}",
+      json::str(to_string(ex.verdict)), json::num(f.residual_rms_rad), json::num(f.noise_floor_rad),
+      json::num(ratio(f)), strings_json(f.effects), params_json(f.params), strings_json(proposed));
+}
+
+/// Pairs of the unit's logs whose values of a parameter differ by more than 4 combined
+/// standard errors.
+std::string disagreements_json(const std::vector<LogResult>& logs, std::vector<std::string>& names) {
+  std::string o = "[";
+  for (std::size_t a = 0; a < logs.size(); ++a) {
+    for (std::size_t b = a + 1; b < logs.size(); ++b) {
+      for (const auto& pa : logs[a].ex.fit.params) {
+        for (const auto& pb : logs[b].ex.fit.params) {
+          if (pa.name != pb.name) continue;
+          const double se = std::hypot(pa.std_error, pb.std_error);
+          const double z = std::abs(pa.value - pb.value) / se;
+          if (!(se > 0.0) || !(z > 4.0)) continue;
+          if (std::find(names.begin(), names.end(), pa.name) == names.end()) names.push_back(pa.name);
+          o += (o.size() > 1 ? "," : "") +
+               fmt::format("{{\"param\":{},\"logs\":[{},{}],\"values\":[{},{}],\"z\":{}}}", json::str(pa.name),
+                           json::str(logs[a].log), json::str(logs[b].log), json::num(pa.value),
+                           json::num(pb.value), json::num(z, 4));
+        }
+      }
+    }
+  }
+  return o + "]";
+}
+
+void write_failed_unit(const std::string& dir, const std::string& unit, const std::string& reason,
+                       std::size_t log_rows, const std::string& logs_json) {
+  write_text_file(dir + "/unit.json",
+                  fmt::format("{{\"unit\":{},\"status\":\"failed\",\"reason\":{},\"log_rows\":{},\"logs\":{}}}\n",
+                              json::str(unit), json::str(reason), log_rows, logs_json));
+}
+
+/// Returns false when the unit failed.
+bool run_unit(const std::string& unit, const std::vector<ManifestRow>& rows, const std::string& manifest,
+              const std::string& out_dir, const FleetOptions& o) {
+  const std::string dir = out_dir + "/" + unit;
+  fs::create_directories(dir);
+  for (const char* stale : {"unit.json", "calibration.csv", "calibration.json", "calibration.h"}) fs::remove(dir + "/" + stale);
+  std::vector<std::string> problems;
+  // The same log twice (however spelt): its fit would count twice.
+  std::map<std::string, std::uint64_t> seen;
+  for (const auto& r : rows) {
+    std::error_code ec;
+    const std::string key = fs::weakly_canonical(r.log, ec).string();
+    const auto [it, fresh] = seen.emplace(ec ? r.log : key, r.line);
+    if (!fresh) {
+      problems.push_back(fmt::format("{}:{}: log {} is listed twice for unit {} (also line {})", manifest, r.line,
+                                     r.log, unit, it->second));
+    }
+  }
+  std::vector<LogResult> logs;
+  std::string logs_json = "[";
+  if (problems.empty()) {
+    for (const auto& r : rows) {
+      logs.push_back(explain_log(r.log, o));
+      const LogResult& l = logs.back();
+      logs_json += (logs.size() > 1 ? "," : "") + std::string("{\"log\":") + json::str(l.log);
+      if (!l.error.empty()) {
+        problems.push_back(fmt::format("{} (manifest line {}): {}", l.log, r.line, l.error));
+        logs_json += ",\"status\":\"failed\",\"reason\":" + json::str(l.error) + "}";
+        continue;
+      }
+      logs_json += fmt::format(",\"status\":\"done\",\"p_r\":{},\"p\":{},{}}}", l.p_r, l.p, fit_fields(l.ex));
+    }
+    for (const auto& l : logs) {
+      if (l.error.empty() && !logs.empty() && logs.front().error.empty() && l.p_r != logs.front().p_r) {
+        problems.push_back(fmt::format("{} has p_r = {}, {} has p_r = {}", l.log, l.p_r,
+                                       logs.front().log, logs.front().p_r));
+      }
+    }
+  }
+  logs_json += "]";
+  if (!problems.empty()) {
+    const std::string reason = fmt::format("{}", fmt::join(problems, "; "));
+    std::cerr << "resolver-model fleet: unit " << unit << " failed: " << reason << "\n";
+    write_failed_unit(dir, unit, reason, rows.size(), logs_json);
+    return false;
+  }
+  // The unit's calibration: its log with the smallest residual against its floor.
+  const auto best = std::min_element(logs.begin(), logs.end(),
+                                     [](const LogResult& a, const LogResult& b) { return ratio(a.ex.fit) < ratio(b.ex.fit); });
+  const ModelFit& fit = best->ex.fit;
+  const CalibrationTable table = tabulate(fit.model, o.points);
+  write_text_file(dir + "/calibration.csv", calibration_text(table, best->log, "csv"));
+  write_text_file(dir + "/calibration.json", calibration_text(table, best->log, "json"));
+  write_text_file(dir + "/calibration.h", calibration_text(table, best->log, "c-header"));
+  std::vector<std::string> disagreeing;
+  const std::string disagreements = disagreements_json(logs, disagreeing);
+  std::string needed = "null";
+  if (best->ex.verdict == Verdict::kMissingEffect && !best->ex.candidates.empty()) {
+    needed = json::str(best->ex.candidates.front().effect);
+  }
+  write_text_file(dir + "/unit.json",
+                  fmt::format("{{\"unit\":{},\"status\":\"done\",\"calibration_log\":{},\"p_r\":{},\"p\":{},{},"
+                              "\"needed\":{},\"disagreeing\":{},\"disagreements\":{},\"log_rows\":{},"
+                              "\"files\":[\"calibration.csv\",\"calibration.json\",\"calibration.h\"],\"logs\":{}}}\n",
+                              json::str(unit), json::str(best->log), best->p_r, best->p, fit_fields(best->ex), needed,
+                              strings_json(disagreeing), disagreements, rows.size(), logs_json));
+  if (!disagreeing.empty()) {
+    std::cerr << "resolver-model fleet: unit " << unit << ": its logs disagree on " << fmt::format("{}", fmt::join(disagreeing, ", "))
+              << " (more than 4 combined standard errors; unit.json: disagreements)\n";
+  }
+  return true;
+}
+
+// ---- the summary ------------------------------------------------------------------
+
+/// Linear interpolation between order statistics (numpy's default).
+double quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) return std::nan("");
+  const double pos = q * static_cast<double>(sorted.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const std::size_t hi = std::min(lo + 1, sorted.size() - 1);
+  return sorted[lo] + (pos - static_cast<double>(lo)) * (sorted[hi] - sorted[lo]);
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return quantile(v, 0.5);
+}
+
+struct UnitSummary {
+  std::string unit;
+  bool done = false;
+  std::string reason;
+  int p_r = 0;
+  std::string verdict, needed;
+  double ratio = 0.0;
+  std::vector<std::string> proposed, disagreeing;
+  std::vector<std::pair<std::string, double>> params;
+  std::size_t logs = 0;
+};
+
+UnitSummary read_unit(const fs::path& file) {
+  UnitSummary u;
+  u.unit = file.parent_path().filename().string();
+  std::ifstream in(file);
+  std::stringstream text;
+  text << in.rdbuf();
+  try {
+    const json::Json j = json::parse_json(trim(text.str()));
+    u.logs = static_cast<std::size_t>(j["log_rows"].integer());
+    if (j["status"].text != "done") {
+      u.reason = j.has("reason") ? j["reason"].text : "failed";
+      return u;
+    }
+    u.p_r = static_cast<int>(j["p_r"].integer());
+    u.verdict = j["verdict"].text;
+    u.ratio = j["residual_over_floor"].is_null() ? std::nan("") : j["residual_over_floor"].number();
+    u.needed = j["needed"].is_null() ? "" : j["needed"].text;
+    for (const auto& e : j["proposed"].items) u.proposed.push_back(e.text);
+    for (const auto& e : j["disagreeing"].items) u.disagreeing.push_back(e.text);
+    for (const auto& [name, p] : j["params"].members) u.params.emplace_back(name, p["value"].number());
+    u.done = true;
+  } catch (const std::exception& e) {
+    u.reason = fmt::format("{}: unreadable ({})", file.string(), e.what());
+  }
+  return u;
+}
+
+}  // namespace
+
+std::vector<ManifestRow> read_manifest(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::system_error(errno, std::generic_category(), "cannot open manifest " + path);
+  const fs::path base = fs::path(path).parent_path();
+  std::vector<ManifestRow> rows;
+  std::string line;
+  std::uint64_t n = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++n;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (trim(line).empty() || trim(line).front() == '#') continue;
+    const auto comma = line.find(',');
+    if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos) {
+      throw InputError(Fault::kUsage, "a manifest row is \"unit,log\" (two fields): " + line, Where::at_file(path, n));
+    }
+    ManifestRow r{trim(line.substr(0, comma)), trim(line.substr(comma + 1)), n};
+    if (!header) {
+      if (r.unit != "unit" || r.log != "log") {
+        throw InputError(Fault::kUsage, "the manifest's first line is the header \"unit,log\", not: " + line,
+                         Where::at_file(path, n));
+      }
+      header = true;
+      continue;
+    }
+    if (!safe_unit_name(r.unit) || r.log.empty()) {
+      throw InputError(Fault::kUsage,
+                       "unit '" + r.unit + "': a unit is a folder name of letters, digits, '_', '-', '.' (not first), "
+                       "and every row names a log",
+                       Where::at_file(path, n));
+    }
+    if (fs::path(r.log).is_relative()) r.log = (base / r.log).lexically_normal().string();
+    rows.push_back(std::move(r));
+  }
+  if (!header) throw InputError(Fault::kUsage, "empty manifest: expected the header \"unit,log\"", Where::at_file(path));
+  return rows;
+}
+
+std::string calibration_text(const CalibrationTable& table, const std::string& log, const std::string& format) {
+  char date[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  const TableOrigin origin{log, date, "resolver-model"};
+  return format == "json"       ? format_table_json(table, origin)
+         : format == "c-header" ? format_table_c_header(table, origin)
+                                : format_table_csv(table, origin);
+}
+
+int run_fleet_units(const std::vector<ManifestRow>& rows, const std::string& manifest, const std::string& out_dir,
+                    const FleetOptions& options) {
+  std::map<std::string, std::vector<ManifestRow>> units;  // sorted by name: the same order every run
+  for (const auto& r : rows) units[r.unit].push_back(r);
+  int failed = 0;
+  for (const auto& [unit, unit_rows] : units) {
+    if (!run_unit(unit, unit_rows, manifest, out_dir, options)) ++failed;
+  }
+  return failed;
+}
+
+std::string summarize_fleet(const std::string& out_dir, int& failed) {
+  std::vector<UnitSummary> units;
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(out_dir)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && !name.empty() && name.front() != '.' && fs::exists(entry.path() / "unit.json")) {
+      files.push_back(entry.path() / "unit.json");
+    }
+  }
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) units.push_back(read_unit(f));
+  // The fleet's p_r: the most common among the units done; a unit with another is left out.
+  std::map<int, int> p_r_count;
+  for (const auto& u : units) {
+    if (u.done) ++p_r_count[u.p_r];
+  }
+  int fleet_p_r = 0, most = 0;
+  for (const auto& [p_r, count] : p_r_count) {
+    if (count > most) fleet_p_r = p_r, most = count;
+  }
+  for (auto& u : units) {
+    if (u.done && u.p_r != fleet_p_r) {
+      u.done = false;
+      u.reason = fmt::format("its logs have p_r = {}, the fleet's is {} ({} units): left out of the summary", u.p_r,
+                             fleet_p_r, most);
+    }
+  }
+  std::size_t logs_total = 0, logs_left_out = 0;
+  std::map<std::string, std::vector<double>> values;  // per parameter, over the units done
+  std::map<std::string, int> proposed, needed;
+  for (const auto& u : units) {
+    logs_total += u.logs;
+    if (!u.done) {
+      logs_left_out += u.logs;
+      continue;
+    }
+    for (const auto& [name, v] : u.params) values[name].push_back(v);
+    for (const auto& e : u.proposed) ++proposed[e];
+    if (!u.needed.empty()) ++needed[u.needed];
+  }
+  const int done = static_cast<int>(std::count_if(units.begin(), units.end(), [](const UnitSummary& u) { return u.done; }));
+  failed = static_cast<int>(units.size()) - done;
+
+  struct Stat {
+    double median, spread;
+  };
+  std::map<std::string, Stat> stats;
+  std::string params = "{";
+  std::string table = fmt::format("{:<36} {:>5} {:>12} {:>11} {:>12} {:>12}\n", "parameter", "units", "median",
+                                  "spread", "q05", "q95");
+  for (auto& [name, v] : values) {
+    std::sort(v.begin(), v.end());
+    const double med = quantile(v, 0.5);
+    std::vector<double> dev;
+    for (double x : v) dev.push_back(std::abs(x - med));
+    const double spread = 1.4826 * median(dev);
+    stats[name] = {med, spread};
+    params += (params.size() > 1 ? "," : "") +
+              fmt::format("{}:{{\"units\":{},\"median\":{},\"spread\":{},\"q05\":{},\"q25\":{},\"q75\":{},\"q95\":{},"
+                          "\"min\":{},\"max\":{}}}",
+                          json::str(name), v.size(), json::num(med), json::num(spread), json::num(quantile(v, 0.05)),
+                          json::num(quantile(v, 0.25)), json::num(quantile(v, 0.75)), json::num(quantile(v, 0.95)),
+                          json::num(v.front()), json::num(v.back()));
+    table += fmt::format("{:<36} {:>5} {:>12.5g} {:>11.3g} {:>12.5g} {:>12.5g}\n", name, v.size(), med, spread,
+                         quantile(v, 0.05), quantile(v, 0.95));
+  }
+  params += "}";
+  // Units outside the spread: |value - median| > 4 robust spreads, with the parameter.
+  std::string outliers = "[";
+  std::string outlier_lines;
+  for (const auto& u : units) {
+    if (!u.done) continue;
+    for (const auto& [name, v] : u.params) {
+      const Stat& s = stats[name];
+      if (!(s.spread > 0.0) || values[name].size() < 3) continue;
+      const double z = (v - s.median) / s.spread;
+      if (std::abs(z) <= 4.0) continue;
+      outliers += (outliers.size() > 1 ? "," : "") + fmt::format("{{\"unit\":{},\"param\":{},\"value\":{},\"z\":{}}}",
+                                                                 json::str(u.unit), json::str(name), json::num(v),
+                                                                 json::num(z, 4));
+      outlier_lines += fmt::format("outlier: unit {} {} = {:.5g} (robust z {:+.1f})\n", u.unit, name, v, z);
+    }
+  }
+  outliers += "]";
+  const auto counted = [&](const std::map<std::string, int>& m) {
+    std::vector<std::pair<std::string, int>> v(m.begin(), m.end());
+    std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+    std::string o = "[";
+    for (const auto& [e, n] : v) {
+      o += (o.size() > 1 ? "," : "") + fmt::format("{{\"effect\":{},\"units\":{},\"most_units\":{}}}", json::str(e), n,
+                                                   2 * n > done ? "true" : "false");
+    }
+    return o + "]";
+  };
+  std::string failed_json = "[", failed_lines, units_json = "[";
+  for (const auto& u : units) {
+    if (!u.done) {
+      failed_json += (failed_json.size() > 1 ? "," : "") +
+                     fmt::format("{{\"unit\":{},\"reason\":{}}}", json::str(u.unit), json::str(u.reason));
+      failed_lines += fmt::format("failed: unit {}: {}\n", u.unit, u.reason);
+      continue;
+    }
+    units_json += (units_json.size() > 1 ? "," : "") +
+                  fmt::format("{{\"unit\":{},\"verdict\":{},\"residual_over_floor\":{},\"needed\":{},\"disagreeing\":{}}}",
+                              json::str(u.unit), json::str(u.verdict), json::num(u.ratio),
+                              u.needed.empty() ? std::string("null") : json::str(u.needed), strings_json(u.disagreeing));
+  }
+  failed_json += "]";
+  units_json += "]";
+  write_text_file(out_dir + "/fleet.json",
+                  fmt::format("{{\"units_total\":{},\"units_done\":{},\"units_failed\":{},\"logs_total\":{},"
+                              "\"logs_left_out\":{},\"p_r\":{},\"params\":{},\"outliers\":{},\"proposed\":{},"
+                              "\"needed\":{},\"failed\":{},\"units\":{}}}\n",
+                              units.size(), done, failed, logs_total, logs_left_out, fleet_p_r, params, outliers,
+                              counted(proposed), counted(needed), failed_json, units_json));
+  std::string text = fmt::format("fleet: {} units, {} done, {} failed ({} of {} logs left out); p_r = {}\n",
+                                 units.size(), done, failed, logs_left_out, logs_total, fleet_p_r);
+  text += table + outlier_lines;
+  for (const auto& [e, n] : needed) text += fmt::format("needed: {} by {} of {} units\n", e, n, done);
+  text += failed_lines;
+  text += "wrote " + out_dir + "/fleet.json\n";
+  return text;
+}
+
+}  // namespace resolver

@@ -1,0 +1,57 @@
+// resolver-model fleet (issue 24 parts 3-4): a production line's calibrations, one unit
+// per folder, and the fleet's summary.
+//
+//   MANIFEST (CSV "unit,log") ─► per unit: each log read and explained (the code explain
+//   runs) ─► DIR/UNIT/unit.json + the calibration of its best log (export's formats)
+//   DIR/*/unit.json ─► summarize_fleet ─► DIR/fleet.json + a text table
+//
+// The summary is computed from the unit.json files only, so a fleet run on one machine
+// and one whose units ran elsewhere (tools/python/resolver_bench, Dask) give the same
+// fleet.json by construction.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "daemon/app/daemon_config.h"
+#include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/model/calibration_table.h"
+
+namespace resolver {
+
+/// One manifest row.
+struct ManifestRow {
+  std::string unit;
+  std::string log;   ///< as resolved: relative paths are relative to the manifest's folder
+  std::uint64_t line = 0;
+};
+
+/// Reads MANIFEST. Throws std::system_error (exit 3) when it cannot be read and
+/// InputError kUsage (exit 2) naming the line when the header is not "unit,log", a row
+/// has not two fields or a unit name is not a safe folder name ([A-Za-z0-9_.-], not
+/// starting with '.').
+[[nodiscard]] std::vector<ManifestRow> read_manifest(const std::string& path);
+
+struct FleetOptions {
+  std::vector<std::string> effects;  ///< the model each log is fitted with
+  DaemonConfig config;
+  DiscoveryOptions discovery;
+  int points = 1024;                 ///< calibration table points
+};
+
+/// Runs every unit of `rows` into out_dir/UNIT/ (unit.json + calibration.{csv,json,h});
+/// a unit that fails gets a unit.json saying why, and a line on stderr naming the unit
+/// and the file. Returns the number of units that failed.
+int run_fleet_units(const std::vector<ManifestRow>& rows, const std::string& manifest, const std::string& out_dir,
+                    const FleetOptions& options);
+
+/// Recomputes out_dir/fleet.json from out_dir/*/unit.json and returns the text table.
+/// `failed` is set to the number of units that are not done (including those whose p_r
+/// differs from the fleet's).
+[[nodiscard]] std::string summarize_fleet(const std::string& out_dir, int& failed);
+
+/// The calibration text in export's formats ("csv", "json", "c-header").
+[[nodiscard]] std::string calibration_text(const CalibrationTable& table, const std::string& log,
+                                           const std::string& format);
+
+}  // namespace resolver
