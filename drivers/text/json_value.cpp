@@ -1,4 +1,4 @@
-#include "tools/model/json_value.h"
+#include "drivers/text/json_value.h"
 
 #include <cstdlib>
 #include <stdexcept>
