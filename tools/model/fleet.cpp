@@ -19,7 +19,7 @@
 #include "daemon/service/table_file.h"
 #include "tools/model/html_report.h"
 #include "tools/model/json_text.h"
-#include "drivers/text/json_value.h"
+#include "tools/model/json_value.h"
 #include "tools/model/log_samples.h"
 
 namespace resolver {

@@ -1,12 +1,37 @@
-// The echo tests' JSON parser: the project's strict reader (drivers/text/json_value.h),
-// independent of resolver-echo's writer that the tests check.
+// A minimal strict JSON parser for the tests: an independent check that
+// resolver-echo's output is valid JSON and holds the right values.
+// Numbers keep their text so int64 values compare exactly.
 #pragma once
 
-#include "drivers/text/json_value.h"
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 namespace echo_test_support {
 
-using resolver::json::Json;
-using resolver::json::parse_json;
+struct Json {
+  enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject };
+  Kind kind = Kind::kNull;
+  bool boolean = false;
+  std::string text;  ///< number text or decoded string
+  std::vector<Json> items;
+  std::vector<std::pair<std::string, Json>> members;  ///< in document order
+
+  bool is_null() const { return kind == Kind::kNull; }
+  double number() const;
+  long long integer() const;
+  /// The member called `key`; throws std::out_of_range if absent.
+  const Json& operator[](std::string_view key) const;
+  const Json& operator[](std::size_t index) const { return items.at(index); }
+  bool has(std::string_view key) const;
+  std::vector<std::string> keys() const;
+};
+
+/// Parses exactly one JSON value filling `text`; throws std::runtime_error
+/// (with the offset) on anything that is not strict JSON.
+Json parse_json(std::string_view text);
 
 }  // namespace echo_test_support

@@ -1,7 +1,7 @@
-// A minimal strict JSON reader: resolver-model fleet --summarize reads its own
-// unit.json files back with it, and the echo tests check resolver-echo's JSON with
-// it (independent of the writer they check). Numbers keep their text, so int64
-// values compare exactly.
+// A minimal strict JSON reader: what resolver-model fleet --summarize reads its own
+// unit.json files back with. A copy of tests/unit/echo/json_test_parser (kept there
+// separately: the echo tests want a parser independent of the code they check).
+// Numbers keep their text.
 #pragma once
 
 #include <map>

@@ -1,4 +1,4 @@
-#include "drivers/text/json_value.h"
+#include "tools/model/json_value.h"
 
 #include <cstdlib>
 #include <stdexcept>
