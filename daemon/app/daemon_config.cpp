@@ -15,6 +15,7 @@
 
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/angles.h"
+#include "daemon/core/estimation/estimator_models.h"
 #include "daemon/decode/signal_units.h"
 
 namespace resolver {
@@ -24,10 +25,12 @@ std::string default_dbc_path() { return "proto/resolver_bench.dbc (built into re
 namespace {
 
 constexpr std::int64_t kMaxExtendedCanId = 0x1FFFFFFF;
-/// [estimator] max_order's largest value: at 64 (129 parameters) a 2 s log of the
-/// default bench replays at 54k frames/s on the project's machine, 9 times its
-/// frame rate; at 128 at 24k, at 512 at 870 frames/s (slower than the bench).
-constexpr int kMaxFourierOrder = 64;
+/// [estimator] max_order's largest value: the fit's result is a Model of the catalog
+/// (estimator_models.h), whose harmonics effect ends at k20, error order 19; an order
+/// above it would be fitted but neither compensated nor published. (Speed is not the
+/// limit: at 64, 129 parameters, a 2 s log of the default bench replayed at 54k
+/// frames/s on the project's machine.)
+constexpr int kMaxFourierOrder = kFourierModelMaxOrder;
 /// [Hz] Sample and row rates: above 1 MHz two samples share a microsecond stamp;
 /// below 1 Hz no bench samples a resolver (1e-300 made every period 1e300 s, and
 /// every window "0 moving" over 3.2e+303 s).

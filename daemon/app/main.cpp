@@ -81,7 +81,12 @@ Model model_from_calibration(const Calibration& cal, const DaemonConfig& config)
     if (!known) specs.push_back(CustomEffectSpec{c.name, c.signal, c.terms, "", "saved calibration"});
   }
   auto customs = std::make_shared<const CustomEffects>(specs);
-  Model m(ModelSpec::parse(cal.model, customs.get()), cal.p_r, cal.p);
+  std::vector<std::string> names;
+  for (const auto& p : cal.params) names.push_back(p.name);
+  // A file without the model's references (an older method's, before they were
+  // saved): the registry parameters it lists are the model.
+  Model m(cal.model.empty() ? ModelSpec::for_parameters(names) : ModelSpec::parse(cal.model, customs.get()), cal.p_r,
+          cal.p);
   m.keep(customs);
   for (const auto& p : cal.params) {
     try {
@@ -254,22 +259,20 @@ static int run(int argc, char** argv) {
     }
     if (loaded.status == LoadResult::Status::kLoaded) {
       const Calibration& cal = *loaded.calibration;
-      if (config.method == EstimatorMethod::kModel && !cal.model.empty()) {
-        try {
-          pipeline->seed_model(model_from_calibration(cal, config));
-          std::cerr << "resolverd: compensating with the saved model (" << fmt::format("{}", fmt::join(cal.model, ", "))
-                    << ") from " << calibration_path(state_dir) << " until this run's first window is fitted\n";
-        } catch (const std::exception& e) {
-          std::cerr << "resolverd: the saved model in " << calibration_path(state_dir) << " is not used: " << e.what()
+      // Every method compensates with the saved Model until this run has its own estimate.
+      try {
+        Model saved = model_from_calibration(cal, config);
+        if (!saved.empty()) {
+          std::cerr << "resolverd: compensating with the saved model ("
+                    << fmt::format("{}", fmt::join(saved.spec().references(), ", ")) << ") from "
+                    << calibration_path(state_dir) << " until this run's "
+                    << (config.method == EstimatorMethod::kModel ? "first window is fitted" : "estimate converges")
                     << "\n";
+          pipeline->seed_model(std::move(saved));
         }
-      }
-      for (const auto& param : cal.params) {
-        if (param.name == "amplitude_imbalance.alpha" && config.method != EstimatorMethod::kModel) {
-          pipeline->seed_alpha(param.value);
-          std::cerr << "resolverd: compensating with the saved alpha = " << param.value << " from "
-                    << calibration_path(state_dir) << " until this run's estimate converges\n";
-        }
+      } catch (const std::exception& e) {
+        std::cerr << "resolverd: the saved model in " << calibration_path(state_dir) << " is not used: " << e.what()
+                  << "\n";
       }
     } else if (loaded.status == LoadResult::Status::kRejected) {
       std::cerr << "resolverd: " << loaded.problem << "\n";
@@ -336,7 +339,7 @@ static int run(int argc, char** argv) {
       cal.method = model.method;
       cal.samples = model.samples;
       cal.params = model.params;
-      if (pipeline->processor().config().method == EstimatorMethod::kModel) describe_model(pipeline->processor().model(), cal);
+      describe_model(pipeline->processor().estimated_model(), cal);
       Calibration::Provenance& pv = cal.provenance;
       pv.config = config_path;
       pv.config_crc32 = config_crc;

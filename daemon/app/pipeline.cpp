@@ -191,9 +191,7 @@ const Pipeline::Reload& Pipeline::reload(const DaemonConfig& fresh) {
     if (model_fit_) {
       // Its last windows are fitted and published under the config they were read with.
       model_fit_->finish();
-      if (auto fitted = model_fit_->take_model(); fitted && now.method == EstimatorMethod::kModel) {
-        processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
-      }
+      adopt_live_fit();
       if (fit) fit->continue_from(*model_fit_);
     }
     model_fit_ = std::move(fit);
@@ -205,8 +203,9 @@ const Pipeline::Reload& Pipeline::reload(const DaemonConfig& fresh) {
     if (same_model && next.method == EstimatorMethod::kModel && !processor_.model().empty()) {
       replacement->set_model(processor_.model(), learned.samples, learned.revolutions);
       estimate_kept = true;
-    } else if (same_model && next.method == EstimatorMethod::kHwangIntegral && processor_.active_alpha() != 0.0) {
-      replacement->seed_alpha(processor_.active_alpha());  // compensation goes on while it learns again
+    } else if (same_model && !processor_.model().empty()) {
+      // An older method learns again; its last model compensates meanwhile.
+      replacement->set_model(processor_.model(), learned.samples, learned.revolutions);
     }
     if (table_) replacement->set_table(*table_);
     std::string why = next.method != now.method     ? "the method changed (" + learned.method + " -> " +
@@ -305,19 +304,25 @@ void Pipeline::tick(std::int64_t now_us) {
   if (now_us - health_window_start_us_ >= kHealthPeriodUs) publish_health(now_us);
 }
 
+bool Pipeline::adopt_live_fit() {
+  auto fitted = model_fit_->take_model();
+  // With an older method the live fit is a diagnostic (model_fit_t): the method's
+  // own estimate compensates.
+  if (!fitted || processor_.config().method != EstimatorMethod::kModel) return false;
+  processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+  return true;
+}
+
 void Pipeline::finish() {
   stream_.flush();
   if (model_fit_) {
     model_fit_->finish();
-    if (auto fitted = model_fit_->take_model()) {
-      processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+    if (adopt_live_fit()) {
       // No sample follows to carry it: publish the final estimate now.
-      if (processor_.config().method == EstimatorMethod::kModel) {
-        Sample last;
-        last.utime = last_utime_;
-        last.index = last_sample_index_;
-        publish_estimate(last, last_counter_);
-      }
+      Sample last;
+      last.utime = last_utime_;
+      last.index = last_sample_index_;
+      publish_estimate(last, last_counter_);
     }
   }
   signal_health_.finish();
@@ -364,9 +369,7 @@ void Pipeline::on_sample(const Sample& sample, std::uint8_t counter) {
       if (faults[i].active) active = static_cast<std::uint8_t>(active | (1U << i));
     }
     model_fit_->add(sample, pc.p_r, pc.p, {sample.utime, sample.index, counter}, active);
-    if (auto fitted = model_fit_->take_model()) {
-      processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
-    }
+    adopt_live_fit();
   }
   summary_.add(out, processor_, sample.t);
   if (!out.has_angle) return;

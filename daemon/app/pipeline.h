@@ -106,9 +106,8 @@ class Pipeline {
   /// Live idle time: publishes health_t when a second has passed since the
   /// last one even if no frame arrived. now_us [us] on the frames' clock.
   void tick(std::int64_t now_us);
-  /// Compensate with a persisted alpha until the estimator converges.
-  void seed_alpha(double alpha) { processor_.seed_alpha(alpha); }
-  /// Compensate with a persisted or loaded model until the live fit has one.
+  /// Compensate with a persisted or loaded model until this run's estimate (the live
+  /// fit's, or an older method's own) has one.
   void seed_model(Model model) { processor_.set_model(std::move(model), 0, 0.0); }
   /// Compensate with an exported table (resolverd --calibration); kept across reloads.
   void use_table(CalibrationTable table) {
@@ -161,6 +160,8 @@ class Pipeline {
  private:
   void on_sample(const Sample& sample, std::uint8_t counter);
   void on_bench_info(const BenchInfo& info);
+  /// Takes the live fit's newest model, if any; method kModel compensates with it (true).
+  bool adopt_live_fit();
   void publish_estimate(const Sample& sample, std::uint8_t counter);
   void advance_health_clock(std::int64_t now_us);
   void publish_health(std::int64_t utime);

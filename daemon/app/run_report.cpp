@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/effects/amplitude_imbalance.h"
 #include "drivers/text/json_string.h"
 
 namespace resolver {
@@ -250,8 +251,9 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
   j += fmt::format("\"p_r\":{},\"p\":{},", p.processor().config().p_r, p.processor().config().p);
   const ModelEstimate model = p.processor().estimate();
   double alpha = est.alpha(), alpha_se = est.alpha_stderr();
+  const std::string alpha_name = amplitude_imbalance_alpha_name();
   for (const ModelParameter& prm : model.params) {
-    if (prm.name == "amplitude_imbalance.alpha") {
+    if (prm.name == alpha_name) {
       alpha = prm.value;
       alpha_se = prm.std_error;
     }

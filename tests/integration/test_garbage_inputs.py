@@ -244,7 +244,7 @@ class ConfigRanges(unittest.TestCase):
     def test_max_order_beyond_its_range(self):
         for v in ("2000", "2147483647", "0"):
             refused(self, '[estimator]\nmethod = "fourier_reference"\nmax_order = %s\n' % v, "max_order_" + v,
-                    ":3: [estimator] max_order must be 1..64", "got " + v)
+                    ":3: [estimator] max_order must be 1..19", "got " + v)
 
     def test_absurd_sample_rates(self):
         for v in ("1e-300", "0.001", "1e300", "-5", "inf"):
@@ -257,9 +257,9 @@ class ConfigRanges(unittest.TestCase):
         refused(self, "[bench]\np = 1000\n", "p_huge", ":2: [bench] p must be 1..255 (motor pole pairs")
 
     def test_control_max_order_at_its_limit_runs(self):
-        config = write("max_order_64.toml", '[estimator]\nmethod = "fourier_reference"\nmax_order = 64\n')
+        config = write("max_order_19.toml", '[estimator]\nmethod = "fourier_reference"\nmax_order = 19\n')
         proc = run([os.path.join(ARGS.bin, "resolverd"), "--replay", sim_log(), "--once", "--fast", "--config", config,
-                    "--lcm", "file://" + work("max_order_64.lcmlog") + "?mode=w"], timeout=60)
+                    "--lcm", "file://" + work("max_order_19.lcmlog") + "?mode=w"], timeout=60)
         self.assertEqual(proc.returncode, 0, proc.stderr[-2000:])
 
 

@@ -87,4 +87,8 @@ const Effect& amplitude_imbalance_effect() {
   return effect;
 }
 
+std::string amplitude_imbalance_alpha_name() {
+  return std::string(amplitude_imbalance_effect().name()) + "." + std::string(kParams[kAlpha].name);
+}
+
 }  // namespace resolver

@@ -11,6 +11,8 @@
 // alpha^2/8), see tests/unit/effects for the bound.
 #pragma once
 
+#include <string>
+
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
@@ -31,5 +33,8 @@ struct AmplitudeImbalance {
 /// The registry unit of this effect (registry.h).
 class Effect;
 [[nodiscard]] const Effect& amplitude_imbalance_effect();
+/// "amplitude_imbalance.alpha": alpha's name in estimate_t, the calibration and the
+/// reports (the run report's headline alpha looks it up by this).
+[[nodiscard]] std::string amplitude_imbalance_alpha_name();
 
 }  // namespace resolver

@@ -7,38 +7,15 @@
 #include <string>
 #include <string_view>
 
-#include "daemon/core/effects/amplitude_imbalance.h"
-#include "daemon/core/effects/harmonics.h"
-#include "daemon/core/effects/offsets.h"
-#include "daemon/core/effects/quadrature.h"
-#include "daemon/core/effects/registry.h"
 #include "daemon/core/estimation/dq_transform.h"
+#include "daemon/core/estimation/estimator_models.h"
 
 namespace resolver {
 
 namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// An older estimator's value of a registry effect's parameter: named and united
-/// by the effect (a name the effect lacks is a programming error).
-ModelParameter param_of(const Effect& effect, std::string_view param, double value, double std_error) {
-  const int i = find_param(effect, param);
-  if (i < 0) throw std::logic_error(std::string(effect.name()) + " has no parameter " + std::string(param));
-  return ModelParameter{.name = std::string(effect.name()) + "." + std::string(param), .value = value,
-                        .std_error = std_error,
-                        .unit = std::string(effect.params()[static_cast<std::size_t>(i)].unit)};
-}
-
-/// The sin/cos fits' envelope parameters (alpha, beta, o_s, o_c), as the registry's effects.
-template <typename Fit>
-std::vector<ModelParameter> envelope_params(const Fit& f) {
-  return {param_of(amplitude_imbalance_effect(), "alpha", f.alpha.value, f.alpha.std_error),
-          param_of(quadrature_effect(), "beta", f.beta.value, f.beta.std_error),
-          param_of(offsets_effect(), "o_s", f.o_s.value, f.o_s.std_error),
-          param_of(offsets_effect(), "o_c", f.o_c.value, f.o_c.std_error)};
-}
-
-/// A value no registry effect has (the signal's amplitude, the Fourier reference's series).
+/// A value no registry effect has: the sin/cos signal's amplitude (a nuisance of its fit).
 ModelParameter extra_param(std::string name, double value, double std_error, std::string unit) {
   return ModelParameter{.name = std::move(name), .value = value, .std_error = std_error, .unit = std::move(unit)};
 }
@@ -117,7 +94,7 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
       out.revolution = estimator_.update(in.t, theta_meas);
       if (out.revolution) {
         out.estimate_updated = true;
-        if (config_.compensate && estimator_.converged()) active_alpha_ = estimator_.alpha();
+        if (estimator_.converged()) adopt(estimated_model());
       }
       break;
     case EstimatorMethod::kSinCosLeastSquares:
@@ -142,13 +119,7 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   } else if (std::abs(rd_unwrap_.continuous - rev_anchor_) >= kTwoPi) {
     rev_anchor_ += rd_unwrap_.continuous > rev_anchor_ ? kTwoPi : -kTwoPi;
     ++revolutions_;
-    if (config_.method == EstimatorMethod::kSinCosLeastSquares) {
-      sincos_fit_ = sincos_ls_.solve();
-      out.estimate_updated = true;
-    } else if (config_.method == EstimatorMethod::kFourierReference) {
-      fourier_fit_ = fourier_.solve();
-      out.estimate_updated = true;
-    }
+    close_revolution(out);
   }
 
   // Motion gate: travel over the last kTravelSpan samples against the noise of the
@@ -173,23 +144,21 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   }
   const double omega = speed_.update(in.t, theta_meas);
   out.speed_mech = omega / p_r;
-  // Compensation (docs/ARCHITECTURE.md §3 sign): theta_c = theta_rd + eps_hat.
+  // Compensation (docs/ARCHITECTURE.md §3 sign): theta_c = theta_rd + eps_hat, one
+  // path for every method: the exported table, else the Model inverted.
   if (table_ && config_.compensate) {
     out.theta_comp = table_->correct(theta_meas, omega, in.has_ref ? wrap_2pi(in.theta_m_ref) : kNaN);
     out.eps_hat = wrap_pi(out.theta_comp - theta_meas);
-  } else if (config_.method == EstimatorMethod::kModel) {
-    if (config_.compensate && model_set_) {
-      const bool signal = config_.domain == CompensationDomain::kSignal && in.has_sincos;
-      out.theta_comp = compensator_.correct(signal ? out.theta_sincos : theta_meas, in.t, omega, 0.0, signal);
-      out.eps_hat = wrap_pi(out.theta_comp - theta_meas);
-      if (in.has_ref) compensator_.learn_reference(wrap_2pi(in.theta_m_ref));
-    } else {
-      out.eps_hat = 0.0;
-      out.theta_comp = theta_meas;
-    }
+  } else if (config_.compensate && model_set_) {
+    // Signal domain: the angle of the raw envelopes with the envelope prediction
+    // (bypasses the R/D converter); angle domain: the R/D angle with the rd one.
+    const bool signal = config_.domain == CompensationDomain::kSignal && in.has_sincos;
+    out.theta_comp = compensator_.correct(signal ? out.theta_sincos : theta_meas, in.t, omega, 0.0, signal);
+    out.eps_hat = wrap_pi(out.theta_comp - theta_meas);
+    if (in.has_ref) compensator_.learn_reference(wrap_2pi(in.theta_m_ref));
   } else {
-    out.eps_hat = compensation_eps(in, theta_meas);
-    out.theta_comp = wrap_2pi(theta_meas + out.eps_hat);
+    out.eps_hat = 0.0;
+    out.theta_comp = theta_meas;
   }
 
   double theta_ref_cont = kNaN;
@@ -238,50 +207,49 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
 }
 
 void SampleProcessor::set_model(Model model, std::int64_t samples, double revolutions) {
-  compensator_ = Compensator(std::move(model));
-  model_set_ = true;
+  adopt(std::move(model));
+  if (config_.method != EstimatorMethod::kModel) return;
   model_updated_ = true;
   model_samples_ = samples;
   model_revolutions_ = revolutions;
 }
 
+void SampleProcessor::adopt(Model model) {
+  if (!model_set_) compensator_ = Compensator(std::move(model));
+  else compensator_.replace_model(std::move(model));
+  model_set_ = true;
+}
+
+void SampleProcessor::close_revolution(SampleOutput& out) {
+  if (config_.method == EstimatorMethod::kSinCosLeastSquares) {
+    sincos_fit_ = sincos_ls_.solve();
+  } else if (config_.method == EstimatorMethod::kFourierReference) {
+    fourier_fit_ = fourier_.solve();
+  } else {
+    return;
+  }
+  out.estimate_updated = true;
+  Model own = estimated_model();
+  if (!own.empty()) adopt(std::move(own));
+}
+
+Model SampleProcessor::estimated_model() const {
+  switch (config_.method) {
+    case EstimatorMethod::kModel: return model_set_ ? compensator_.model() : Model{};
+    case EstimatorMethod::kHwangIntegral:
+      return hwang_model(estimator_.alpha(), estimator_.alpha_stderr(), config_.p_r, config_.p);
+    case EstimatorMethod::kSinCosLeastSquares:
+      return sincos_fit_ ? sincos_model(*sincos_fit_, config_.p_r, config_.p) : Model{};
+    case EstimatorMethod::kFourierReference:
+      return fourier_fit_ ? fourier_model(*fourier_fit_, config_.p_r, config_.p) : Model{};
+  }
+  return {};
+}
+
 bool SampleProcessor::compensating() const {
   if (!config_.compensate) return false;
   if (table_) return true;
-  switch (config_.method) {
-    case EstimatorMethod::kModel: return model_set_ && compensator_.active();
-    case EstimatorMethod::kHwangIntegral: return active_alpha_ != 0.0;
-    case EstimatorMethod::kSinCosLeastSquares: return sincos_fit_.has_value() && revolutions_ >= 1;
-    case EstimatorMethod::kFourierReference: return fourier_fit_.has_value() && revolutions_ >= 1;
-  }
-  return false;
-}
-
-double SampleProcessor::compensation_eps(const SampleInput& in, double theta_meas) const {
-  if (!compensating()) return 0.0;
-  switch (config_.method) {
-    case EstimatorMethod::kModel: return 0.0;  // the compensator's (process())
-    case EstimatorMethod::kHwangIntegral:
-      return amplitude_imbalance_eps(active_alpha_, theta_meas);
-    case EstimatorMethod::kSinCosLeastSquares: {
-      const SinCosFit& f = *sincos_fit_;
-      if (config_.domain == CompensationDomain::kSignal && in.has_sincos) {
-        // Signal domain: correct the envelopes, take their angle (bypasses the R/D converter).
-        const double corrected = corrected_angle(SinCosCorrection::from_fit(f), in.sin, in.cos);
-        return wrap_pi(corrected - theta_meas);
-      }
-      // Angle domain: first-order signatures of the fitted effects, evaluated at
-      // the measured angle: alpha/2 sin 2theta (Hanselman 5), -(beta/2)(1 - cos 2theta)
-      // (Hanselman 7, sign checked numerically against the exact model),
-      // o_c sin theta - o_s cos theta (offsets).
-      const double th = theta_meas;
-      return 0.5 * f.alpha.value * std::sin(2.0 * th) - 0.5 * f.beta.value * (1.0 - std::cos(2.0 * th)) +
-             f.o_c.value * std::sin(th) - f.o_s.value * std::cos(th);
-    }
-    case EstimatorMethod::kFourierReference:
-      return fourier_fit_->eps(theta_meas);
-  }
-  return 0.0;
+  return model_set_ && compensator_.active();
 }
 
 ModelEstimate SampleProcessor::estimate() const {
@@ -289,15 +257,14 @@ ModelEstimate SampleProcessor::estimate() const {
   e.method = std::string(estimator_name(config_.method));
   e.samples = samples_;
   e.revolutions = static_cast<double>(revolutions_);
+  e.params = estimated_model().parameters();
   switch (config_.method) {
     case EstimatorMethod::kModel:
-      e.params = compensator_.model().parameters();
       e.samples = model_samples_;
       e.revolutions = model_revolutions_;
       e.converged = model_set_;
       break;
     case EstimatorMethod::kHwangIntegral:
-      e.params = {param_of(amplitude_imbalance_effect(), "alpha", estimator_.alpha(), estimator_.alpha_stderr())};
       e.samples = estimator_.samples_used();
       e.revolutions = static_cast<double>(estimator_.revolutions());
       e.converged = estimator_.converged();
@@ -305,27 +272,14 @@ ModelEstimate SampleProcessor::estimate() const {
     case EstimatorMethod::kSinCosLeastSquares:
       if (sincos_fit_) {
         const SinCosFit& f = *sincos_fit_;
-        e.params = envelope_params(f);
         e.params.push_back(extra_param("signal.amplitude", f.amplitude.value, f.amplitude.std_error, "[signal units]"));
-        for (std::size_t i = 0; i < f.k.size() && i < f.harmonic_orders.size(); ++i) {
-          e.params.push_back(param_of(harmonics_effect(), "k" + std::to_string(f.harmonic_orders[i]), f.k[i].value,
-                                      f.k[i].std_error));
-        }
         e.samples = f.samples_seen;
         e.converged = revolutions_ >= 1;
       }
       break;
     case EstimatorMethod::kFourierReference:
       if (fourier_fit_) {
-        const AngleErrorFit& f = *fourier_fit_;
-        e.params = envelope_params(f);
-        for (int n = 1; n <= f.max_order && static_cast<std::size_t>(n) < f.a.size(); ++n) {
-          const auto& a = f.a[static_cast<std::size_t>(n)];
-          const auto& b = f.b[static_cast<std::size_t>(n)];
-          e.params.push_back(extra_param("fourier.a" + std::to_string(n), a.value, a.std_error, "[rad]"));
-          e.params.push_back(extra_param("fourier.b" + std::to_string(n), b.value, b.std_error, "[rad]"));
-        }
-        e.samples = static_cast<std::int64_t>(f.samples);
+        e.samples = static_cast<std::int64_t>(fourier_fit_->samples);
         e.converged = revolutions_ >= 1;
       }
       break;

@@ -127,26 +127,27 @@ class SampleProcessor {
   /// True once the compensation uses a converged (or seeded) estimate.
   [[nodiscard]] bool compensating() const;
   [[nodiscard]] const RippleSet& ripple() const { return ripple_; }
-  /// Starts compensating with a previously learned alpha (persisted
-  /// calibration) until this run's estimator has converged.
-  void seed_alpha(double alpha) {
-    if (config_.compensate) active_alpha_ = alpha;
-  }
-  /// alpha used by the compensation now (0 until the estimator converged or a seed).
-  [[nodiscard]] double active_alpha() const { return active_alpha_; }
-  /// Method kModel: compensate with `model` from now on (a live window's fit, or a
-  /// persisted calibration at start). `samples`, `revolutions`: what it was fitted on.
+  /// Compensates with `model` from now on: method kModel's live window fit (also its
+  /// estimate), or a persisted calibration at start or a reload's carried-over model,
+  /// which an older method's own estimate replaces once it has one (estimator_models.h).
+  /// `samples`, `revolutions`: what it was fitted on.
   void set_model(Model model, std::int64_t samples, double revolutions);
   /// resolverd --calibration: compensate with an exported table from now on
   /// (instead of the estimator's own result; the estimator still runs and publishes).
   void set_table(CalibrationTable table) { table_.emplace(std::move(table)); }
-  /// The model compensating now (empty before the first fit).
+  /// The model compensating now (empty before the first fit or seed).
   [[nodiscard]] const Model& model() const { return compensator_.model(); }
+  /// The active method's own estimate as a Model (kModel: the model set last; the
+  /// older methods: their latest result, estimator_models.h; empty before one).
+  [[nodiscard]] Model estimated_model() const;
   /// Hwang's integral runs beside every method, as the seed's baseline for reports.
   [[nodiscard]] const HwangIntegralEstimator& hwang() const { return estimator_; }
 
  private:
-  double compensation_eps(const SampleInput& in, double theta_meas) const;
+  /// Compensates with `model` from now on (when compensation is on).
+  void adopt(Model model);
+  /// Solves the sin/cos or Fourier fit at the end of a resolver revolution.
+  void close_revolution(SampleOutput& out);
 
   ProcessorConfig config_;
   HwangIntegralEstimator estimator_;
@@ -169,7 +170,6 @@ class SampleProcessor {
   double second_diff_ema_ = 0.0;  ///< [rad] running mean |second difference| of the angle
   bool moving_ = false;
   RippleSet ripple_;
-  double active_alpha_ = 0.0;
   Compensator compensator_;
   std::optional<TableCompensator> table_;
   bool model_set_ = false;

@@ -6,6 +6,11 @@ namespace resolver {
 
 Compensator::Compensator(Model model) : model_(std::move(model)), active_(model_.has_angle_terms()) {}
 
+void Compensator::replace_model(Model model) {
+  model_ = std::move(model);
+  active_ = model_.has_angle_terms();
+}
+
 double Compensator::correct(double theta_meas, double t, double omega, double accel, bool sincos) {
   if (!active_) {
     last_eps_ = 0.0;

@@ -26,6 +26,9 @@ class Compensator {
  public:
   Compensator() = default;
   explicit Compensator(Model model);
+  /// A newer estimate of the same sensor: the angle tracking (unwrapping, the
+  /// resolver's cycle learned from the reference, the direction) goes on.
+  void replace_model(Model model);
 
   /// The corrected angle [rad, wrapped] for a measured angle `theta_meas` [rad] at
   /// time t [s], speed omega [rad/s, resolver electrical], acceleration accel

@@ -208,6 +208,19 @@ void ModelSpec::add(const ModelTerm& term) {
   terms.push_back(term);
 }
 
+ModelSpec ModelSpec::for_parameters(std::span<const std::string> names) {
+  ModelSpec spec;
+  for (const std::string& name : names) {
+    const std::size_t dot = name.find('.');
+    if (dot == std::string::npos) continue;
+    const Effect* e = find_effect(std::string_view(name).substr(0, dot));
+    if (e == nullptr) continue;
+    const int i = find_param(*e, std::string_view(name).substr(dot + 1));
+    if (i >= 0) spec.add(ModelTerm{e, {i}});
+  }
+  return spec;
+}
+
 std::size_t ModelSpec::parameter_count() const {
   std::size_t n = 0;
   for (const ModelTerm& t : terms) n += t.params.size();

@@ -39,6 +39,10 @@ struct ModelSpec {
   /// and the valid ones, or an effect that only sets the floor (noise,
   /// quantization, outliers). `customs` (may be null) resolves user effects.
   [[nodiscard]] static ModelSpec parse(std::span<const std::string> references, const CustomEffects* customs = nullptr);
+  /// The registry parameters among `names` ("effect.param"; any other name is
+  /// skipped), each fitted: a calibration file's parameter list as a model (files
+  /// written before the model's references were saved with it). Cannot fail.
+  [[nodiscard]] static ModelSpec for_parameters(std::span<const std::string> names);
   /// The references, one per term.
   [[nodiscard]] std::vector<std::string> references() const;
   /// The term of `effect`, or nullptr.

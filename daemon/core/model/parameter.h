@@ -9,8 +9,8 @@
 namespace resolver {
 
 struct ModelParameter {
-  std::string name;        ///< "effect.param" (the registry's names; "signal.amplitude",
-                           ///< "fourier.aN"/"bN" for what the older estimators add)
+  std::string name;        ///< "effect.param" (the registry's names; "signal.amplitude" for
+                           ///< the sin/cos least squares' nuisance)
   double value = 0.0;      ///< in the parameter's own unit
   double std_error = 0.0;  ///< one standard error, same unit; NaN: not identifiable
   std::string unit;        ///< the registry's ParamInfo::unit, e.g. "[rad]"; empty where it has none
