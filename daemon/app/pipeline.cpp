@@ -309,6 +309,7 @@ bool Pipeline::adopt_live_fit() {
   // With an older method the live fit is a diagnostic (model_fit_t): the method's
   // own estimate compensates.
   if (!fitted || processor_.config().method != EstimatorMethod::kModel) return false;
+  run_estimate_.add(fitted->model, fitted->samples, fitted->revolutions);
   processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
   return true;
 }
@@ -317,7 +318,15 @@ void Pipeline::finish() {
   stream_.flush();
   if (model_fit_) {
     model_fit_->finish();
-    if (adopt_live_fit()) {
+    bool fresh = adopt_live_fit();
+    // The run's estimate is every window's, combined; compensation is over (no
+    // sample follows), so the processor now holds it for the report, the last
+    // estimate_t and the calibration.
+    if (processor_.config().method == EstimatorMethod::kModel && run_estimate_.windows() > 1) {
+      processor_.set_model(run_estimate_.combined(), run_estimate_.samples(), run_estimate_.revolutions());
+      fresh = true;
+    }
+    if (fresh) {
       // No sample follows to carry it: publish the final estimate now.
       Sample last;
       last.utime = last_utime_;

@@ -46,6 +46,7 @@
 #include "daemon/app/run_summary.h"
 #include "daemon/app/signal_health_log.h"
 #include "daemon/core/estimation/sample_processor.h"
+#include "daemon/core/model/run_estimate.h"
 #include "daemon/decode/sample_stream.h"
 
 namespace resolver {
@@ -154,6 +155,9 @@ class Pipeline {
   void set_sample_observer(std::function<void(const Sample&)> observer) { observer_ = std::move(observer); }
   /// nullptr when [model] enabled = false.
   [[nodiscard]] const LiveModelFit* model_fit() const { return model_fit_.get(); }
+  /// Method kModel: every window's model this run, combined (after finish(), the
+  /// processor's estimate is this; run_estimate.h).
+  [[nodiscard]] const RunEstimate& run_estimate() const { return run_estimate_; }
   /// Signal faults (LOS, DOS, LOT, ...) and the sin/cos amplitude.
   [[nodiscard]] const SignalHealthLog& signal_health() const { return signal_health_; }
 
@@ -192,6 +196,7 @@ class Pipeline {
   bool bench_info_seen_ = false;
   std::int64_t kernel_drops_ = 0;
   std::unique_ptr<LiveModelFit> model_fit_;
+  RunEstimate run_estimate_;
   SignalHealthLog signal_health_;
   std::function<void(const Sample&)> observer_;
   std::optional<CalibrationTable> table_;  ///< --calibration, re-applied after a reload

@@ -87,6 +87,9 @@ std::string estimate_std_error_basis(const Pipeline& p) {
     return fmt::format("robust: revolution-to-revolution spread of {} revolutions (the whole run)",
                        p.processor().estimator().revolutions());
   }
+  if (p.processor().config().method == EstimatorMethod::kModel && p.run_estimate().windows() > 1) {
+    return p.run_estimate().basis();
+  }
   if (p.processor().config().method == EstimatorMethod::kModel) {
     const LiveModelFit* mf = p.model_fit();
     const std::string basis = mf != nullptr ? mf->taken_std_error_basis() : std::string();
