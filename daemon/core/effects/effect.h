@@ -219,12 +219,14 @@ class Effect {
   /// Only a log with changing speed or reversals separates it from the others
   /// (tracking loop, delay and backlash look like constants at one speed).
   [[nodiscard]] virtual bool needs_speed_change() const { return false; }
-  /// The motion without which the effect is not identifiable at all: at one speed in
-  /// one direction its signature is a constant or a turn of the other effects'
-  /// harmonics (delay: omega d; the loop: H(j k omega) per order), and in one
-  /// direction a play is a constant. Discovery lists it as "not identifiable here"
-  /// with what to record instead of proposing it (issue 21).
-  enum class Needs : std::uint8_t { kNothing, kSpeedChangeOrReversal, kSpeedChange, kReversal };
+  /// The motion (or signal) without which the effect is not identifiable at all: at
+  /// one speed in one direction its signature is a constant or a turn of the other
+  /// effects' harmonics (delay: omega d; the loop: H(j k omega) per order), and in one
+  /// direction a play is a constant. The loop filters only the R/D angle, so with the
+  /// sin/cos envelopes beside it (an unfiltered view of the same error harmonics) one
+  /// speed shows H(j k omega) directly: kSpeedChangeOrSinCos. Discovery lists the
+  /// effect as "not identifiable here" with what to record instead of proposing it.
+  enum class Needs : std::uint8_t { kNothing, kSpeedChangeOrReversal, kSpeedChangeOrSinCos, kReversal };
   [[nodiscard]] virtual Needs identifiable_with() const { return Needs::kNothing; }
   /// The candidate terms discovery tries for this effect, from the residual's
   /// spectrum (a harmonic at the orders the residual shows, with its phase, and as a

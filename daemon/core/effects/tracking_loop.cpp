@@ -80,7 +80,7 @@ class TrackingLoopEffect final : public BasicEffect {
                      "in amplitude and phase with speed, the sin/cos signals do not"},
                     kParams, EffectStage::kConverter) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
-  [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChange; }
+  [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChangeOrSinCos; }
   [[nodiscard]] bool active(Values v) const override { return v[kOmegaN] > 0.0; }
   void validate(Values v) const override {
     if (v[kOmegaN] > 0.0 && !(v[kZeta] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
