@@ -138,6 +138,9 @@ class AngleBasis {
   /// sin / cos (n theta_m') of the mechanical angle the envelopes carry.
   [[nodiscard]] double env_mech_sin(int n) const;
   [[nodiscard]] double env_mech_cos(int n) const;
+  /// False when no tracking loop filters the R/D angle: rd_sin(k) == env_sin(k) then,
+  /// and a caller summing both may compute one.
+  [[nodiscard]] bool rd_filtered() const { return transform_.omega_n > 0.0; }
   /// [rad] the envelopes' resolver angle theta(t - d) + shift and mechanical angle theta_m(t - d).
   [[nodiscard]] double env_angle() const { return env_.angle; }
   [[nodiscard]] double env_mech_angle() const { return mech_.angle; }
@@ -158,13 +161,17 @@ class AngleBasis {
       c.clear();
     }
     void grow(int k) const;
+    // Inline fast path: a fit reads the same orders of a row many times (a quarter
+    // of explain's time was the out-of-line call before it).
     [[nodiscard]] double sin_k(int k) const {
-      grow(k);
-      return s[static_cast<std::size_t>(k)];
+      const auto i = static_cast<std::size_t>(k);
+      if (i >= s.size()) grow(k);
+      return s[i];
     }
     [[nodiscard]] double cos_k(int k) const {
-      grow(k);
-      return c[static_cast<std::size_t>(k)];
+      const auto i = static_cast<std::size_t>(k);
+      if (i >= c.size()) grow(k);
+      return c[i];
     }
   };
   /// g sin(k a + phi) or g cos(k a + phi) with g e^{j phi} = H(j k w).

@@ -79,12 +79,16 @@ SinCos envelopes_through(std::span<const EnvelopeMember> members, double phi) {
 
 SignalValues EnvelopeSeries::at(const AngleBasis& basis) const {
   SignalValues out;
+  const bool filtered = basis.rd_filtered();
   for (std::size_t i = 0; i < k.size(); ++i) {
     const int n = k[i];
-    out.sa += e_cos[i] * basis.env_cos(n) + e_sin[i] * basis.env_sin(n);
-    out.rd += e_cos[i] * basis.rd_cos(n) + e_sin[i] * basis.rd_sin(n);
-    out.sr += r_cos[i] * basis.env_cos(n) + r_sin[i] * basis.env_sin(n);
+    const double c = basis.env_cos(n), s = basis.env_sin(n);
+    out.sa += e_cos[i] * c + e_sin[i] * s;
+    if (filtered) out.rd += e_cos[i] * basis.rd_cos(n) + e_sin[i] * basis.rd_sin(n);
+    out.sr += r_cos[i] * c + r_sin[i] * s;
   }
+  // Without a loop the R/D angle sees the envelopes' error term for term (the same sums).
+  if (!filtered) out.rd = out.sa;
   return out;
 }
 
