@@ -411,6 +411,199 @@ void read_input_section(const toml::table& t, DaemonConfig& c, const std::string
   }
 }
 
+void read_lcm_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "lcm", {"url"}, s);
+  read(t, "url", c.lcm_url, s, "lcm");
+}
+
+void read_can_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "can", {"receive_buffer_bytes", "wake_ids"}, s);
+  read(t, "receive_buffer_bytes", c.can.receive_buffer_bytes, s, "can");
+  if (c.can.receive_buffer_bytes < 0) throw ConfigError(s + ": [can] receive_buffer_bytes must be >= 0");
+  read_wake_ids(t, c.can.wake_auto, c.can.wake_ids, s);
+}
+
+void read_channels_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "channels", {"angle", "dq", "estimate", "model_fit", "health"}, s);
+  read(t, "angle", c.channels.angle, s, "channels");
+  read(t, "dq", c.channels.dq, s, "channels");
+  read(t, "estimate", c.channels.estimate, s, "channels");
+  read(t, "model_fit", c.channels.model_fit, s, "channels");
+  read(t, "health", c.channels.health, s, "channels");
+}
+
+void read_output_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "output", {"angle_decimation", "dq_decimation", "ripple_revolutions"}, s);
+  read(t, "ripple_revolutions", c.ripple_revolutions, s, "output");
+  require_positive(c.ripple_revolutions, "[output] ripple_revolutions", s);
+  read(t, "angle_decimation", c.angle_decimation, s, "output");
+  read(t, "dq_decimation", c.dq_decimation, s, "output");
+  require_positive(c.angle_decimation, "[output] angle_decimation", s);
+  require_positive(c.dq_decimation, "[output] dq_decimation", s);
+}
+
+void read_bench_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source", "reference_aligned"}, s);
+  read(t, "sample_rate_hz", c.bench.sample_rate_hz, s, "bench");
+  // Written so NaN fails too (found by fuzzing: NaN < 0 is false).
+  check_rate(t, "sample_rate_hz", c.bench.sample_rate_hz, "bench", "0 = take it from BENCH_INFO", s);
+  std::string time_source = "counter";
+  read(t, "time_source", time_source, s, "bench");
+  if (time_source != "counter" && time_source != "frame") {
+    throw ConfigError(s + ": [bench] time_source must be \"counter\" or \"frame\", got \"" + time_source + "\"");
+  }
+  c.bench.time_from_counter = time_source == "counter";
+  read(t, "p_r", c.bench.p_r, s, "bench");
+  read(t, "p", c.bench.p, s, "bench");
+  read(t, "rd_bits", c.bench.rd_bits, s, "bench");
+  read(t, "use_bench_info", c.bench.use_bench_info, s, "bench");
+  read(t, "reference_aligned", c.bench.reference_aligned, s, "bench");
+  // 1..255, as BENCH_INFO and resolver-sim carry them: p_r = 2147483647 on a real
+  // log gave "model: converged over 2856153251 revolutions".
+  for (const auto& [key, value] : {std::pair<const char*, int>{"p_r", c.bench.p_r}, {"p", c.bench.p}}) {
+    if (value < 1 || value > 255) {
+      const toml::node* node = t.get(key);
+      throw ConfigError((node != nullptr ? where(s, *node) : s) + ": [bench] " + key + " must be 1..255 (" +
+                        (std::string_view(key) == "p_r" ? "resolver" : "motor") +
+                        " pole pairs, as BENCH_INFO carries them), got " + std::to_string(value));
+    }
+  }
+  if (c.bench.rd_bits < 1 || c.bench.rd_bits > 16) {
+    throw ConfigError(s + ": [bench] rd_bits must be 1..16 (the rd_angle signal is 16 bits), got " +
+                      std::to_string(c.bench.rd_bits));
+  }
+}
+
+/// [layout.signals]: a user map replaces the default one entirely, roles not named are unmapped.
+void read_layout_signals(const toml::node& sig, SignalMap& map, const std::string& s) {
+  if (!sig.is_table()) throw ConfigError(where(s, sig) + ": [layout.signals] must be a table");
+  map.roles = {};
+  for (const auto& [key, node] : *sig.as_table()) {
+    const auto role = role_from_name(key.str());
+    if (!role) {
+      throw ConfigError(where(s, node) + ": [layout.signals] unknown role '" + std::string(key.str()) +
+                        "'; valid roles: sin, cos, rd_angle, i_a, i_b, i_c, ref_angle");
+    }
+    const auto value = node.value<std::string>();
+    const auto dot = value ? value->find('.') : std::string::npos;
+    if (!value || dot == std::string::npos || dot == 0 || dot + 1 == value->size()) {
+      throw ConfigError(where(s, node) + ": [layout.signals] " + std::string(key.str()) +
+                        " must be \"MESSAGE.signal\" as named in the DBC");
+    }
+    map.roles[static_cast<std::size_t>(*role)] = SignalRef{value->substr(0, dot), value->substr(dot + 1)};
+  }
+}
+
+void read_layout_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "layout",
+             {"dbc", "counter_signal", "crc_signal", "crc", "bench_info_message", "max_counter_delta", "signals"}, s);
+  read(t, "dbc", c.dbc_path, s, "layout");
+  // A relative DBC path belongs with the config that names it, wherever resolverd is started from.
+  if (!c.dbc_path.empty() && std::filesystem::path(c.dbc_path).is_relative()) {
+    c.dbc_path = (std::filesystem::path(s).parent_path() / c.dbc_path).string();
+  }
+  read(t, "counter_signal", c.signal_map.counter_signal, s, "layout");
+  read(t, "crc_signal", c.signal_map.crc_signal, s, "layout");
+  read(t, "bench_info_message", c.signal_map.bench_info_message, s, "layout");
+  read(t, "max_counter_delta", c.max_counter_delta, s, "layout");
+  require_positive(c.max_counter_delta, "[layout] max_counter_delta", s);
+  std::string crc = "j1850_bench";
+  read(t, "crc", crc, s, "layout");
+  if (crc == "j1850_bench") {
+    c.signal_map.crc = CrcAlgorithm::kBenchJ1850;
+  } else if (crc == "none") {
+    c.signal_map.crc = CrcAlgorithm::kNone;
+  } else {
+    throw ConfigError(where(s, *t.get("crc")) + ": [layout] crc must be \"j1850_bench\" or \"none\", got \"" + crc + "\"");
+  }
+  if (const toml::node* sig = t.get("signals")) read_layout_signals(*sig, c.signal_map, s);
+}
+
+/// [estimator] harmonics: the orders sincos_least_squares fits besides the first.
+void read_estimator_harmonics(const toml::node& h, std::vector<int>& harmonics, const std::string& s) {
+  const toml::array* arr = h.as_array();
+  if (arr == nullptr) throw ConfigError(where(s, h) + ": [estimator] harmonics must be an array of orders, e.g. [3]");
+  harmonics.clear();
+  for (const auto& el : *arr) {
+    // is_integer first: value<int64_t>() of a float like 1e90 converts out of range
+    // (undefined behaviour; fuzz finding F4).
+    const auto n = el.is_integer() ? el.value<std::int64_t>() : std::nullopt;
+    if (!n || *n < 2 || *n > 16) {
+      throw ConfigError(where(s, h) + ": [estimator] harmonics: orders must be integers 2..16");
+    }
+    harmonics.push_back(static_cast<int>(*n));
+  }
+}
+
+void read_estimator_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "estimator",
+             {"method", "min_revolutions", "max_speed_change", "min_samples_per_revolution", "forgetting",
+              "harmonics", "max_order"},
+             s);
+  read(t, "method", c.estimator_method, s, "estimator");
+  double forgetting = 1.0;
+  read(t, "forgetting", forgetting, s, "estimator");
+  if (!(forgetting > 0.0 && forgetting <= 1.0)) {
+    throw ConfigError(s + ": [estimator] forgetting must be in (0, 1], got " + std::to_string(forgetting));
+  }
+  c.sincos.forgetting = forgetting;
+  c.fourier.forgetting = forgetting;
+  read(t, "max_order", c.fourier.max_order, s, "estimator");
+  // The fit has 2 max_order + 1 parameters, updated every sample at a cost of
+  // their square: 2000 ran for minutes on a 2 s log, 2^31 - 1 ended in bad_alloc.
+  if (c.fourier.max_order < 1 || c.fourier.max_order > kMaxFourierOrder) {
+    throw ConfigError(where(s, *t.get("max_order")) + ": [estimator] max_order must be 1.." +
+                      std::to_string(kMaxFourierOrder) + " (the highest harmonic fourier_reference fits; each order "
+                      "adds two parameters, updated every sample), got " + std::to_string(c.fourier.max_order));
+  }
+  if (const toml::node* h = t.get("harmonics")) read_estimator_harmonics(*h, c.sincos.harmonics, s);
+  read(t, "min_revolutions", c.hwang.min_revolutions, s, "estimator");
+  read(t, "max_speed_change", c.hwang.max_speed_change, s, "estimator");
+  read(t, "min_samples_per_revolution", c.hwang.min_samples_per_revolution, s, "estimator");
+  const auto method = estimator_from_name(c.estimator_method);
+  if (!method) {
+    throw ConfigError(s + ": [estimator] method \"" + c.estimator_method +
+                      "\" is not available; available: " + estimator_names());
+  }
+  c.method = *method;
+  require_positive(c.hwang.min_revolutions, "[estimator] min_revolutions", s);
+  if (!(c.hwang.max_speed_change > 0.0) || !std::isfinite(c.hwang.max_speed_change)) {
+    throw ConfigError(s + ": [estimator] max_speed_change must be a finite number > 0");
+  }
+}
+
+void read_compensation_section(const toml::table& t, DaemonConfig& c, const std::string& s) {
+  check_keys(t, "compensation", {"enabled", "domain"}, s);
+  read(t, "enabled", c.compensation_enabled, s, "compensation");
+  std::string domain = "angle";
+  read(t, "domain", domain, s, "compensation");
+  if (domain == "angle") {
+    c.compensation_domain = CompensationDomain::kAngle;
+  } else if (domain == "signal") {
+    c.compensation_domain = CompensationDomain::kSignal;
+  } else {
+    throw ConfigError(s + ": [compensation] domain must be \"angle\" or \"signal\", got \"" + domain + "\"");
+  }
+}
+
+/// The TOML text as a table; a syntax error names the file, line and column.
+toml::table parse_toml(std::string_view text, const std::string& source_name) {
+  try {
+    return toml::parse(text, source_name);
+  } catch (const toml::parse_error& e) {
+    throw ConfigError(source_name + ":" + std::to_string(e.source().begin.line) + ":" +
+                      std::to_string(e.source().begin.column) + ": TOML syntax error: " + std::string(e.description()));
+  }
+}
+
+/// The top-level section `name`, null when absent; anything but a table is an error.
+const toml::table* section_table(const toml::table& root, const char* name, const std::string& s) {
+  const toml::node* n = root.get(name);
+  if (n == nullptr) return nullptr;
+  if (!n->is_table()) throw ConfigError(where(s, *n) + ": '" + name + "' must be a table ([" + name + "])");
+  return n->as_table();
+}
+
 }  // namespace
 
 std::optional<LogFormat> log_format_from_name(std::string_view name) {
@@ -441,13 +634,7 @@ LogFormat log_format_for_path(std::string_view path) {
 }
 
 DaemonConfig parse_daemon_config(std::string_view text, const std::string& source_name) {
-  toml::table root;
-  try {
-    root = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    throw ConfigError(source_name + ":" + std::to_string(e.source().begin.line) + ":" +
-                      std::to_string(e.source().begin.column) + ": TOML syntax error: " + std::string(e.description()));
-  }
+  const toml::table root = parse_toml(text, source_name);
   DaemonConfig c;
   c.source = source_name;
   const std::string& s = source_name;
@@ -455,179 +642,18 @@ DaemonConfig parse_daemon_config(std::string_view text, const std::string& sourc
              {"lcm", "can", "channels", "output", "bench", "layout", "estimator", "compensation", "model", "health",
               "input"},
              s);
-
-  auto section = [&root, &s](const char* name) -> const toml::table* {
-    const toml::node* n = root.get(name);
-    if (n == nullptr) return nullptr;
-    if (!n->is_table()) throw ConfigError(where(s, *n) + ": '" + name + "' must be a table ([" + name + "])");
-    return n->as_table();
-  };
-
-  if (const auto* t = section("lcm")) {
-    check_keys(*t, "lcm", {"url"}, s);
-    read(*t, "url", c.lcm_url, s, "lcm");
-  }
-  if (const auto* t = section("can")) {
-    check_keys(*t, "can", {"receive_buffer_bytes", "wake_ids"}, s);
-    read(*t, "receive_buffer_bytes", c.can.receive_buffer_bytes, s, "can");
-    if (c.can.receive_buffer_bytes < 0) throw ConfigError(s + ": [can] receive_buffer_bytes must be >= 0");
-    read_wake_ids(*t, c.can.wake_auto, c.can.wake_ids, s);
-  }
-  if (const auto* t = section("channels")) {
-    check_keys(*t, "channels", {"angle", "dq", "estimate", "model_fit", "health"}, s);
-    read(*t, "angle", c.channels.angle, s, "channels");
-    read(*t, "dq", c.channels.dq, s, "channels");
-    read(*t, "estimate", c.channels.estimate, s, "channels");
-    read(*t, "model_fit", c.channels.model_fit, s, "channels");
-    read(*t, "health", c.channels.health, s, "channels");
-  }
-  if (const auto* t = section("output")) {
-    check_keys(*t, "output", {"angle_decimation", "dq_decimation", "ripple_revolutions"}, s);
-    read(*t, "ripple_revolutions", c.ripple_revolutions, s, "output");
-    require_positive(c.ripple_revolutions, "[output] ripple_revolutions", s);
-    read(*t, "angle_decimation", c.angle_decimation, s, "output");
-    read(*t, "dq_decimation", c.dq_decimation, s, "output");
-    require_positive(c.angle_decimation, "[output] angle_decimation", s);
-    require_positive(c.dq_decimation, "[output] dq_decimation", s);
-  }
-  if (const auto* t = section("bench")) {
-    check_keys(*t, "bench", {"p_r", "p", "rd_bits", "use_bench_info", "sample_rate_hz", "time_source", "reference_aligned"}, s);
-    read(*t, "sample_rate_hz", c.bench.sample_rate_hz, s, "bench");
-    // Written so NaN fails too (found by fuzzing: NaN < 0 is false).
-    check_rate(*t, "sample_rate_hz", c.bench.sample_rate_hz, "bench", "0 = take it from BENCH_INFO", s);
-    std::string time_source = "counter";
-    read(*t, "time_source", time_source, s, "bench");
-    if (time_source != "counter" && time_source != "frame") {
-      throw ConfigError(s + ": [bench] time_source must be \"counter\" or \"frame\", got \"" + time_source + "\"");
-    }
-    c.bench.time_from_counter = time_source == "counter";
-    read(*t, "p_r", c.bench.p_r, s, "bench");
-    read(*t, "p", c.bench.p, s, "bench");
-    read(*t, "rd_bits", c.bench.rd_bits, s, "bench");
-    read(*t, "use_bench_info", c.bench.use_bench_info, s, "bench");
-    read(*t, "reference_aligned", c.bench.reference_aligned, s, "bench");
-    // 1..255, as BENCH_INFO and resolver-sim carry them: p_r = 2147483647 on a real
-    // log gave "model: converged over 2856153251 revolutions".
-    for (const auto& [key, value] : {std::pair<const char*, int>{"p_r", c.bench.p_r}, {"p", c.bench.p}}) {
-      if (value < 1 || value > 255) {
-        const toml::node* node = t->get(key);
-        throw ConfigError((node != nullptr ? where(s, *node) : s) + ": [bench] " + key + " must be 1..255 (" +
-                          (std::string_view(key) == "p_r" ? "resolver" : "motor") +
-                          " pole pairs, as BENCH_INFO carries them), got " + std::to_string(value));
-      }
-    }
-    if (c.bench.rd_bits < 1 || c.bench.rd_bits > 16) {
-      throw ConfigError(s + ": [bench] rd_bits must be 1..16 (the rd_angle signal is 16 bits), got " +
-                        std::to_string(c.bench.rd_bits));
-    }
-  }
-  if (const auto* t = section("layout")) {
-    check_keys(*t, "layout",
-               {"dbc", "counter_signal", "crc_signal", "crc", "bench_info_message", "max_counter_delta", "signals"}, s);
-    read(*t, "dbc", c.dbc_path, s, "layout");
-    // A relative DBC path belongs with the config that names it, wherever resolverd is started from.
-    if (!c.dbc_path.empty() && std::filesystem::path(c.dbc_path).is_relative()) {
-      c.dbc_path = (std::filesystem::path(s).parent_path() / c.dbc_path).string();
-    }
-    read(*t, "counter_signal", c.signal_map.counter_signal, s, "layout");
-    read(*t, "crc_signal", c.signal_map.crc_signal, s, "layout");
-    read(*t, "bench_info_message", c.signal_map.bench_info_message, s, "layout");
-    read(*t, "max_counter_delta", c.max_counter_delta, s, "layout");
-    require_positive(c.max_counter_delta, "[layout] max_counter_delta", s);
-    std::string crc = "j1850_bench";
-    read(*t, "crc", crc, s, "layout");
-    if (crc == "j1850_bench") {
-      c.signal_map.crc = CrcAlgorithm::kBenchJ1850;
-    } else if (crc == "none") {
-      c.signal_map.crc = CrcAlgorithm::kNone;
-    } else {
-      throw ConfigError(where(s, *t->get("crc")) + ": [layout] crc must be \"j1850_bench\" or \"none\", got \"" + crc + "\"");
-    }
-    if (const toml::node* sig = t->get("signals")) {
-      if (!sig->is_table()) throw ConfigError(where(s, *sig) + ": [layout.signals] must be a table");
-      // A user map replaces the default one entirely: roles not named are unmapped.
-      c.signal_map.roles = {};
-      for (const auto& [key, node] : *sig->as_table()) {
-        const auto role = role_from_name(key.str());
-        if (!role) {
-          throw ConfigError(where(s, node) + ": [layout.signals] unknown role '" + std::string(key.str()) +
-                            "'; valid roles: sin, cos, rd_angle, i_a, i_b, i_c, ref_angle");
-        }
-        const auto value = node.value<std::string>();
-        const auto dot = value ? value->find('.') : std::string::npos;
-        if (!value || dot == std::string::npos || dot == 0 || dot + 1 == value->size()) {
-          throw ConfigError(where(s, node) + ": [layout.signals] " + std::string(key.str()) +
-                            " must be \"MESSAGE.signal\" as named in the DBC");
-        }
-        c.signal_map.roles[static_cast<std::size_t>(*role)] = SignalRef{value->substr(0, dot), value->substr(dot + 1)};
-      }
-    }
-  }
-  if (const auto* t = section("estimator")) {
-    check_keys(*t, "estimator",
-               {"method", "min_revolutions", "max_speed_change", "min_samples_per_revolution", "forgetting",
-                "harmonics", "max_order"},
-               s);
-    read(*t, "method", c.estimator_method, s, "estimator");
-    double forgetting = 1.0;
-    read(*t, "forgetting", forgetting, s, "estimator");
-    if (!(forgetting > 0.0 && forgetting <= 1.0)) {
-      throw ConfigError(s + ": [estimator] forgetting must be in (0, 1], got " + std::to_string(forgetting));
-    }
-    c.sincos.forgetting = forgetting;
-    c.fourier.forgetting = forgetting;
-    read(*t, "max_order", c.fourier.max_order, s, "estimator");
-    // The fit has 2 max_order + 1 parameters, updated every sample at a cost of
-    // their square: 2000 ran for minutes on a 2 s log, 2^31 - 1 ended in bad_alloc.
-    if (c.fourier.max_order < 1 || c.fourier.max_order > kMaxFourierOrder) {
-      throw ConfigError(where(s, *t->get("max_order")) + ": [estimator] max_order must be 1.." +
-                        std::to_string(kMaxFourierOrder) + " (the highest harmonic fourier_reference fits; each order "
-                        "adds two parameters, updated every sample), got " + std::to_string(c.fourier.max_order));
-    }
-    if (const toml::node* h = t->get("harmonics")) {
-      const toml::array* arr = h->as_array();
-      if (arr == nullptr) throw ConfigError(where(s, *h) + ": [estimator] harmonics must be an array of orders, e.g. [3]");
-      c.sincos.harmonics.clear();
-      for (const auto& el : *arr) {
-        // is_integer first: value<int64_t>() of a float like 1e90 converts out of range
-        // (undefined behaviour; fuzz finding F4).
-        const auto n = el.is_integer() ? el.value<std::int64_t>() : std::nullopt;
-        if (!n || *n < 2 || *n > 16) {
-          throw ConfigError(where(s, *h) + ": [estimator] harmonics: orders must be integers 2..16");
-        }
-        c.sincos.harmonics.push_back(static_cast<int>(*n));
-      }
-    }
-    read(*t, "min_revolutions", c.hwang.min_revolutions, s, "estimator");
-    read(*t, "max_speed_change", c.hwang.max_speed_change, s, "estimator");
-    read(*t, "min_samples_per_revolution", c.hwang.min_samples_per_revolution, s, "estimator");
-    const auto method = estimator_from_name(c.estimator_method);
-    if (!method) {
-      throw ConfigError(s + ": [estimator] method \"" + c.estimator_method +
-                        "\" is not available; available: " + estimator_names());
-    }
-    c.method = *method;
-    require_positive(c.hwang.min_revolutions, "[estimator] min_revolutions", s);
-    if (!(c.hwang.max_speed_change > 0.0) || !std::isfinite(c.hwang.max_speed_change)) {
-      throw ConfigError(s + ": [estimator] max_speed_change must be a finite number > 0");
-    }
-  }
-  if (const auto* t = section("compensation")) {
-    check_keys(*t, "compensation", {"enabled", "domain"}, s);
-    read(*t, "enabled", c.compensation_enabled, s, "compensation");
-    std::string domain = "angle";
-    read(*t, "domain", domain, s, "compensation");
-    if (domain == "angle") {
-      c.compensation_domain = CompensationDomain::kAngle;
-    } else if (domain == "signal") {
-      c.compensation_domain = CompensationDomain::kSignal;
-    } else {
-      throw ConfigError(s + ": [compensation] domain must be \"angle\" or \"signal\", got \"" + domain + "\"");
-    }
-  }
-  if (const auto* t = section("model")) read_model_section(*t, c.model, s);
-  if (const auto* t = section("health")) read_health_section(*t, c, s);
-  if (const auto* t = section("input")) read_input_section(*t, c, s);
+  // In this order: the first error found is the one reported.
+  if (const auto* t = section_table(root, "lcm", s)) read_lcm_section(*t, c, s);
+  if (const auto* t = section_table(root, "can", s)) read_can_section(*t, c, s);
+  if (const auto* t = section_table(root, "channels", s)) read_channels_section(*t, c, s);
+  if (const auto* t = section_table(root, "output", s)) read_output_section(*t, c, s);
+  if (const auto* t = section_table(root, "bench", s)) read_bench_section(*t, c, s);
+  if (const auto* t = section_table(root, "layout", s)) read_layout_section(*t, c, s);
+  if (const auto* t = section_table(root, "estimator", s)) read_estimator_section(*t, c, s);
+  if (const auto* t = section_table(root, "compensation", s)) read_compensation_section(*t, c, s);
+  if (const auto* t = section_table(root, "model", s)) read_model_section(*t, c.model, s);
+  if (const auto* t = section_table(root, "health", s)) read_health_section(*t, c, s);
+  if (const auto* t = section_table(root, "input", s)) read_input_section(*t, c, s);
   if (c.compensation_domain == CompensationDomain::kSignal && c.method != EstimatorMethod::kSinCosLeastSquares) {
     throw ConfigError(s + ": [compensation] domain = \"signal\" needs [estimator] method = \"sincos_least_squares\" "
                           "(only it estimates the sin/cos signal parameters)");

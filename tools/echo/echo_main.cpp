@@ -81,12 +81,8 @@ void print_line(const std::string& line) {
   std::fputc('\n', stdout);
 }
 
-int run(int argc, char** argv) {
-  CLI::App app{kDescription, "resolver-echo"};
-  app.footer(kFooter);
-  app.set_version_flag("--version", resolver::version_line("resolver-echo"));
-  app.get_formatter()->column_width(28);
-
+/// What the command line asks for.
+struct EchoArguments {
   std::string log_path;
   std::string lcm_url;
   std::string channel_regex;
@@ -97,124 +93,165 @@ int run(int argc, char** argv) {
   std::optional<double> timeout_s;
   std::string csv_dir;
   bool list_types = false;
+};
 
-  auto* log_opt = app.add_option("--log", log_path, "read this LCM event log (lcm-logger output or file://)");
-  auto* lcm_opt = app.add_option("--lcm", lcm_url, "subscribe live to this LCM URL (udpm://..., memq://...)");
-  app.add_flag("--list-types", list_types, "print the known types and their fingerprints, then exit");
+void add_echo_options(CLI::App& app, EchoArguments& a) {
+  auto* log_opt = app.add_option("--log", a.log_path, "read this LCM event log (lcm-logger output or file://)");
+  auto* lcm_opt = app.add_option("--lcm", a.lcm_url, "subscribe live to this LCM URL (udpm://..., memq://...)");
+  app.add_flag("--list-types", a.list_types, "print the known types and their fingerprints, then exit");
   log_opt->excludes(lcm_opt);
   lcm_opt->excludes(log_opt);
-  app.add_option("--channel", channel_regex, "only channels fully matching this regex (ECMAScript), e.g. 'RESOLVER_.*'");
-  app.add_option("--type", type_name, "only messages of this type: resolver.angle_t or angle_t");
-  app.add_option("--types", type_dirs, "also load the *.lcm files in this directory (repeatable)")
+  app.add_option("--channel", a.channel_regex, "only channels fully matching this regex (ECMAScript), e.g. 'RESOLVER_.*'");
+  app.add_option("--type", a.type_name, "only messages of this type: resolver.angle_t or angle_t");
+  app.add_option("--types", a.type_dirs, "also load the *.lcm files in this directory (repeatable)")
       ->check(CLI::ExistingDirectory);
-  app.add_option("--limit", limit, "--log: stop after printing N messages")
+  app.add_option("--limit", a.limit, "--log: stop after printing N messages")
                         ->check(CLI::PositiveNumber)->needs(log_opt);
-  app.add_option("--count", count, "--lcm: exit after printing N messages")
+  app.add_option("--count", a.count, "--lcm: exit after printing N messages")
                         ->check(CLI::PositiveNumber)->needs(lcm_opt);
-  app.add_option("--timeout", timeout_s, "--lcm: exit after SEC seconds (default: never)")
+  app.add_option("--timeout", a.timeout_s, "--lcm: exit after SEC seconds (default: never)")
                           ->check(CLI::PositiveNumber)->needs(lcm_opt);
-  app.add_option("--csv", csv_dir, "--log: write each channel as DIR/<channel>.csv (numeric members, a utime_s "
-                                   "column) instead of JSON lines; DIR is created when missing")
+  app.add_option("--csv", a.csv_dir, "--log: write each channel as DIR/<channel>.csv (numeric members, a utime_s "
+                                     "column) instead of JSON lines; DIR is created when missing")
       ->needs(log_opt);
-  if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
+}
 
-  if (!list_types && log_path.empty() && lcm_url.empty()) {
+/// No input, or a --log that cannot be read: its exit code, after the message.
+std::optional<int> check_input(const EchoArguments& a) {
+  if (!a.list_types && a.log_path.empty() && a.lcm_url.empty()) {
     std::cerr << "resolver-echo: give --log FILE or --lcm URL (or --list-types); see --help\n";
     return exit_code::kUsage;
   }
-  if (!log_path.empty()) {
-    if (auto problem = exit_code::unreadable("--log", log_path)) {
+  if (!a.log_path.empty()) {
+    if (auto problem = exit_code::unreadable("--log", a.log_path)) {
       std::cerr << "resolver-echo: " << *problem << '\n';
       return exit_code::kIo;
     }
   }
+  return std::nullopt;
+}
 
+/// The --types directories into the registry: a bad .lcm file is a usage error (its exit
+/// code); what the registry could not resolve are warnings.
+std::optional<int> add_type_dirs(resolver::LcmTypeRegistry& registry, const std::vector<std::string>& type_dirs) {
   try {
-    resolver::LcmTypeRegistry registry = resolver::LcmTypeRegistry::with_embedded_types();
-    try {
-      for (const auto& dir : type_dirs) registry.add_directory(dir);
-    } catch (const resolver::LcmParseError& e) {
-      std::cerr << "resolver-echo: " << e.what() << '\n';
-      return exit_code::kUsage;
-    }
-    for (const auto& problem : registry.problems()) std::cerr << "resolver-echo: warning: " << problem << '\n';
+    for (const auto& dir : type_dirs) registry.add_directory(dir);
+  } catch (const resolver::LcmParseError& e) {
+    std::cerr << "resolver-echo: " << e.what() << '\n';
+    return exit_code::kUsage;
+  }
+  for (const auto& problem : registry.problems()) std::cerr << "resolver-echo: warning: " << problem << '\n';
+  return std::nullopt;
+}
 
-    if (list_types) {
-      for (const auto* t : registry.types()) {
-        const auto fp = registry.fingerprint_of(t->full_name());
-        std::cout << (fp ? resolver::hex64(*fp) : std::string("(unresolved)      ")) << "  " << t->full_name()
-                  << "  (" << t->source << ")\n";
-      }
-      return 0;
-    }
-    if (!type_name.empty() && registry.find_by_name(type_name) == nullptr) {
-      bool short_name_known = false;
-      for (const auto* t : registry.types()) short_name_known = short_name_known || t->name == type_name;
-      if (!short_name_known) {
-        std::cerr << fmt::format("resolver-echo: --type {}: no such type; see --list-types or add it with --types\n",
-                                 type_name);
-        return exit_code::kUsage;
-      }
-    }
+/// --list-types: one line per type, its fingerprint first.
+void print_types(const resolver::LcmTypeRegistry& registry) {
+  for (const auto* t : registry.types()) {
+    const auto fp = registry.fingerprint_of(t->full_name());
+    std::cout << (fp ? resolver::hex64(*fp) : std::string("(unresolved)      ")) << "  " << t->full_name()
+              << "  (" << t->source << ")\n";
+  }
+}
 
-    resolver::EchoFilter filter;
-    try {
-      filter = resolver::make_echo_filter(channel_regex, type_name);
-    } catch (const std::invalid_argument& e) {
-      std::cerr << "resolver-echo: " << e.what() << '\n';
-      return exit_code::kUsage;
-    }
-    const resolver::LcmJsonDecoder decoder(registry);
+/// --type names a known type, by its full or its short name.
+bool type_known(const resolver::LcmTypeRegistry& registry, const std::string& type_name) {
+  if (registry.find_by_name(type_name) != nullptr) return true;
+  bool short_name_known = false;
+  for (const auto* t : registry.types()) short_name_known = short_name_known || t->name == type_name;
+  return short_name_known;
+}
 
-    if (!log_path.empty() && !csv_dir.empty()) {
-      resolver::CsvExportResult written;
-      try {
-        written = resolver::export_log_csv(log_path, decoder, filter, limit, csv_dir);
-      } catch (const resolver::EventLogError&) {
-        throw;
-      } catch (const std::runtime_error& e) {  // a file that cannot be written
-        std::cerr << "resolver-echo: --csv: " << e.what() << '\n';
-        return exit_code::kIo;
-      }
-      for (const auto& f : written.files) {
-        std::cout << fmt::format("wrote {}: {} rows x {} columns ({} on channel {})\n", f.path, f.rows, f.columns,
-                                 fmt::join(f.types, ", "), f.channel);
-      }
-      if (written.undecoded > 0) {
-        std::cerr << fmt::format("resolver-echo: --csv: {} message(s) could not be decoded and are not in a table "
-                                 "(the first: {}); resolver-echo --log shows them\n",
-                                 written.undecoded, written.first_undecoded_error);
-      }
-      if (written.files.empty()) {
-        std::cerr << "resolver-echo: --csv: no message " << (written.undecoded > 0 ? "could be decoded" : "matched")
-                  << "; nothing written\n";
-        return exit_code::kNoUsableData;
-      }
-      return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;
-    }
-    if (!log_path.empty()) {
-      resolver::echo_log_file(log_path, decoder, filter, limit, print_line);
-      return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;
-    }
+/// --csv DIR: the log's channels as tables, one line per file on stdout.
+int write_csv_tables(const EchoArguments& a, const resolver::LcmJsonDecoder& decoder,
+                     const resolver::EchoFilter& filter) {
+  resolver::CsvExportResult written;
+  try {
+    written = resolver::export_log_csv(a.log_path, decoder, filter, a.limit, a.csv_dir);
+  } catch (const resolver::EventLogError&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // a file that cannot be written
+    std::cerr << "resolver-echo: --csv: " << e.what() << '\n';
+    return exit_code::kIo;
+  }
+  for (const auto& f : written.files) {
+    std::cout << fmt::format("wrote {}: {} rows x {} columns ({} on channel {})\n", f.path, f.rows, f.columns,
+                             fmt::join(f.types, ", "), f.channel);
+  }
+  if (written.undecoded > 0) {
+    std::cerr << fmt::format("resolver-echo: --csv: {} message(s) could not be decoded and are not in a table "
+                             "(the first: {}); resolver-echo --log shows them\n",
+                             written.undecoded, written.first_undecoded_error);
+  }
+  if (written.files.empty()) {
+    std::cerr << "resolver-echo: --csv: no message " << (written.undecoded > 0 ? "could be decoded" : "matched")
+              << "; nothing written\n";
+    return exit_code::kNoUsableData;
+  }
+  return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;
+}
 
-    lcm::LCM lcm(lcm_url);
-    std::optional<std::chrono::milliseconds> timeout;
-    if (timeout_s) timeout = std::chrono::milliseconds(static_cast<std::int64_t>(*timeout_s * 1000.0));
-    resolver::LiveEcho live(lcm, decoder, filter, [](const std::string& line) {
-      print_line(line);
-      std::fflush(stdout);  // live output is watched or piped: do not sit in a buffer
-    });
-    const auto result = live.run(count, timeout);
-    if (!result.error.empty()) {
-      std::cerr << "resolver-echo: --lcm " << lcm_url << ": " << result.error << '\n';
-      return exit_code::kIo;
-    }
-    if (count && result.emitted < *count) {
-      std::cerr << fmt::format("resolver-echo: --timeout {} s expired after {} of --count {} messages\n", *timeout_s,
-                               result.emitted, *count);
-      return exit_code::kNoUsableData;
-    }
-    return exit_code::kDone;
+/// --lcm URL: the messages as they arrive, until --count or --timeout.
+int echo_live(const EchoArguments& a, const resolver::LcmJsonDecoder& decoder, const resolver::EchoFilter& filter) {
+  lcm::LCM lcm(a.lcm_url);
+  std::optional<std::chrono::milliseconds> timeout;
+  if (a.timeout_s) timeout = std::chrono::milliseconds(static_cast<std::int64_t>(*a.timeout_s * 1000.0));
+  resolver::LiveEcho live(lcm, decoder, filter, [](const std::string& line) {
+    print_line(line);
+    std::fflush(stdout);  // live output is watched or piped: do not sit in a buffer
+  });
+  const auto result = live.run(a.count, timeout);
+  if (!result.error.empty()) {
+    std::cerr << "resolver-echo: --lcm " << a.lcm_url << ": " << result.error << '\n';
+    return exit_code::kIo;
+  }
+  if (a.count && result.emitted < *a.count) {
+    std::cerr << fmt::format("resolver-echo: --timeout {} s expired after {} of --count {} messages\n", *a.timeout_s,
+                             result.emitted, *a.count);
+    return exit_code::kNoUsableData;
+  }
+  return exit_code::kDone;
+}
+
+/// The types, then --list-types, or the filter and the log (as JSON lines or CSV) or the live bus.
+int echo(const EchoArguments& a) {
+  resolver::LcmTypeRegistry registry = resolver::LcmTypeRegistry::with_embedded_types();
+  if (auto code = add_type_dirs(registry, a.type_dirs)) return *code;
+  if (a.list_types) {
+    print_types(registry);
+    return 0;
+  }
+  if (!a.type_name.empty() && !type_known(registry, a.type_name)) {
+    std::cerr << fmt::format("resolver-echo: --type {}: no such type; see --list-types or add it with --types\n",
+                             a.type_name);
+    return exit_code::kUsage;
+  }
+  resolver::EchoFilter filter;
+  try {
+    filter = resolver::make_echo_filter(a.channel_regex, a.type_name);
+  } catch (const std::invalid_argument& e) {
+    std::cerr << "resolver-echo: " << e.what() << '\n';
+    return exit_code::kUsage;
+  }
+  const resolver::LcmJsonDecoder decoder(registry);
+  if (!a.log_path.empty() && !a.csv_dir.empty()) return write_csv_tables(a, decoder, filter);
+  if (!a.log_path.empty()) {
+    resolver::echo_log_file(a.log_path, decoder, filter, a.limit, print_line);
+    return std::fflush(stdout) == 0 ? exit_code::kDone : exit_code::kIo;
+  }
+  return echo_live(a, decoder, filter);
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{kDescription, "resolver-echo"};
+  app.footer(kFooter);
+  app.set_version_flag("--version", resolver::version_line("resolver-echo"));
+  app.get_formatter()->column_width(28);
+  EchoArguments a;
+  add_echo_options(app, a);
+  if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
+  if (auto code = check_input(a)) return *code;
+  try {
+    return echo(a);
   } catch (...) {
     std::fflush(stdout);  // the messages echoed before the failure come first
     throw;

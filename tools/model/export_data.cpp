@@ -137,105 +137,138 @@ Var mat_struct(const char* name, std::vector<std::pair<std::string, Var>> fields
   return s;
 }
 
-}  // namespace
+// ---- the table ----------------------------------------------------------------------
 
-ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, const ModelFit& fit,
-                         std::string_view log_path) {
-  ExportTable t;
-  const std::size_t n = log.rows.size();
-  const std::size_t time = add(t, "t_s", "s", "time from the log's first sample with an angle", n);
-  const std::size_t theta = add(
-      t, "theta_rad", "rad",
-      log.reference ? "true resolver electrical angle (reference encoder x p_r), wrapped to [0, 2 pi)"
-                    : "resolver electrical angle, speed-smoothed ideal (no reference), wrapped to [0, 2 pi)",
-      n);
-  const std::size_t theta_m = add(t, "theta_m_rad", "rad", "true mechanical angle, wrapped to [0, 2 pi)", n);
-  const std::size_t theta_e = add(t, "theta_e_rad", "rad", "true motor electrical angle p theta_m, wrapped to [0, 2 pi)", n);
-  const std::size_t omega = add(t, "omega_rad_s", "rad/s", "resolver electrical speed (signed)", n);
-  const std::size_t rpm = add(t, "speed_rpm", "r/min", "mechanical speed (signed)", n);
-  const std::size_t direction = add(t, "direction", "1", "+1 forward, -1 backward (held through a standstill)", n);
-  const std::size_t moving = add(t, "moving", "0/1", "the rotor moves (standstill samples enter no fit)", n);
-  const std::size_t outlier = add(t, "outlier", "0/1", "an impulsive sample, kept out of the fit and the floors", n);
-  const std::size_t excluded = add(t, "excluded", "0/1", "left out by --direction, or unusable without a reference", n);
-  const std::size_t fitted = add(t, "fitted", "0/1", "in the fit: moving, not an outlier, not excluded", n);
-  const std::size_t fold = add(t, "fold", "1/2", "held-back validation fold", n);
-  // The raw signals behind each row, as decoded (daemon/core/sample.h), a column per
-  // signal any row's sample carries.
-  const auto sample_of = [&](std::size_t i) -> const Sample& { return input.samples.at(log.sample_of_row.at(i)); };
+constexpr std::size_t kNoColumn = static_cast<std::size_t>(-1);
+
+/// Sets row i of `column` (nothing for kNoColumn: a signal no sample carries).
+void set(ExportTable& t, std::size_t column, std::size_t i, double v) {
+  if (column != kNoColumn) t.columns[column].values[i] = v;
+}
+
+/// The columns every row has: time, angles, speed and the row's part in the fit.
+struct RowColumns {
+  std::size_t time, theta, theta_m, theta_e, omega, rpm, direction, moving, outlier, excluded, fitted, fold;
+};
+
+RowColumns add_row_columns(ExportTable& t, const PreparedLog& log, std::size_t n) {
+  RowColumns c{};
+  c.time = add(t, "t_s", "s", "time from the log's first sample with an angle", n);
+  c.theta = add(t, "theta_rad", "rad",
+                log.reference ? "true resolver electrical angle (reference encoder x p_r), wrapped to [0, 2 pi)"
+                              : "resolver electrical angle, speed-smoothed ideal (no reference), wrapped to [0, 2 pi)",
+                n);
+  c.theta_m = add(t, "theta_m_rad", "rad", "true mechanical angle, wrapped to [0, 2 pi)", n);
+  c.theta_e = add(t, "theta_e_rad", "rad", "true motor electrical angle p theta_m, wrapped to [0, 2 pi)", n);
+  c.omega = add(t, "omega_rad_s", "rad/s", "resolver electrical speed (signed)", n);
+  c.rpm = add(t, "speed_rpm", "r/min", "mechanical speed (signed)", n);
+  c.direction = add(t, "direction", "1", "+1 forward, -1 backward (held through a standstill)", n);
+  c.moving = add(t, "moving", "0/1", "the rotor moves (standstill samples enter no fit)", n);
+  c.outlier = add(t, "outlier", "0/1", "an impulsive sample, kept out of the fit and the floors", n);
+  c.excluded = add(t, "excluded", "0/1", "left out by --direction, or unusable without a reference", n);
+  c.fitted = add(t, "fitted", "0/1", "in the fit: moving, not an outlier, not excluded", n);
+  c.fold = add(t, "fold", "1/2", "held-back validation fold", n);
+  return c;
+}
+
+void fill_row_columns(ExportTable& t, const RowColumns& c, const PreparedLog& log, std::size_t i) {
+  const FitRow& r = log.rows[i];
+  const SignatureRow& s = r.sig;
+  set(t, c.time, i, s.t);
+  set(t, c.theta, i, wrap_2pi(s.theta));
+  set(t, c.theta_m, i, wrap_2pi(s.theta_m));
+  set(t, c.theta_e, i, wrap_2pi(log.p * s.theta_m));
+  set(t, c.omega, i, s.omega);
+  set(t, c.rpm, i, s.omega / log.p_r * 60.0 / kTwoPi);
+  set(t, c.direction, i, s.direction);
+  set(t, c.moving, i, r.has(FitRow::kMoving) ? 1.0 : 0.0);
+  set(t, c.outlier, i, r.has(FitRow::kOutlier) ? 1.0 : 0.0);
+  set(t, c.excluded, i, r.has(FitRow::kExcluded) ? 1.0 : 0.0);
+  set(t, c.fitted, i, r.fitted() ? 1.0 : 0.0);
+  set(t, c.fold, i, r.has(FitRow::kFoldB) ? 2.0 : 1.0);
+}
+
+/// The decoded sample behind row i.
+const Sample& sample_of(const DiscoveryInput& input, const PreparedLog& log, std::size_t i) {
+  return input.samples.at(log.sample_of_row.at(i));
+}
+
+/// The raw signals behind each row, as decoded (daemon/core/sample.h), a column per
+/// signal any row's sample carries (kNoColumn for the others).
+struct RawColumns {
+  std::size_t sin, cos, rd, ref, ia, ib, ic;
+};
+
+RawColumns add_raw_columns(ExportTable& t, const DiscoveryInput& input, const PreparedLog& log, std::size_t n) {
   bool any_rd = false, any_sc = false, any_ref = false, any_cur = false;
   for (std::size_t i = 0; i < n; ++i) {
-    const Sample& x = sample_of(i);
+    const Sample& x = sample_of(input, log, i);
     any_rd = any_rd || x.has_rd;
     any_sc = any_sc || x.has_sincos;
     any_ref = any_ref || x.has_ref;
     any_cur = any_cur || x.has_currents;
   }
-  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   const auto add_if = [&](bool present, const char* name, const char* unit, const char* description) {
-    return present ? add(t, name, unit, description, n) : kNone;
+    return present ? add(t, name, unit, description, n) : kNoColumn;
   };
-  const std::size_t raw_sin = add_if(any_sc, "sin_raw", "counts",
-                                     "sin envelope as decoded (ADC counts; a scope export's own unit)");
-  const std::size_t raw_cos = add_if(any_sc, "cos_raw", "counts",
-                                     "cos envelope as decoded (ADC counts; a scope export's own unit)");
-  const std::size_t raw_rd = add_if(any_rd, "theta_rd_rad", "rad",
-                                    "R/D converter angle as decoded, resolver electrical, in [0, 2 pi)");
-  const std::size_t raw_ref = add_if(any_ref, "theta_ref_m_rad", "rad",
-                                     "reference encoder angle as decoded, mechanical, in [0, 2 pi)");
-  const std::size_t raw_ia = add_if(any_cur, "i_a_a", "A", "measured phase current a");
-  const std::size_t raw_ib = add_if(any_cur, "i_b_a", "A", "measured phase current b");
-  const std::size_t raw_ic = add_if(any_cur, "i_c_a", "A", "measured phase current c");
+  RawColumns c{};
+  c.sin = add_if(any_sc, "sin_raw", "counts", "sin envelope as decoded (ADC counts; a scope export's own unit)");
+  c.cos = add_if(any_sc, "cos_raw", "counts", "cos envelope as decoded (ADC counts; a scope export's own unit)");
+  c.rd = add_if(any_rd, "theta_rd_rad", "rad", "R/D converter angle as decoded, resolver electrical, in [0, 2 pi)");
+  c.ref = add_if(any_ref, "theta_ref_m_rad", "rad", "reference encoder angle as decoded, mechanical, in [0, 2 pi)");
+  c.ia = add_if(any_cur, "i_a_a", "A", "measured phase current a");
+  c.ib = add_if(any_cur, "i_b_a", "A", "measured phase current b");
+  c.ic = add_if(any_cur, "i_c_a", "A", "measured phase current c");
+  return c;
+}
+
+void fill_raw_columns(ExportTable& t, const RawColumns& c, const Sample& x, std::size_t i) {
+  if (x.has_sincos) {
+    set(t, c.sin, i, x.sin);
+    set(t, c.cos, i, x.cos);
+  }
+  if (x.has_rd) set(t, c.rd, i, x.theta_rd);
+  if (x.has_ref) set(t, c.ref, i, x.theta_m_ref);
+  if (x.has_currents) {
+    set(t, c.ia, i, x.i_a);
+    set(t, c.ib, i, x.i_b);
+    set(t, c.ic, i, x.i_c);
+  }
+}
+
+/// Measured, model and residual columns of each signal the log has.
+struct FittedColumns {
   SignalColumns rd, sa, sr, d, q;
-  if (log.rd) rd = add_signal(t, "eps_rd", "rad", "rad", "position error theta - theta_rd of the R/D angle", n);
+};
+
+FittedColumns add_fitted_columns(ExportTable& t, const PreparedLog& log, std::size_t n) {
+  FittedColumns c;
+  if (log.rd) c.rd = add_signal(t, "eps_rd", "rad", "rad", "position error theta - theta_rd of the R/D angle", n);
   if (log.sincos) {
-    sa = add_signal(t, "eps_sc", "rad", "rad", "position error theta - atan2(sin, cos) of the envelopes", n);
-    sr = add_signal(t, "radius_dev", "", "1", "envelope radius / median amplitude - 1", n);
+    c.sa = add_signal(t, "eps_sc", "rad", "rad", "position error theta - atan2(sin, cos) of the envelopes", n);
+    c.sr = add_signal(t, "radius_dev", "", "1", "envelope radius / median amplitude - 1", n);
   }
   if (log.currents) {
-    d = add_signal(t, "i_d", "a", "A", "i_d in the frame of the true theta_e", n);
-    q = add_signal(t, "i_q", "a", "A", "i_q in the frame of the true theta_e", n);
+    c.d = add_signal(t, "i_d", "a", "A", "i_d in the frame of the true theta_e", n);
+    c.q = add_signal(t, "i_q", "a", "A", "i_q in the frame of the true theta_e", n);
   }
-  const auto set = [&t](std::size_t column, std::size_t i, double v) {
-    if (column != kNone) t.columns[column].values[i] = v;
-  };
-  const RowPredictor predict(log, fit.model);
-  for (std::size_t i = 0; i < n; ++i) {
-    const FitRow& r = log.rows[i];
-    const SignatureRow& s = r.sig;
-    set(time, i, s.t);
-    set(theta, i, wrap_2pi(s.theta));
-    set(theta_m, i, wrap_2pi(s.theta_m));
-    set(theta_e, i, wrap_2pi(log.p * s.theta_m));
-    set(omega, i, s.omega);
-    set(rpm, i, s.omega / log.p_r * 60.0 / kTwoPi);
-    set(direction, i, s.direction);
-    set(moving, i, r.has(FitRow::kMoving) ? 1.0 : 0.0);
-    set(outlier, i, r.has(FitRow::kOutlier) ? 1.0 : 0.0);
-    set(excluded, i, r.has(FitRow::kExcluded) ? 1.0 : 0.0);
-    set(fitted, i, r.fitted() ? 1.0 : 0.0);
-    set(fold, i, r.has(FitRow::kFoldB) ? 2.0 : 1.0);
-    const Sample& x = sample_of(i);
-    if (x.has_sincos) {
-      set(raw_sin, i, x.sin);
-      set(raw_cos, i, x.cos);
-    }
-    if (x.has_rd) set(raw_rd, i, x.theta_rd);
-    if (x.has_ref) set(raw_ref, i, x.theta_m_ref);
-    if (x.has_currents) {
-      set(raw_ia, i, x.i_a);
-      set(raw_ib, i, x.i_b);
-      set(raw_ic, i, x.i_c);
-    }
-    const SignalValues p = predict(r);
-    fill(t, rd, i, r.has(FitRow::kHasRd), r.y_rd, p.rd);
-    fill(t, sa, i, r.has(FitRow::kHasSc), r.y_sa, p.sa);
-    fill(t, sr, i, r.has(FitRow::kHasSc), r.y_sr, p.sr);
-    fill(t, d, i, r.has(FitRow::kHasCur), r.y_d, p.d);
-    fill(t, q, i, r.has(FitRow::kHasCur), r.y_q, p.q);
-  }
-  t.params = fit.params;
-  for (ModelParameter& p : t.params) p.unit = report::bare_unit(p.unit);
-  t.info = {
+  return c;
+}
+
+void fill_fitted_columns(ExportTable& t, const FittedColumns& c, const FitRow& r, const SignalValues& p,
+                         std::size_t i) {
+  fill(t, c.rd, i, r.has(FitRow::kHasRd), r.y_rd, p.rd);
+  fill(t, c.sa, i, r.has(FitRow::kHasSc), r.y_sa, p.sa);
+  fill(t, c.sr, i, r.has(FitRow::kHasSc), r.y_sr, p.sr);
+  fill(t, c.d, i, r.has(FitRow::kHasCur), r.y_d, p.d);
+  fill(t, c.q, i, r.has(FitRow::kHasCur), r.y_q, p.q);
+}
+
+/// The table's info: the log, the model, the bench and the fit's summary.
+std::vector<std::pair<std::string, std::variant<double, std::string>>> export_info(const PreparedLog& log,
+                                                                                   const ModelFit& fit,
+                                                                                   std::string_view log_path) {
+  return {
       {"log", std::string(log_path)},
       {"model", fit.effects.empty() ? std::string("(nuisance only)") : fmt::format("{}", fmt::join(fit.effects, ","))},
       {"p_r", static_cast<double>(log.p_r)},
@@ -248,6 +281,26 @@ ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, co
       {"prediction", "the model's effects at the fitted values plus the constants fitted beside them (the dq "
                      "operating point, the envelopes' gain, an angle offset without a reference)"},
   };
+}
+
+}  // namespace
+
+ExportTable export_table(const DiscoveryInput& input, const PreparedLog& log, const ModelFit& fit,
+                         std::string_view log_path) {
+  ExportTable t;
+  const std::size_t n = log.rows.size();
+  const RowColumns row_columns = add_row_columns(t, log, n);
+  const RawColumns raw_columns = add_raw_columns(t, input, log, n);
+  const FittedColumns fitted_columns = add_fitted_columns(t, log, n);
+  const RowPredictor predict(log, fit.model);
+  for (std::size_t i = 0; i < n; ++i) {
+    fill_row_columns(t, row_columns, log, i);
+    fill_raw_columns(t, raw_columns, sample_of(input, log, i), i);
+    fill_fitted_columns(t, fitted_columns, log.rows[i], predict(log.rows[i]), i);
+  }
+  t.params = fit.params;
+  for (ModelParameter& p : t.params) p.unit = report::bare_unit(p.unit);
+  t.info = export_info(log, fit, log_path);
   return t;
 }
 

@@ -260,6 +260,174 @@ UnitSummary read_unit(const fs::path& file) {
   return u;
 }
 
+/// Every DIR/*/unit.json (hidden folders skipped), in the order of their paths.
+std::vector<UnitSummary> read_units(const std::string& out_dir) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(out_dir)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_directory() && !name.empty() && name.front() != '.' && fs::exists(entry.path() / "unit.json")) {
+      files.push_back(entry.path() / "unit.json");
+    }
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<UnitSummary> units;
+  for (const auto& f : files) units.push_back(read_unit(f));
+  return units;
+}
+
+/// The fleet's p_r and how many units have it.
+struct FleetPolePairs {
+  int p_r = 0;
+  int units = 0;
+};
+
+/// The fleet's p_r: the most common among the units done; a unit with another is left out.
+FleetPolePairs leave_out_other_p_r(std::vector<UnitSummary>& units) {
+  std::map<int, int> p_r_count;
+  for (const auto& u : units) {
+    if (u.done) ++p_r_count[u.p_r];
+  }
+  FleetPolePairs fleet;
+  for (const auto& [p_r, count] : p_r_count) {
+    if (count > fleet.units) fleet.p_r = p_r, fleet.units = count;
+  }
+  for (auto& u : units) {
+    if (u.done && u.p_r != fleet.p_r) {
+      u.done = false;
+      u.reason = fmt::format("its logs have p_r = {}, the fleet's is {} ({} units): left out of the summary", u.p_r,
+                             fleet.p_r, fleet.units);
+    }
+  }
+  return fleet;
+}
+
+/// What the units done have in common: each parameter's values, the effects proposed
+/// and needed, and the logs counted and left out.
+struct FleetTally {
+  std::size_t logs_total = 0, logs_left_out = 0;
+  std::map<std::string, std::vector<double>> values;  // per parameter, over the units done
+  std::map<std::string, int> proposed, needed;
+  int done = 0;
+};
+
+FleetTally tally_units(const std::vector<UnitSummary>& units) {
+  FleetTally t;
+  for (const auto& u : units) {
+    t.logs_total += u.logs;
+    if (!u.done) {
+      t.logs_left_out += u.logs;
+      continue;
+    }
+    for (const auto& [name, v] : u.params) t.values[name].push_back(v);
+    for (const auto& e : u.proposed) ++t.proposed[e];
+    if (!u.needed.empty()) ++t.needed[u.needed];
+  }
+  t.done = static_cast<int>(std::count_if(units.begin(), units.end(), [](const UnitSummary& u) { return u.done; }));
+  return t;
+}
+
+struct ParamStat {
+  double median, spread;
+};
+
+/// Per parameter: median, robust spread (1.4826 MAD) and quantiles, as fleet.json's
+/// "params" and as the text table.
+struct ParamSummary {
+  std::map<std::string, ParamStat> stats;
+  std::string json, table;
+};
+
+ParamSummary summarize_params(const std::map<std::string, std::vector<double>>& values) {
+  ParamSummary s;
+  s.json = "{";
+  s.table = fmt::format("{:<36} {:>5} {:>12} {:>11} {:>12} {:>12}\n", "parameter", "units", "median", "spread", "q05",
+                        "q95");
+  for (const auto& [name, unsorted] : values) {
+    std::vector<double> v = unsorted;
+    std::sort(v.begin(), v.end());
+    const double med = quantile(v, 0.5);
+    std::vector<double> dev;
+    for (double x : v) dev.push_back(std::abs(x - med));
+    const double spread = 1.4826 * median(dev);
+    s.stats[name] = {med, spread};
+    s.json += (s.json.size() > 1 ? "," : "") +
+              fmt::format("{}:{{\"units\":{},\"median\":{},\"spread\":{},\"q05\":{},\"q25\":{},\"q75\":{},\"q95\":{},"
+                          "\"min\":{},\"max\":{}}}",
+                          json::str(name), v.size(), json::num(med), json::num(spread), json::num(quantile(v, 0.05)),
+                          json::num(quantile(v, 0.25)), json::num(quantile(v, 0.75)), json::num(quantile(v, 0.95)),
+                          json::num(v.front()), json::num(v.back()));
+    s.table += fmt::format("{:<36} {:>5} {:>12.5g} {:>11.3g} {:>12.5g} {:>12.5g}\n", name, v.size(), med, spread,
+                           quantile(v, 0.05), quantile(v, 0.95));
+  }
+  s.json += "}";
+  return s;
+}
+
+/// The outlier units, as fleet.json's "outliers" and as text lines.
+struct FleetOutliers {
+  std::string json, lines;
+};
+
+/// Units outside the spread: |value - median| > 4 robust spreads, with the parameter
+/// (only where the spread is > 0 over at least 3 units).
+FleetOutliers find_outliers(const std::vector<UnitSummary>& units, const ParamSummary& params,
+                            const std::map<std::string, std::vector<double>>& values) {
+  FleetOutliers o;
+  o.json = "[";
+  for (const auto& u : units) {
+    if (!u.done) continue;
+    for (const auto& [name, v] : u.params) {
+      const ParamStat& s = params.stats.at(name);
+      if (!(s.spread > 0.0) || values.at(name).size() < 3) continue;
+      const double z = (v - s.median) / s.spread;
+      if (std::abs(z) <= 4.0) continue;
+      o.json += (o.json.size() > 1 ? "," : "") + fmt::format("{{\"unit\":{},\"param\":{},\"value\":{},\"z\":{}}}",
+                                                             json::str(u.unit), json::str(name), json::num(v),
+                                                             json::num(z, 4));
+      o.lines += fmt::format("outlier: unit {} {} = {:.5g} (robust z {:+.1f})\n", u.unit, name, v, z);
+    }
+  }
+  o.json += "]";
+  return o;
+}
+
+/// Effects by how many units name them, most first: fleet.json's "proposed" and "needed".
+std::string effect_counts_json(const std::map<std::string, int>& m, int done) {
+  std::vector<std::pair<std::string, int>> v(m.begin(), m.end());
+  std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  std::string o = "[";
+  for (const auto& [e, n] : v) {
+    o += (o.size() > 1 ? "," : "") + fmt::format("{{\"effect\":{},\"units\":{},\"most_units\":{}}}", json::str(e), n,
+                                                 2 * n > done ? "true" : "false");
+  }
+  return o + "]";
+}
+
+/// The units done (fleet.json's "units") and the failed ones with the reason (its
+/// "failed" and text lines).
+struct UnitLists {
+  std::string units_json, failed_json, failed_lines;
+};
+
+UnitLists list_units(const std::vector<UnitSummary>& units) {
+  UnitLists l{"[", "[", ""};
+  for (const auto& u : units) {
+    if (!u.done) {
+      l.failed_json += (l.failed_json.size() > 1 ? "," : "") +
+                       fmt::format("{{\"unit\":{},\"reason\":{}}}", json::str(u.unit), json::str(u.reason));
+      l.failed_lines += fmt::format("failed: unit {}: {}\n", u.unit, u.reason);
+      continue;
+    }
+    l.units_json += (l.units_json.size() > 1 ? "," : "") +
+                    fmt::format("{{\"unit\":{},\"verdict\":{},\"residual_over_floor\":{},\"needed\":{},\"disagreeing\":{}}}",
+                                json::str(u.unit), json::str(u.verdict), json::num(u.ratio),
+                                u.needed.empty() ? std::string("null") : json::str(u.needed), strings_json(u.disagreeing));
+  }
+  l.failed_json += "]";
+  l.units_json += "]";
+  return l;
+}
+
 }  // namespace
 
 std::vector<ManifestRow> read_manifest(const std::string& path) {
@@ -322,125 +490,25 @@ int run_fleet_units(const std::vector<ManifestRow>& rows, const std::string& man
 }
 
 std::string summarize_fleet(const std::string& out_dir, int& failed) {
-  std::vector<UnitSummary> units;
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(out_dir)) {
-    const std::string name = entry.path().filename().string();
-    if (entry.is_directory() && !name.empty() && name.front() != '.' && fs::exists(entry.path() / "unit.json")) {
-      files.push_back(entry.path() / "unit.json");
-    }
-  }
-  std::sort(files.begin(), files.end());
-  for (const auto& f : files) units.push_back(read_unit(f));
-  // The fleet's p_r: the most common among the units done; a unit with another is left out.
-  std::map<int, int> p_r_count;
-  for (const auto& u : units) {
-    if (u.done) ++p_r_count[u.p_r];
-  }
-  int fleet_p_r = 0, most = 0;
-  for (const auto& [p_r, count] : p_r_count) {
-    if (count > most) fleet_p_r = p_r, most = count;
-  }
-  for (auto& u : units) {
-    if (u.done && u.p_r != fleet_p_r) {
-      u.done = false;
-      u.reason = fmt::format("its logs have p_r = {}, the fleet's is {} ({} units): left out of the summary", u.p_r,
-                             fleet_p_r, most);
-    }
-  }
-  std::size_t logs_total = 0, logs_left_out = 0;
-  std::map<std::string, std::vector<double>> values;  // per parameter, over the units done
-  std::map<std::string, int> proposed, needed;
-  for (const auto& u : units) {
-    logs_total += u.logs;
-    if (!u.done) {
-      logs_left_out += u.logs;
-      continue;
-    }
-    for (const auto& [name, v] : u.params) values[name].push_back(v);
-    for (const auto& e : u.proposed) ++proposed[e];
-    if (!u.needed.empty()) ++needed[u.needed];
-  }
-  const int done = static_cast<int>(std::count_if(units.begin(), units.end(), [](const UnitSummary& u) { return u.done; }));
-  failed = static_cast<int>(units.size()) - done;
-
-  struct Stat {
-    double median, spread;
-  };
-  std::map<std::string, Stat> stats;
-  std::string params = "{";
-  std::string table = fmt::format("{:<36} {:>5} {:>12} {:>11} {:>12} {:>12}\n", "parameter", "units", "median",
-                                  "spread", "q05", "q95");
-  for (auto& [name, v] : values) {
-    std::sort(v.begin(), v.end());
-    const double med = quantile(v, 0.5);
-    std::vector<double> dev;
-    for (double x : v) dev.push_back(std::abs(x - med));
-    const double spread = 1.4826 * median(dev);
-    stats[name] = {med, spread};
-    params += (params.size() > 1 ? "," : "") +
-              fmt::format("{}:{{\"units\":{},\"median\":{},\"spread\":{},\"q05\":{},\"q25\":{},\"q75\":{},\"q95\":{},"
-                          "\"min\":{},\"max\":{}}}",
-                          json::str(name), v.size(), json::num(med), json::num(spread), json::num(quantile(v, 0.05)),
-                          json::num(quantile(v, 0.25)), json::num(quantile(v, 0.75)), json::num(quantile(v, 0.95)),
-                          json::num(v.front()), json::num(v.back()));
-    table += fmt::format("{:<36} {:>5} {:>12.5g} {:>11.3g} {:>12.5g} {:>12.5g}\n", name, v.size(), med, spread,
-                         quantile(v, 0.05), quantile(v, 0.95));
-  }
-  params += "}";
-  // Units outside the spread: |value - median| > 4 robust spreads, with the parameter.
-  std::string outliers = "[";
-  std::string outlier_lines;
-  for (const auto& u : units) {
-    if (!u.done) continue;
-    for (const auto& [name, v] : u.params) {
-      const Stat& s = stats[name];
-      if (!(s.spread > 0.0) || values[name].size() < 3) continue;
-      const double z = (v - s.median) / s.spread;
-      if (std::abs(z) <= 4.0) continue;
-      outliers += (outliers.size() > 1 ? "," : "") + fmt::format("{{\"unit\":{},\"param\":{},\"value\":{},\"z\":{}}}",
-                                                                 json::str(u.unit), json::str(name), json::num(v),
-                                                                 json::num(z, 4));
-      outlier_lines += fmt::format("outlier: unit {} {} = {:.5g} (robust z {:+.1f})\n", u.unit, name, v, z);
-    }
-  }
-  outliers += "]";
-  const auto counted = [&](const std::map<std::string, int>& m) {
-    std::vector<std::pair<std::string, int>> v(m.begin(), m.end());
-    std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
-    std::string o = "[";
-    for (const auto& [e, n] : v) {
-      o += (o.size() > 1 ? "," : "") + fmt::format("{{\"effect\":{},\"units\":{},\"most_units\":{}}}", json::str(e), n,
-                                                   2 * n > done ? "true" : "false");
-    }
-    return o + "]";
-  };
-  std::string failed_json = "[", failed_lines, units_json = "[";
-  for (const auto& u : units) {
-    if (!u.done) {
-      failed_json += (failed_json.size() > 1 ? "," : "") +
-                     fmt::format("{{\"unit\":{},\"reason\":{}}}", json::str(u.unit), json::str(u.reason));
-      failed_lines += fmt::format("failed: unit {}: {}\n", u.unit, u.reason);
-      continue;
-    }
-    units_json += (units_json.size() > 1 ? "," : "") +
-                  fmt::format("{{\"unit\":{},\"verdict\":{},\"residual_over_floor\":{},\"needed\":{},\"disagreeing\":{}}}",
-                              json::str(u.unit), json::str(u.verdict), json::num(u.ratio),
-                              u.needed.empty() ? std::string("null") : json::str(u.needed), strings_json(u.disagreeing));
-  }
-  failed_json += "]";
-  units_json += "]";
+  std::vector<UnitSummary> units = read_units(out_dir);
+  const FleetPolePairs fleet = leave_out_other_p_r(units);
+  const FleetTally t = tally_units(units);
+  failed = static_cast<int>(units.size()) - t.done;
+  const ParamSummary params = summarize_params(t.values);
+  const FleetOutliers outliers = find_outliers(units, params, t.values);
+  const UnitLists lists = list_units(units);
   write_text_file(out_dir + "/fleet.json",
                   fmt::format("{{\"units_total\":{},\"units_done\":{},\"units_failed\":{},\"logs_total\":{},"
                               "\"logs_left_out\":{},\"p_r\":{},\"params\":{},\"outliers\":{},\"proposed\":{},"
                               "\"needed\":{},\"failed\":{},\"units\":{}}}\n",
-                              units.size(), done, failed, logs_total, logs_left_out, fleet_p_r, params, outliers,
-                              counted(proposed), counted(needed), failed_json, units_json));
+                              units.size(), t.done, failed, t.logs_total, t.logs_left_out, fleet.p_r, params.json,
+                              outliers.json, effect_counts_json(t.proposed, t.done),
+                              effect_counts_json(t.needed, t.done), lists.failed_json, lists.units_json));
   std::string text = fmt::format("fleet: {} units, {} done, {} failed ({} of {} logs left out); p_r = {}\n",
-                                 units.size(), done, failed, logs_left_out, logs_total, fleet_p_r);
-  text += table + outlier_lines;
-  for (const auto& [e, n] : needed) text += fmt::format("needed: {} by {} of {} units\n", e, n, done);
-  text += failed_lines;
+                                 units.size(), t.done, failed, t.logs_left_out, t.logs_total, fleet.p_r);
+  text += params.table + outliers.lines;
+  for (const auto& [e, n] : t.needed) text += fmt::format("needed: {} by {} of {} units\n", e, n, t.done);
+  text += lists.failed_lines;
   text += "wrote " + out_dir + "/fleet.json\n";
   return text;
 }

@@ -14,6 +14,125 @@
 
 namespace resolver {
 
+namespace {
+
+/// Decode problems by reason.
+using ProblemCounts = std::map<std::string, std::int64_t, std::less<>>;
+/// Bad lines by reason: how many, and the first (file:line:column: message).
+using BadLineReasons = std::map<std::string, std::pair<std::int64_t, std::string>, std::less<>>;
+
+/// How the records ran out, and the lines that were not read.
+struct RecordsRead {
+  bool at_end = false;  // the end of the file, not of --to
+  BadLineReasons bad_line_reasons;
+};
+
+/// Every record into the stream until the end of the file or of the slice; counts
+/// frames and bad lines into `out`, and calls progress every 4096 records.
+RecordsRead feed_records(LogInput& reader, SampleStream& stream, const std::string& path,
+                         const std::function<void(const LogReadProgress&)>& progress, LogSamples& out) {
+  RecordsRead read;
+  LogRecord record;
+  std::int64_t since_progress = 0;
+  while (!stream.past_slice_end()) {
+    const auto st = reader.next(record);
+    if (st == LogInput::Status::kEnd) {
+      read.at_end = true;
+      break;
+    }
+    if (st == LogInput::Status::kBadLine) {
+      ++out.bad_lines;
+      // By reason, with the first line of each: resolverd prints them; here they are notes.
+      const TextProblem& p = reader.problem();
+      auto [it, first] = read.bad_line_reasons.try_emplace(p.reason, 0, std::string());
+      if (first) it->second.second = fmt::format("{}:{}:{}: {}", path, reader.line_number(), p.column, p.message);
+      ++it->second.first;
+      continue;
+    }
+    ++out.frames;
+    if (record.is_row) {
+      stream.feed_row(record.row, reader.line_number());
+    } else {
+      stream.feed(record.frame, reader.line_number());
+    }
+    if (progress && ++since_progress >= 4096) {  // a std::function call per 4096 records: not measurable
+      since_progress = 0;
+      progress(LogReadProgress{reader.bytes_read(), reader.total_bytes(),
+                               static_cast<std::int64_t>(out.input.samples.size()), false});
+    }
+  }
+  return read;
+}
+
+/// A regular file read to its end has given exactly the bytes it had when opened.
+/// Fewer: it was truncated or replaced while read, and the samples may mix two logs
+/// (thrown). More: a log still being written (candump -l running); the samples are
+/// those read (a note).
+void check_size_while_read(const LogInput& reader, bool at_end, const std::string& path, LogSamples& out) {
+  const std::uint64_t at_open = reader.total_bytes();  // 0: a FIFO, pipe or device
+  if (at_end && at_open > 0 && reader.bytes_read() < at_open) {
+    throw IoError(fmt::format("{}: the file shrank while it was read: {} bytes when opened, its end came after {} "
+                              "(truncated, or replaced by another file?); read a copy that nothing writes to",
+                              path, at_open, reader.bytes_read()));
+  }
+  if (at_end && at_open > 0 && reader.bytes_read() > at_open) {
+    out.grew_while_read = fmt::format("{} grew while it was read ({} bytes when opened, {} read to the end): a log "
+                                      "still being written; these are the samples of the bytes read, and a last "
+                                      "line cut short counts as a bad line",
+                                      path, at_open, reader.bytes_read());
+    out.notes.push_back(out.grew_while_read);
+  }
+}
+
+/// No sample at all: all of them outside --from/--to, or none decoded with the layout in use.
+[[noreturn]] void throw_no_samples(const std::string& path, LogFormat format, const DaemonConfig& config,
+                                   const FrameDecoder& decoder, const SampleSlice& slice, const LogSamples& out,
+                                   double last_t) {
+  if (slice.limited() && out.outside_slice > 0) {
+    const std::string to = std::isfinite(slice.to_s) ? fmt::format(" to --to {} s", slice.to_s) : "";
+    throw InputError(Fault::kData,
+                     fmt::format("no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
+                                 slice.from_s, to, out.outside_slice, last_t),
+                     Where::at_file(path));
+  }
+  const std::string layout = format == LogFormat::kCsv ? "the [input.csv] column map of " + config.source
+                                                       : describe_layout(config, decoder);
+  throw InputError(Fault::kData,
+                   fmt::format("no samples: {} {} read as {}, {} bad lines, none decoded with {}", out.frames,
+                               format == LogFormat::kCsv ? "rows" : "frames", log_format_name(format), out.bad_lines,
+                               layout),
+                   Where::at_file(path));
+}
+
+/// The notes of a read: where p_r and p came from, clock re-anchors, lines not read,
+/// gaps and the slice.
+void add_read_notes(LogSamples& out, const DaemonConfig& config, const SampleSlice& slice,
+                    const ProblemCounts& problem_counts, const BadLineReasons& bad_line_reasons) {
+  if (!out.bench_info) {
+    out.notes.push_back("p_r = " + std::to_string(out.input.p_r) + ", p = " + std::to_string(out.input.p) + " from " +
+                        (config.source.empty() ? std::string("the defaults") : config.source) +
+                        (config.bench.use_bench_info ? " (no BENCH_INFO frame in the log)" : " (use_bench_info = false)"));
+  }
+  for (const char* odd : {"timestamp_step_back", "timestamp_jump", "sample_clock_reanchored"}) {
+    const auto it = problem_counts.find(odd);
+    if (it != problem_counts.end()) {
+      out.notes.push_back(fmt::format("{}: {} (the sample clock re-anchored; every sample after it used)", odd, it->second));
+    }
+  }
+  for (const auto& [reason, seen] : bad_line_reasons) {
+    out.notes.push_back(fmt::format("{}: {} line(s) not read, the first: {}", reason, seen.first, seen.second));
+  }
+  if (const auto it = problem_counts.find("sample_gap"); it != problem_counts.end()) {
+    out.notes.push_back(fmt::format("sample_gap: {} (samples missing from the recording, found from time)", it->second));
+  }
+  if (slice.limited()) {
+    out.notes.push_back(fmt::format("slice {} s .. {} s: {} samples used, {} outside", slice.from_s, slice.to_s,
+                                    out.input.samples.size(), out.outside_slice));
+  }
+}
+
+}  // namespace
+
 LogSamples read_log_samples(const std::string& path, const std::function<void(const LogReadProgress&)>& progress,
                             const DaemonConfig& config, const LogReadOptions& options) {
   LogSamples out;
@@ -22,7 +141,7 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
   const LogFormat format = resolve_log_format(path, options.format, config);
   const std::unique_ptr<LogInput> reader = open_log_input(path, format, config);  // throws "cannot open <path>: ..."
   const auto decoder = make_frame_decoder(config);
-  std::map<std::string, std::int64_t, std::less<>> problem_counts;
+  ProblemCounts problem_counts;
   SignalHealthMonitor health(health_config_for(config, *decoder), config.bench.p_r, config.bench.sample_rate_hz);
   if (format == LogFormat::kCsv && !config.health_full_scale_set) {
     health.set_full_scale(csv_sincos_full_scale(config.csv.map), 0.0);  // as resolverd's Pipeline::feed_row
@@ -46,53 +165,8 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
                             ++out.problems;
                             ++problem_counts[std::string(reason)];
                           }});
-  std::map<std::string, std::pair<std::int64_t, std::string>, std::less<>> bad_line_reasons;  ///< count, first
-  LogRecord record;
-  std::int64_t since_progress = 0;
-  bool at_end = false;  // the end of the file, not of --to
-  while (!stream.past_slice_end()) {
-    const auto st = reader->next(record);
-    if (st == LogInput::Status::kEnd) {
-      at_end = true;
-      break;
-    }
-    if (st == LogInput::Status::kBadLine) {
-      ++out.bad_lines;
-      // By reason, with the first line of each: resolverd prints them; here they are notes.
-      const TextProblem& p = reader->problem();
-      auto [it, first] = bad_line_reasons.try_emplace(p.reason, 0, std::string());
-      if (first) it->second.second = fmt::format("{}:{}:{}: {}", path, reader->line_number(), p.column, p.message);
-      ++it->second.first;
-      continue;
-    }
-    ++out.frames;
-    if (record.is_row) {
-      stream.feed_row(record.row, reader->line_number());
-    } else {
-      stream.feed(record.frame, reader->line_number());
-    }
-    if (progress && ++since_progress >= 4096) {  // a std::function call per 4096 records: not measurable
-      since_progress = 0;
-      progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
-                               static_cast<std::int64_t>(out.input.samples.size()), false});
-    }
-  }
-  // A regular file read to its end has given exactly the bytes it had when opened.
-  // Fewer: it was truncated or replaced while read, and the samples may mix two logs.
-  // More: a log still being written (candump -l running); the samples are those read.
-  const std::uint64_t at_open = reader->total_bytes();  // 0: a FIFO, pipe or device
-  if (at_end && at_open > 0 && reader->bytes_read() < at_open) {
-    throw IoError(fmt::format("{}: the file shrank while it was read: {} bytes when opened, its end came after {} "
-                              "(truncated, or replaced by another file?); read a copy that nothing writes to",
-                              path, at_open, reader->bytes_read()));
-  }
-  if (at_end && at_open > 0 && reader->bytes_read() > at_open) {
-    out.grew_while_read = fmt::format("{} grew while it was read ({} bytes when opened, {} read to the end): a log "
-                                      "still being written; these are the samples of the bytes read, and a last "
-                                      "line cut short counts as a bad line",
-                                      path, at_open, reader->bytes_read());
-    out.notes.push_back(out.grew_while_read);
-  }
+  const RecordsRead read = feed_records(*reader, stream, path, progress, out);
+  check_size_while_read(*reader, read.at_end, path, out);
   stream.flush();
   health.finish();
   out.faults = health.faults();
@@ -103,42 +177,9 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
                              static_cast<std::int64_t>(out.input.samples.size()), true});
   }
   if (out.input.samples.empty()) {
-    if (options.slice.limited() && out.outside_slice > 0) {
-      const std::string to = std::isfinite(options.slice.to_s) ? fmt::format(" to --to {} s", options.slice.to_s) : "";
-      throw InputError(Fault::kData,
-                       fmt::format("no samples from --from {} s{}: the log's {} samples span 0 .. {:.6g} s",
-                                   options.slice.from_s, to, out.outside_slice, stream.clock().last_t()),
-                       Where::at_file(path));
-    }
-    const std::string layout = format == LogFormat::kCsv ? "the [input.csv] column map of " + config.source
-                                                         : describe_layout(config, *decoder);
-    throw InputError(Fault::kData,
-                     fmt::format("no samples: {} {} read as {}, {} bad lines, none decoded with {}", out.frames,
-                                 format == LogFormat::kCsv ? "rows" : "frames", log_format_name(format), out.bad_lines,
-                                 layout),
-                     Where::at_file(path));
+    throw_no_samples(path, format, config, *decoder, options.slice, out, stream.clock().last_t());
   }
-  if (!out.bench_info) {
-    out.notes.push_back("p_r = " + std::to_string(out.input.p_r) + ", p = " + std::to_string(out.input.p) + " from " +
-                        (config.source.empty() ? std::string("the defaults") : config.source) +
-                        (config.bench.use_bench_info ? " (no BENCH_INFO frame in the log)" : " (use_bench_info = false)"));
-  }
-  for (const char* odd : {"timestamp_step_back", "timestamp_jump", "sample_clock_reanchored"}) {
-    const auto it = problem_counts.find(odd);
-    if (it != problem_counts.end()) {
-      out.notes.push_back(fmt::format("{}: {} (the sample clock re-anchored; every sample after it used)", odd, it->second));
-    }
-  }
-  for (const auto& [reason, seen] : bad_line_reasons) {
-    out.notes.push_back(fmt::format("{}: {} line(s) not read, the first: {}", reason, seen.first, seen.second));
-  }
-  if (const auto it = problem_counts.find("sample_gap"); it != problem_counts.end()) {
-    out.notes.push_back(fmt::format("sample_gap: {} (samples missing from the recording, found from time)", it->second));
-  }
-  if (options.slice.limited()) {
-    out.notes.push_back(fmt::format("slice {} s .. {} s: {} samples used, {} outside", options.slice.from_s,
-                                    options.slice.to_s, out.input.samples.size(), out.outside_slice));
-  }
+  add_read_notes(out, config, options.slice, problem_counts, read.bad_line_reasons);
   return out;
 }
 

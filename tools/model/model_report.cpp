@@ -15,10 +15,16 @@ std::string json_str(std::string_view s) { return text::json_string(s); }
 
 std::string json_num(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : "null"; }
 
-}  // namespace
+/// The items of v as JSON, comma-separated (without the brackets).
+template <typename T, typename Item>
+std::string json_items(const std::vector<T>& v, Item&& item) {
+  std::string o;
+  for (std::size_t i = 0; i < v.size(); ++i) o += (i ? "," : "") + item(v[i]);
+  return o;
+}
 
-std::string format_model_text(const Explanation& ex, bool explain, const std::vector<std::string>& notes) {
-  const ModelFit& f = ex.fit;
+/// The model, what the fit covers, the notes and the parameters.
+std::string text_header(const ModelFit& f, const std::vector<std::string>& notes) {
   const SampleAccount& a = f.account;
   std::string o;
   o += fmt::format("model: {}\n", f.effects.empty() ? std::string("(none)") : fmt::format("{}", fmt::join(f.effects, ", ")));
@@ -35,7 +41,13 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
   for (const auto& p : f.params) {
     o += fmt::format("  {:<36} {:>12.5g} +- {:.2g} {}\n", p.name, p.value, p.std_error, p.unit);
   }
-  o += "\nresidual rms vs noise floor (held back: fitted on one fold, evaluated on the other):\n";
+  return o;
+}
+
+/// Each signal's residual against its floor, where the floors come from, the folds,
+/// the whiteness test and the outliers.
+std::string text_residuals(const ModelFit& f) {
+  std::string o = "\nresidual rms vs noise floor (held back: fitted on one fold, evaluated on the other):\n";
   for (const auto& s : f.signals) {
     const bool rad = s.signal == "position_error";
     const std::string unit = s.signal == "i_dq" ? " A" : " of the amplitude";
@@ -58,7 +70,7 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
   floor_line("position", f.floors.rd);
   floor_line("sin/cos", f.floors.sc);
   floor_line("i_dq", f.floors.cur);
-  o += fmt::format("  held-back folds: {}\n", a.fold_rule);
+  o += fmt::format("  held-back folds: {}\n", f.account.fold_rule);
   if (f.whiteness.lags > 0) {
     o += fmt::format("  whiteness: autocorrelation at lags 1..{} within +-{:.3g} (99 %): {} outside, largest {:.3g}\n",
                      f.whiteness.lags, f.whiteness.band, f.whiteness.outside, f.whiteness.max_abs);
@@ -66,7 +78,12 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
   for (const auto& out : f.outliers) {
     o += fmt::format("  outliers on {}: {} (largest {:.3g}), kept out of the fit\n", out.signal, out.count, out.largest);
   }
-  o += "\nposition-error residual by harmonic order of theta [rad]:\n ";
+  return o;
+}
+
+/// The residual by harmonic order of theta, theta_m and (i_d / i_q) theta_e.
+std::string text_harmonics(const ModelFit& f) {
+  std::string o = "\nposition-error residual by harmonic order of theta [rad]:\n ";
   for (const auto& h : f.harmonics) o += fmt::format(" {}:{:.2g}", h.order, h.amplitude);
   if (!f.harmonics_mech.empty()) {
     o += "\nby harmonic order of theta_m [rad]:\n ";
@@ -78,7 +95,12 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
       o += fmt::format(" {}:{:.2g}/{:.2g}", n, f.harmonics_id[n].amplitude, f.harmonics_iq[n].amplitude);
     }
   }
-  o += "\n\nby speed bin (moving samples):\n";
+  return o;
+}
+
+/// The residual by speed bin, direction and time window.
+std::string text_bins(const ModelFit& f) {
+  std::string o = "\n\nby speed bin (moving samples):\n";
   for (const auto& b : f.speed_bins) {
     o += fmt::format("  {:>7.0f} r/min  {:>7} samples  rms {:.3g} rad ({:.2f}x floor), 2theta {}\n", b.rpm_mid,
                      b.samples, b.rms, b.rms / f.noise_floor_rad,
@@ -95,11 +117,13 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
     o += fmt::format("  {:>7.2f}-{:<7.2f} s  rms {:.3g} rad ({:.2f}x floor), mean {:.3g} rad\n", b.t_lo, b.t_hi,
                      b.rms, b.rms / f.noise_floor_rad, b.mean);
   }
-  if (!explain) {
-    o += fmt::format("\nverdict: {}\n", f.explained ? "explained (every signal at its floor, held back too)"
-                                                     : "not explained: run `resolver-model explain` for why");
-    return o;
-  }
+  return o;
+}
+
+/// explain's part: where the model fails, the ranked candidates, the verdict and a suggested custom effect.
+std::string text_explanation(const Explanation& ex) {
+  const ModelFit& f = ex.fit;
+  std::string o;
   if (!ex.where_it_fails.empty()) {
     o += "\nwhere it fails:\n";
     for (const auto& w : ex.where_it_fails) o += "  - " + w + "\n";
@@ -122,15 +146,13 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
   return o;
 }
 
-std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes) {
-  const ModelFit& f = ex.fit;
-  std::string o = "{\"effects\":[";
-  for (std::size_t i = 0; i < f.effects.size(); ++i) o += (i ? "," : "") + json_str(f.effects[i]);
-  o += "],\"params\":{";
-  for (std::size_t i = 0; i < f.params.size(); ++i) {
-    o += (i ? "," : "") + json_str(f.params[i].name) + ":{\"value\":" + json_num(f.params[i].value) +
-         ",\"stderr\":" + json_num(f.params[i].std_error) + ",\"unit\":" + json_str(f.params[i].unit) + "}";
-  }
+/// "effects" .. "floors": the model, its parameters, the residual and floor, what the fit covers.
+std::string json_fit_head(const ModelFit& f) {
+  std::string o = "{\"effects\":[" + json_items(f.effects, json_str);
+  o += "],\"params\":{" + json_items(f.params, [](const auto& p) {
+    return json_str(p.name) + ":{\"value\":" + json_num(p.value) + ",\"stderr\":" + json_num(p.std_error) +
+           ",\"unit\":" + json_str(p.unit) + "}";
+  });
   o += "},\"residual_rms_rad\":" + json_num(f.residual_rms_rad);
   o += ",\"residual_rms_arcmin\":" + json_num(rad_to_arcmin(f.residual_rms_rad));
   o += ",\"noise_floor_rad\":" + json_num(f.noise_floor_rad);
@@ -152,12 +174,15 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
   };
   o += ",\"floors\":{\"position_error\":" + floor_json(f.floors.rd) + ",\"sin_cos\":" + floor_json(f.floors.sc) +
        ",\"i_dq\":" + floor_json(f.floors.cur) + "}";
-  o += ",\"outliers\":[";
-  for (std::size_t i = 0; i < f.outliers.size(); ++i) {
-    const auto& x = f.outliers[i];
-    o += (i ? "," : "") + fmt::format("{{\"signal\":{},\"count\":{},\"largest\":{},\"first_times_s\":[{}]}}",
-                                      json_str(x.signal), x.count, json_num(x.largest), fmt::join(x.times, ","));
-  }
+  return o;
+}
+
+/// "outliers" .. "harmonics_mech": how far the fit can be trusted and the residual by direction.
+std::string json_diagnostics(const ModelFit& f) {
+  std::string o = ",\"outliers\":[" + json_items(f.outliers, [](const auto& x) {
+    return fmt::format("{{\"signal\":{},\"count\":{},\"largest\":{},\"first_times_s\":[{}]}}", json_str(x.signal),
+                       x.count, json_num(x.largest), fmt::join(x.times, ","));
+  });
   o += "],\"residual_with_outliers_rad\":" + json_num(f.rms_with_outliers_rad);
   o += fmt::format(",\"whiteness\":{{\"lags\":{},\"band\":{},\"max_abs\":{},\"outside\":{},\"samples\":{}}}",
                    f.whiteness.lags, json_num(f.whiteness.band), json_num(f.whiteness.max_abs), f.whiteness.outside,
@@ -165,86 +190,94 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
   o += ",\"robust_standard_errors\":" + std::string(f.robust_errors ? "true" : "false");
   o += ",\"standard_errors\":" + json_str(std_error_basis(f));
   o += ",\"passes\":" + std::to_string(f.passes);
-  o += ",\"directions\":[";
-  for (std::size_t i = 0; i < f.directions.size(); ++i) {
-    const auto& d = f.directions[i];
-    o += (i ? "," : "") + fmt::format("{{\"direction\":{},\"samples\":{},\"rms_rad\":{},\"mean_rad\":{}}}",
-                                      d.direction, d.samples, json_num(d.rms), json_num(d.mean));
-  }
-  o += "],\"harmonics_mech\":[";
-  for (std::size_t i = 0; i < f.harmonics_mech.size(); ++i) {
-    o += (i ? "," : "") + fmt::format("{{\"order\":{},\"amplitude_rad\":{},\"phase_rad\":{}}}",
-                                      f.harmonics_mech[i].order, json_num(f.harmonics_mech[i].amplitude),
-                                      json_num(f.harmonics_mech[i].phase));
-  }
-  o += "]";
-  o += ",\"signals\":[";
-  for (std::size_t i = 0; i < f.signals.size(); ++i) {
-    const auto& s = f.signals[i];
-    o += (i ? "," : "") + fmt::format("{{\"signal\":{},\"rms\":{},\"floor\":{},\"raw_rms\":{},\"held_back_rms\":{},"
-                                      "\"rows\":{}}}",
-                                      json_str(s.signal), json_num(s.rms), json_num(s.floor), json_num(s.raw_rms),
-                                      json_num(s.held_back_rms), s.rows);
-  }
-  o += "],\"harmonics\":[";
-  for (std::size_t i = 0; i < f.harmonics.size(); ++i) {
-    o += (i ? "," : "") + fmt::format("{{\"order\":{},\"amplitude_rad\":{},\"phase_rad\":{}}}", f.harmonics[i].order,
-                                      json_num(f.harmonics[i].amplitude), json_num(f.harmonics[i].phase));
-  }
+  o += ",\"directions\":[" + json_items(f.directions, [](const auto& d) {
+    return fmt::format("{{\"direction\":{},\"samples\":{},\"rms_rad\":{},\"mean_rad\":{}}}", d.direction, d.samples,
+                       json_num(d.rms), json_num(d.mean));
+  });
+  o += "],\"harmonics_mech\":[" + json_items(f.harmonics_mech, [](const auto& h) {
+    return fmt::format("{{\"order\":{},\"amplitude_rad\":{},\"phase_rad\":{}}}", h.order, json_num(h.amplitude),
+                       json_num(h.phase));
+  });
+  return o + "]";
+}
+
+/// "signals" .. "time_bins": the residual per signal, by harmonic, speed and time.
+std::string json_breakdowns(const ModelFit& f) {
+  std::string o = ",\"signals\":[" + json_items(f.signals, [](const auto& s) {
+    return fmt::format("{{\"signal\":{},\"rms\":{},\"floor\":{},\"raw_rms\":{},\"held_back_rms\":{},\"rows\":{}}}",
+                       json_str(s.signal), json_num(s.rms), json_num(s.floor), json_num(s.raw_rms),
+                       json_num(s.held_back_rms), s.rows);
+  });
+  o += "],\"harmonics\":[" + json_items(f.harmonics, [](const auto& h) {
+    return fmt::format("{{\"order\":{},\"amplitude_rad\":{},\"phase_rad\":{}}}", h.order, json_num(h.amplitude),
+                       json_num(h.phase));
+  });
   o += "],\"harmonics_dq\":[";
   for (std::size_t i = 0; i < f.harmonics_id.size() && i < f.harmonics_iq.size(); ++i) {
     o += (i ? "," : "") + fmt::format("{{\"order_theta_e\":{},\"i_d_amplitude_a\":{},\"i_q_amplitude_a\":{}}}",
                                       f.harmonics_id[i].order, json_num(f.harmonics_id[i].amplitude),
                                       json_num(f.harmonics_iq[i].amplitude));
   }
-  o += "],\"speed_bins\":[";
-  for (std::size_t i = 0; i < f.speed_bins.size(); ++i) {
-    const auto& b = f.speed_bins[i];
-    o += (i ? "," : "") + fmt::format("{{\"rpm\":{},\"samples\":{},\"rms_rad\":{},\"order2_rad\":{}}}", json_num(b.rpm_mid),
-                                      b.samples, json_num(b.rms), json_num(b.order2_amplitude));
+  o += "],\"speed_bins\":[" + json_items(f.speed_bins, [](const auto& b) {
+    return fmt::format("{{\"rpm\":{},\"samples\":{},\"rms_rad\":{},\"order2_rad\":{}}}", json_num(b.rpm_mid),
+                       b.samples, json_num(b.rms), json_num(b.order2_amplitude));
+  });
+  o += "],\"time_bins\":[" + json_items(f.time_bins, [](const auto& b) {
+    return fmt::format("{{\"t_lo_s\":{},\"t_hi_s\":{},\"samples\":{},\"rms_rad\":{},\"order2_rad\":{}}}",
+                       json_num(b.t_lo), json_num(b.t_hi), b.samples, json_num(b.rms), json_num(b.order2_amplitude));
+  });
+  return o + "]";
+}
+
+/// One ranked candidate as a JSON object.
+std::string json_candidate(const Candidate& c) {
+  return fmt::format("{{\"effect\":{},\"residual_after_rad\":{},\"dq_residual_after_a\":{},"
+                     "\"score\":{},\"bic_drop\":{},\"err\":{},"
+                     "\"proposed\":{},\"reaches_floor\":{},\"reason\":{},\"fits_as_well\":[{}],"
+                     "\"params\":{{",
+                     json_str(c.effect), json_num(c.residual_after_rad), json_num(c.dq_residual_after),
+                     json_num(c.score), json_num(c.bic_drop), json_num(c.err), c.proposed, c.reaches_floor,
+                     json_str(c.reason), json_items(c.fits_as_well, json_str)) +
+         json_items(c.params,
+                    [](const auto& p) {
+                      return json_str(p.name) + ":{\"value\":" + json_num(p.value) +
+                             ",\"stderr\":" + json_num(p.std_error) + "}";
+                    }) +
+         "}}";
+}
+
+/// explain's members: the candidates, where the model fails, the verdict and a suggested custom effect.
+std::string json_explanation(const Explanation& ex) {
+  std::string o = ",\"candidates\":[" + json_items(ex.candidates, json_candidate);
+  o += "],\"where_it_fails\":[" + json_items(ex.where_it_fails, json_str);
+  o += "],\"missing_pair\":[" + json_items(ex.missing_pair, json_str);
+  o += "],\"not_evaluated\":[" + json_items(ex.not_evaluated, json_str);
+  o += "],\"verdict\":" + json_str(to_string(ex.verdict)) + ",\"summary\":" + json_str(ex.summary);
+  o += ",\"suggested_custom\":" + (ex.suggested_custom.empty() ? std::string("null") : json_str(ex.suggested_custom));
+  return o;
+}
+
+}  // namespace
+
+std::string format_model_text(const Explanation& ex, bool explain, const std::vector<std::string>& notes) {
+  const ModelFit& f = ex.fit;
+  std::string o = text_header(f, notes) + text_residuals(f) + text_harmonics(f) + text_bins(f);
+  if (!explain) {
+    o += fmt::format("\nverdict: {}\n", f.explained ? "explained (every signal at its floor, held back too)"
+                                                     : "not explained: run `resolver-model explain` for why");
+    return o;
   }
-  o += "],\"time_bins\":[";
-  for (std::size_t i = 0; i < f.time_bins.size(); ++i) {
-    const auto& b = f.time_bins[i];
-    o += (i ? "," : "") + fmt::format("{{\"t_lo_s\":{},\"t_hi_s\":{},\"samples\":{},\"rms_rad\":{},\"order2_rad\":{}}}",
-                                      json_num(b.t_lo), json_num(b.t_hi), b.samples, json_num(b.rms),
-                                      json_num(b.order2_amplitude));
-  }
-  o += "],\"bic\":" + json_num(f.bic) + ",\"notes\":[";
+  return o + text_explanation(ex);
+}
+
+std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes) {
+  const ModelFit& f = ex.fit;
+  std::string o = json_fit_head(f) + json_diagnostics(f) + json_breakdowns(f);
   std::vector<std::string> all = notes;
   all.insert(all.end(), f.notes.begin(), f.notes.end());
-  for (std::size_t i = 0; i < all.size(); ++i) o += (i ? "," : "") + json_str(all[i]);
-  o += "]";
+  o += ",\"bic\":" + json_num(f.bic) + ",\"notes\":[" + json_items(all, json_str) + "]";
   if (explain) {
-    o += ",\"candidates\":[";
-    for (std::size_t i = 0; i < ex.candidates.size(); ++i) {
-      const auto& c = ex.candidates[i];
-      o += (i ? "," : "") + fmt::format("{{\"effect\":{},\"residual_after_rad\":{},\"dq_residual_after_a\":{},"
-                                        "\"score\":{},\"bic_drop\":{},\"err\":{},"
-                                        "\"proposed\":{},\"reaches_floor\":{},\"reason\":{},\"fits_as_well\":[{}],"
-                                        "\"params\":{{",
-                                        json_str(c.effect), json_num(c.residual_after_rad),
-                                        json_num(c.dq_residual_after), json_num(c.score),
-                                        json_num(c.bic_drop), json_num(c.err), c.proposed, c.reaches_floor,
-                                        json_str(c.reason), [&] {
-                                          std::string l;
-                                          for (const auto& x : c.fits_as_well) l += (l.empty() ? "" : ",") + json_str(x);
-                                          return l;
-                                        }());
-      for (std::size_t j = 0; j < c.params.size(); ++j) {
-        o += (j ? "," : "") + json_str(c.params[j].name) + ":{\"value\":" + json_num(c.params[j].value) +
-             ",\"stderr\":" + json_num(c.params[j].std_error) + "}";
-      }
-      o += "}}";
-    }
-    o += "],\"where_it_fails\":[";
-    for (std::size_t i = 0; i < ex.where_it_fails.size(); ++i) o += (i ? "," : "") + json_str(ex.where_it_fails[i]);
-    o += "],\"missing_pair\":[";
-    for (std::size_t i = 0; i < ex.missing_pair.size(); ++i) o += (i ? "," : "") + json_str(ex.missing_pair[i]);
-    o += "],\"not_evaluated\":[";
-    for (std::size_t i = 0; i < ex.not_evaluated.size(); ++i) o += (i ? "," : "") + json_str(ex.not_evaluated[i]);
-    o += "],\"verdict\":" + json_str(to_string(ex.verdict)) + ",\"summary\":" + json_str(ex.summary);
-    o += ",\"suggested_custom\":" + (ex.suggested_custom.empty() ? std::string("null") : json_str(ex.suggested_custom));
+    o += json_explanation(ex);
   } else {
     o += std::string(",\"verdict\":") + (f.explained ? "\"explained\"" : "\"not_explained\"");
   }

@@ -246,6 +246,298 @@ int run_fleet(const std::string& manifest, const std::string& out, const std::st
   return failed > 0 ? resolver::exit_code::kNoUsableData : resolver::exit_code::kDone;
 }
 
+/// The subcommands; several share an argument (LOG, --effects, --config, ...).
+enum class Command { kFit, kExplain, kReport, kExportData, kExport, kFleet };
+
+/// Every value the command line sets, one field per option whatever subcommand gives it.
+struct Arguments {
+  Command command = Command::kFit;
+  std::string log;
+  std::vector<std::string> effects_args;
+  std::string config_path;
+  std::string format_name;
+  resolver::SampleSlice slice;
+  bool json = false;
+  bool progress = false;
+  std::string direction = "both";
+  bool moving_only = false;
+  bool reference_aligned = false;
+  std::string html_out;  // report
+  int max_steps = 6;
+  std::string csv_out, mat_out;  // export-data
+  std::string export_format = "csv", export_out;  // export
+  int export_points = 1024;  // export and fleet
+  std::string manifest, fleet_out, summarize_dir;  // fleet
+};
+
+/// fit and explain: the log, the model (with the fittable effects listed) and --json.
+void add_model_options(CLI::App* sub, Arguments& a, const std::string& fittable) {
+  sub->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
+  sub->add_option("--effects", a.effects_args,
+                  "the model: comma-separated effect references, an effect by name (its default parameters) or "
+                  "with a parameter list, e.g. amplitude_imbalance,harmonics(k5,k3_opp),delay; catalog effects or "
+                  "the config's [[model.custom]] names (default amplitude_imbalance); fittable: " + fittable);
+  sub->add_flag("--json", a.json, "print one JSON object instead of the text report");
+}
+
+/// Which of the log's samples a fit uses.
+void add_slicing_options(CLI::App* sub, Arguments& a) {
+  sub->add_option("--direction", a.direction,
+                  "fit only the samples moving this way: forward, backward or both (default both); the others are "
+                  "counted as excluded")
+      ->check(CLI::IsMember({"forward", "backward", "both"}));
+  sub->add_flag("--reference-aligned", a.reference_aligned,
+                "the reference encoder's zero is on the rotor d axis (as resolver-sim's is; [bench] "
+                "reference_aligned): a constant position error is then the mounting offset, not a free constant");
+  sub->add_flag("--moving-only", a.moving_only,
+                "leave standstill samples out of everything, the noise floor too (default: they give the floor "
+                "and never enter a fit)");
+}
+
+/// How the log is read: config, format, time range and progress.
+void add_config_options(CLI::App* sub, Arguments& a) {
+  sub->add_option("--config", a.config_path,
+                  "resolverd config (TOML): its [layout] DBC and signals decode the log ([input.csv] a CSV), "
+                  "[bench] p_r/p apply without BENCH_INFO, [model] effects is the model when --effects is not given");
+  sub->add_option("--format", a.format_name,
+                  "log format: candump, asc (Vector ASC) or csv (scope export, needs [input.csv] in --config); "
+                  "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
+      ->check(CLI::IsMember({"candump", "asc", "csv"}));
+  sub->add_option("--from", a.slice.from_s, "use samples from this time on [s, 0 = the log's first sample]")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_option("--to", a.slice.to_s, "use samples up to this time [s, from the log's first sample]")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--progress", a.progress,
+                "show progress on stderr (bytes read of the total, samples, rate, ETA; then the fit) even when it "
+                "is not a terminal, one line per update; on a terminal it is shown anyway once a run takes 1.5 s");
+}
+
+/// The subcommands as added to the app, to tell after parsing which one was given.
+struct Subcommands {
+  CLI::App* fit = nullptr;
+  CLI::App* explain = nullptr;
+  CLI::App* report = nullptr;
+  CLI::App* export_data = nullptr;
+  CLI::App* exporter = nullptr;
+  CLI::App* fleet = nullptr;
+
+  [[nodiscard]] Command parsed() const {
+    if (explain->parsed()) return Command::kExplain;
+    if (report->parsed()) return Command::kReport;
+    if (export_data->parsed()) return Command::kExportData;
+    if (exporter->parsed()) return Command::kExport;
+    if (fleet->parsed()) return Command::kFleet;
+    return Command::kFit;
+  }
+};
+
+/// fit, explain, report and export-data, in this order (--help lists them so).
+void add_discovery_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
+  std::string fittable;
+  for (auto e : resolver::fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(e);
+  subs.fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
+  subs.explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
+  add_model_options(subs.fit, a, fittable);
+  add_model_options(subs.explain, a, fittable);
+  subs.fit->footer(sub_footer(kFitExamples));
+  subs.explain->footer(sub_footer(kExplainExamples));
+  CLI::App* report = subs.report = app.add_subcommand(
+      "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
+  report->footer(sub_footer(kReportExamples));
+  report->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
+  report->add_option("--effects", a.effects_args, "starting model, as for explain (default amplitude_imbalance)");
+  report->add_option("--html", a.html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
+  report->add_option("--max-steps", a.max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
+  CLI::App* export_data = subs.export_data = app.add_subcommand(
+      "export-data", "write the log's samples, the fitted model's prediction and residual per sample, and the "
+                     "parameters with units: CSV (MATLAB readtable, pandas) and/or MATLAB .mat");
+  export_data->footer(sub_footer(kExportDataExamples));
+  export_data->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
+  export_data->add_option("--effects", a.effects_args, "the model, as for fit (default amplitude_imbalance)");
+  export_data->add_option("--csv", a.csv_out, "CSV of the samples [one header line, units in the column names]; the "
+                                              "parameters go to OUT's stem + .params.csv");
+  export_data->add_option("--mat", a.mat_out, "MATLAB MAT-5 file: structs samples, units, descriptions, params, info");
+  for (CLI::App* sub : {subs.fit, subs.explain, report, export_data}) {
+    add_config_options(sub, a);
+    add_slicing_options(sub, a);
+  }
+}
+
+/// export and fleet, after the others.
+void add_calibration_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
+  CLI::App* exporter = subs.exporter = app.add_subcommand(
+      "export", "fit the model and write what a drive firmware loads: a correction table over one mechanical "
+                "revolution with its harmonic coefficients (resolverd --calibration reads the CSV)");
+  exporter->footer(sub_footer(kExportExamples));
+  exporter->add_option("LOG", a.log, "the log to fit (as for fit)")->required();
+  exporter->add_option("--effects", a.effects_args, "the model, as for fit (default amplitude_imbalance)");
+  exporter->add_option("--table-format", a.export_format, "the table's format: csv (default), json or c-header")
+      ->check(CLI::IsMember({"csv", "json", "c-header"}));
+  exporter->add_option("--points", a.export_points, "table points over one mechanical revolution (default 1024)")
+      ->check(CLI::Range(8, 1 << 20));
+  exporter->add_option("--out", a.export_out, "file to write (default: standard output)");
+  add_config_options(exporter, a);
+  add_slicing_options(exporter, a);
+  CLI::App* fleet = subs.fleet = app.add_subcommand(
+      "fleet", "a production line: explain and calibrate every unit of a manifest (CSV unit,log), one folder per "
+               "unit, and summarize the fleet (spread, outliers, failed units) in OUT/fleet.json");
+  fleet->footer(sub_footer(kFleetExamples));
+  fleet->add_option("MANIFEST", a.manifest, "CSV with the header unit,log; one row per log");
+  fleet->add_option("--out", a.fleet_out, "folder for OUT/UNIT/ and OUT/fleet.json (created)");
+  fleet->add_option("--summarize", a.summarize_dir,
+                    "only recompute DIR/fleet.json from DIR/*/unit.json (units run elsewhere, e.g. on Dask)");
+  fleet->add_option("--effects", a.effects_args, "the model every log is fitted with, as for explain");
+  fleet->add_option("--points", a.export_points, "calibration table points per mechanical revolution (default 1024)")
+      ->check(CLI::Range(8, 1 << 20));
+  fleet->add_option("--config", a.config_path, "resolverd config (TOML), as for explain");
+}
+
+/// A usage error or an unreadable input, said before anything is read: its exit code.
+std::optional<int> check_arguments(const Arguments& a) {
+  if (a.slice.to_s < a.slice.from_s) {
+    std::cerr << "resolver-model: --to " << a.slice.to_s << " s is before --from " << a.slice.from_s << " s\n";
+    return resolver::exit_code::kUsage;
+  }
+  for (const auto& [option, path] : {std::pair{"LOG", a.log}, std::pair{"--config", a.config_path}}) {
+    if (path.empty()) continue;
+    if (auto problem = resolver::exit_code::unreadable(option, path)) {
+      std::cerr << "resolver-model: " << *problem << "\n";
+      return resolver::exit_code::kIo;
+    }
+  }
+  if (a.command == Command::kExportData && a.csv_out.empty() && a.mat_out.empty()) {
+    std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
+    return resolver::exit_code::kUsage;
+  }
+  return std::nullopt;
+}
+
+/// The config (its defaults without --config) and the model's effects.
+struct Model {
+  resolver::DaemonConfig config;
+  std::vector<std::string> effects;
+};
+
+/// --effects, checked before the log is read, else the config's [model] effects.
+Model load_model(const Arguments& a) {
+  Model m;
+  if (!a.config_path.empty()) m.config = resolver::load_daemon_config(a.config_path);  // throws naming file and key
+  m.effects = split_effects(a.effects_args);
+  if (!m.effects.empty()) {
+    // A misspelt effect is a usage error, found before the log is read (the
+    // config's [model] effects were checked when it was loaded).
+    try {
+      (void)resolver::ModelSpec::parse(m.effects, m.config.model.customs.get());
+    } catch (const std::invalid_argument& e) {
+      throw resolver::InputError(resolver::Fault::kUsage, e.what(), resolver::Where::at_option("--effects"));
+    }
+  }
+  if (m.effects.empty()) m.effects = m.config.model.effects;  // default ["amplitude_imbalance"]
+  return m;
+}
+
+/// The log's samples, with a progress bar while it is read.
+resolver::LogSamples read_samples(const Arguments& a, const resolver::DaemonConfig& config,
+                                  const resolver::ProgressMeter::Options& shown) {
+  resolver::LogSamples samples;
+  {
+    resolver::ProgressMeter bar(stderr, "reading " + a.log, shown);
+    resolver::LogReadOptions read_options;
+    read_options.format = resolver::log_format_from_name(a.format_name);
+    read_options.slice = a.slice;
+    samples = resolver::read_log_samples(
+        a.log, [&](const resolver::LogReadProgress& p) { bar.bytes(p.bytes_read, p.total_bytes, p.samples, p.done); },
+        config, read_options);
+  }
+  if (!samples.grew_while_read.empty()) std::cerr << "resolver-model: warning: " << samples.grew_while_read << "\n";
+  return samples;
+}
+
+/// The offline discovery settings with the command line's slicing and the config's custom effects.
+resolver::DiscoveryOptions discovery_options(const Arguments& a, const resolver::DaemonConfig& config) {
+  resolver::DiscoveryOptions options;
+  options.max_report_order = resolver::kOfflineReportOrder;
+  options.harmonic_families = true;
+  options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
+  options.prepare.direction = a.direction == "forward"    ? resolver::DirectionFilter::kForward
+                              : a.direction == "backward" ? resolver::DirectionFilter::kBackward
+                                                          : resolver::DirectionFilter::kBoth;
+  options.prepare.moving_only = a.moving_only;
+  options.prepare.reference_aligned = a.reference_aligned || config.bench.reference_aligned;
+  return options;
+}
+
+/// Faults over a tenth of the log forbid "explained"; shorter ones are notes.
+void weigh_signal_faults(resolver::LogSamples& samples, resolver::DiscoveryOptions& options) {
+  const resolver::FaultCounts faults = resolver::fault_counts(samples);
+  options.untrusted_input = resolver::lasting_faults(faults, samples.health_samples, resolver::kUntrustedFaultShare);
+  for (const std::string& f : resolver::lasting_faults(faults, samples.health_samples, 0.0)) {
+    samples.notes.push_back("signal health: " + f);
+  }
+}
+
+/// report, export or export-data: the files they write.
+int write_outputs(const Arguments& a, const resolver::LogSamples& samples, const std::vector<std::string>& effects,
+                  const resolver::DiscoveryOptions& options, const resolver::ProgressMeter::Options& shown) {
+  // The effects were checked before the log was read: what the fit refuses now
+  // (too few samples, the rotor hardly moves, no angle signal) is the data's fault.
+  try {
+    if (a.command == Command::kReport) {
+      return write_report(samples, a.log, effects, options, a.max_steps, a.html_out, shown);
+    }
+    if (a.command == Command::kExport) {
+      return write_export(samples, a.log, effects, options, a.export_format, a.export_points, a.export_out);
+    }
+    std::cout << resolver::export_data(samples.input, effects, options, a.log, a.csv_out, a.mat_out);
+    return 0;
+  } catch (const std::invalid_argument& e) {
+    throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(a.log));
+  }
+}
+
+/// fit or explain, with a progress bar; a fit the data refuses is the data's fault.
+resolver::Explanation fit_or_explain(const resolver::LogSamples& samples, const std::string& log,
+                                     const std::vector<std::string>& effects, resolver::DiscoveryOptions options,
+                                     bool explain, const resolver::ProgressMeter::Options& shown) {
+  resolver::Explanation ex;
+  try {
+    resolver::ProgressMeter bar(stderr, "fitting", shown);
+    options.progress = [&](double f) { bar.fraction(f); };
+    if (explain) ex = resolver::explain_model(samples.input, effects, options);
+    else ex.fit = resolver::fit_model(samples.input, effects, options);
+    bar.fraction(1.0);  // fit_model reports only its first steps
+  } catch (const std::invalid_argument& e) {
+    throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
+  }
+  return ex;
+}
+
+/// The report's notes: the reader's, then what it skipped and counted.
+std::vector<std::string> report_notes(const resolver::LogSamples& samples) {
+  std::vector<std::string> notes = samples.notes;
+  if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
+  if (samples.problems > 0) notes.push_back(std::to_string(samples.problems) + " input problems counted (by reason above: a gap is counted, not skipped)");
+  return notes;
+}
+
+/// Every subcommand but fleet: read the log, then fit, explain or write.
+int run_on_log(const Arguments& a) {
+  const Model model = load_model(a);
+  const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(a.progress);
+  resolver::LogSamples samples = read_samples(a, model.config, shown);
+  resolver::DiscoveryOptions options = discovery_options(a, model.config);
+  weigh_signal_faults(samples, options);
+  if (a.command == Command::kReport || a.command == Command::kExport || a.command == Command::kExportData) {
+    return write_outputs(a, samples, model.effects, options, shown);
+  }
+  const bool do_explain = a.command == Command::kExplain;
+  const resolver::Explanation ex = fit_or_explain(samples, a.log, model.effects, options, do_explain, shown);
+  const std::vector<std::string> notes = report_notes(samples);
+  std::cout << (a.json ? resolver::format_model_json(ex, do_explain, notes)
+                       : resolver::format_model_text(ex, do_explain, notes));
+  return 0;
+}
+
 int run(int argc, char** argv) {
   // The program's name, not argv[0] (a build path), in every usage line and man page.
   CLI::App app{"resolver-model: compare the effect model with a log, see where it fails, name the missing effect.",
@@ -253,205 +545,18 @@ int run(int argc, char** argv) {
   app.footer(std::string(kExamples) + "\n\n" + resolver::exit_code::kHelpText);
   app.require_subcommand(1);
   app.set_version_flag("--version", resolver::version_line("resolver-model"));
-  std::string log;
-  std::vector<std::string> effects_args;
-  std::string config_path;
-  std::string format_name;
-  resolver::SampleSlice slice;
-  bool json = false;
-  std::string fittable;
-  for (auto e : resolver::fittable_effects()) fittable += (fittable.empty() ? "" : ", ") + std::string(e);
-  auto add_common = [&](CLI::App* sub) {
-    sub->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
-    sub->add_option("--effects", effects_args,
-                    "the model: comma-separated effect references, an effect by name (its default parameters) or "
-                    "with a parameter list, e.g. amplitude_imbalance,harmonics(k5,k3_opp),delay; catalog effects or "
-                    "the config's [[model.custom]] names (default amplitude_imbalance); fittable: " + fittable);
-    sub->add_flag("--json", json, "print one JSON object instead of the text report");
-  };
-  bool progress = false;
-  std::string direction = "both";
-  bool moving_only = false;
-  bool reference_aligned = false;
-  auto add_slicing = [&](CLI::App* sub) {
-    sub->add_option("--direction", direction,
-                    "fit only the samples moving this way: forward, backward or both (default both); the others are "
-                    "counted as excluded")
-        ->check(CLI::IsMember({"forward", "backward", "both"}));
-    sub->add_flag("--reference-aligned", reference_aligned,
-                  "the reference encoder's zero is on the rotor d axis (as resolver-sim's is; [bench] "
-                  "reference_aligned): a constant position error is then the mounting offset, not a free constant");
-    sub->add_flag("--moving-only", moving_only,
-                  "leave standstill samples out of everything, the noise floor too (default: they give the floor "
-                  "and never enter a fit)");
-  };
-  auto add_config = [&](CLI::App* sub) {
-    sub->add_option("--config", config_path,
-                    "resolverd config (TOML): its [layout] DBC and signals decode the log ([input.csv] a CSV), "
-                    "[bench] p_r/p apply without BENCH_INFO, [model] effects is the model when --effects is not given");
-    sub->add_option("--format", format_name,
-                    "log format: candump, asc (Vector ASC) or csv (scope export, needs [input.csv] in --config); "
-                    "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
-        ->check(CLI::IsMember({"candump", "asc", "csv"}));
-    sub->add_option("--from", slice.from_s, "use samples from this time on [s, 0 = the log's first sample]")
-        ->check(CLI::NonNegativeNumber);
-    sub->add_option("--to", slice.to_s, "use samples up to this time [s, from the log's first sample]")
-        ->check(CLI::NonNegativeNumber);
-    sub->add_flag("--progress", progress,
-                  "show progress on stderr (bytes read of the total, samples, rate, ETA; then the fit) even when it "
-                  "is not a terminal, one line per update; on a terminal it is shown anyway once a run takes 1.5 s");
-  };
-  CLI::App* fit = app.add_subcommand("fit", "fit the model: parameters, residual vs noise floor, by harmonic and speed");
-  CLI::App* explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
-  add_common(fit);
-  add_common(explain);
-  fit->footer(sub_footer(kFitExamples));
-  explain->footer(sub_footer(kExplainExamples));
-  CLI::App* report = app.add_subcommand(
-      "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
-  report->footer(sub_footer(kReportExamples));
-  std::string html_out;
-  int max_steps = 6;
-  report->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
-  report->add_option("--effects", effects_args, "starting model, as for explain (default amplitude_imbalance)");
-  report->add_option("--html", html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
-  report->add_option("--max-steps", max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
-  CLI::App* export_data = app.add_subcommand(
-      "export-data", "write the log's samples, the fitted model's prediction and residual per sample, and the "
-                     "parameters with units: CSV (MATLAB readtable, pandas) and/or MATLAB .mat");
-  export_data->footer(sub_footer(kExportDataExamples));
-  std::string csv_out, mat_out;
-  export_data->add_option("LOG", log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
-  export_data->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
-  export_data->add_option("--csv", csv_out, "CSV of the samples [one header line, units in the column names]; the "
-                                            "parameters go to OUT's stem + .params.csv");
-  export_data->add_option("--mat", mat_out, "MATLAB MAT-5 file: structs samples, units, descriptions, params, info");
-  add_config(fit);
-  add_config(explain);
-  add_config(report);
-  add_config(export_data);
-  add_slicing(fit);
-  add_slicing(explain);
-  add_slicing(report);
-  CLI::App* exporter = app.add_subcommand(
-      "export", "fit the model and write what a drive firmware loads: a correction table over one mechanical "
-                "revolution with its harmonic coefficients (resolverd --calibration reads the CSV)");
-  exporter->footer(sub_footer(kExportExamples));
-  std::string export_format = "csv", export_out;
-  int export_points = 1024;
-  exporter->add_option("LOG", log, "the log to fit (as for fit)")->required();
-  exporter->add_option("--effects", effects_args, "the model, as for fit (default amplitude_imbalance)");
-  exporter->add_option("--table-format", export_format, "the table's format: csv (default), json or c-header")
-      ->check(CLI::IsMember({"csv", "json", "c-header"}));
-  exporter->add_option("--points", export_points, "table points over one mechanical revolution (default 1024)")
-      ->check(CLI::Range(8, 1 << 20));
-  exporter->add_option("--out", export_out, "file to write (default: standard output)");
-  add_config(exporter);
-  add_slicing(exporter);
-  add_slicing(export_data);
-  CLI::App* fleet = app.add_subcommand(
-      "fleet", "a production line: explain and calibrate every unit of a manifest (CSV unit,log), one folder per "
-               "unit, and summarize the fleet (spread, outliers, failed units) in OUT/fleet.json");
-  fleet->footer(sub_footer(kFleetExamples));
-  std::string manifest, fleet_out, summarize_dir;
-  fleet->add_option("MANIFEST", manifest, "CSV with the header unit,log; one row per log");
-  fleet->add_option("--out", fleet_out, "folder for OUT/UNIT/ and OUT/fleet.json (created)");
-  fleet->add_option("--summarize", summarize_dir,
-                    "only recompute DIR/fleet.json from DIR/*/unit.json (units run elsewhere, e.g. on Dask)");
-  fleet->add_option("--effects", effects_args, "the model every log is fitted with, as for explain");
-  fleet->add_option("--points", export_points, "calibration table points per mechanical revolution (default 1024)")
-      ->check(CLI::Range(8, 1 << 20));
-  fleet->add_option("--config", config_path, "resolverd config (TOML), as for explain");
+  Arguments a;
+  Subcommands subs;
+  add_discovery_subcommands(app, a, subs);
+  add_calibration_subcommands(app, a, subs);
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
-  if (fleet->parsed()) return run_fleet(manifest, fleet_out, summarize_dir, split_effects(effects_args), config_path,
-                                        export_points);
-  if (slice.to_s < slice.from_s) {
-    std::cerr << "resolver-model: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
-    return resolver::exit_code::kUsage;
+  a.command = subs.parsed();
+  if (a.command == Command::kFleet) {
+    return run_fleet(a.manifest, a.fleet_out, a.summarize_dir, split_effects(a.effects_args), a.config_path,
+                     a.export_points);
   }
-  for (const auto& [option, path] : {std::pair{"LOG", log}, std::pair{"--config", config_path}}) {
-    if (path.empty()) continue;
-    if (auto problem = resolver::exit_code::unreadable(option, path)) {
-      std::cerr << "resolver-model: " << *problem << "\n";
-      return resolver::exit_code::kIo;
-    }
-  }
-
-  const bool do_explain = explain->parsed();
-  if (export_data->parsed() && csv_out.empty() && mat_out.empty()) {
-    std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
-    return resolver::exit_code::kUsage;
-  }
-  {
-    resolver::DaemonConfig config;
-    if (!config_path.empty()) config = resolver::load_daemon_config(config_path);  // throws naming file and key
-    std::vector<std::string> effects = split_effects(effects_args);
-    if (!effects.empty()) {
-      // A misspelt effect is a usage error, found before the log is read (the
-      // config's [model] effects were checked when it was loaded).
-      try {
-        (void)resolver::ModelSpec::parse(effects, config.model.customs.get());
-      } catch (const std::invalid_argument& e) {
-        throw resolver::InputError(resolver::Fault::kUsage, e.what(), resolver::Where::at_option("--effects"));
-      }
-    }
-    if (effects.empty()) effects = config.model.effects;  // default ["amplitude_imbalance"]
-    resolver::LogSamples samples;
-    const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(progress);
-    {
-      resolver::ProgressMeter bar(stderr, "reading " + log, shown);
-      resolver::LogReadOptions read_options;
-      read_options.format = resolver::log_format_from_name(format_name);
-      read_options.slice = slice;
-      samples = resolver::read_log_samples(
-          log, [&](const resolver::LogReadProgress& p) { bar.bytes(p.bytes_read, p.total_bytes, p.samples, p.done); },
-          config, read_options);
-    }
-    if (!samples.grew_while_read.empty()) std::cerr << "resolver-model: warning: " << samples.grew_while_read << "\n";
-    resolver::DiscoveryOptions options;
-    options.max_report_order = resolver::kOfflineReportOrder;
-    options.harmonic_families = true;
-    options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
-    options.prepare.direction = direction == "forward"    ? resolver::DirectionFilter::kForward
-                                : direction == "backward" ? resolver::DirectionFilter::kBackward
-                                                          : resolver::DirectionFilter::kBoth;
-    options.prepare.moving_only = moving_only;
-    options.prepare.reference_aligned = reference_aligned || config.bench.reference_aligned;
-    // Faults over a tenth of the log forbid "explained"; shorter ones are notes.
-    const resolver::FaultCounts faults = resolver::fault_counts(samples);
-    options.untrusted_input = resolver::lasting_faults(faults, samples.health_samples, resolver::kUntrustedFaultShare);
-    for (const std::string& f : resolver::lasting_faults(faults, samples.health_samples, 0.0)) {
-      samples.notes.push_back("signal health: " + f);
-    }
-    // The effects were checked before the log was read: what the fit refuses now
-    // (too few samples, the rotor hardly moves, no angle signal) is the data's fault.
-    try {
-      if (report->parsed()) return write_report(samples, log, effects, options, max_steps, html_out, shown);
-      if (exporter->parsed()) return write_export(samples, log, effects, options, export_format, export_points, export_out);
-      if (export_data->parsed()) {
-        std::cout << resolver::export_data(samples.input, effects, options, log, csv_out, mat_out);
-        return 0;
-      }
-    } catch (const std::invalid_argument& e) {
-      throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
-    }
-    resolver::Explanation ex;
-    try {
-      resolver::ProgressMeter bar(stderr, "fitting", shown);
-      options.progress = [&](double f) { bar.fraction(f); };
-      if (do_explain) ex = resolver::explain_model(samples.input, effects, options);
-      else ex.fit = resolver::fit_model(samples.input, effects, options);
-      bar.fraction(1.0);  // fit_model reports only its first steps
-    } catch (const std::invalid_argument& e) {
-      throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(log));
-    }
-    std::vector<std::string> notes = samples.notes;
-    if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
-    if (samples.problems > 0) notes.push_back(std::to_string(samples.problems) + " input problems counted (by reason above: a gap is counted, not skipped)");
-    std::cout << (json ? resolver::format_model_json(ex, do_explain, notes)
-                       : resolver::format_model_text(ex, do_explain, notes));
-    return 0;
-  }
+  if (auto code = check_arguments(a)) return *code;
+  return run_on_log(a);
 }
 
 }  // namespace

@@ -69,6 +69,7 @@ struct Options {
   std::uint64_t seed = 1;
   std::string iface = "can0";
   bool list_effects = false;
+  bool effects_markdown = false;
 };
 
 [[noreturn]] void fail(const std::string& message, int code = resolver::exit_code::kUsage) {
@@ -207,15 +208,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
   return c;
 }
 
-int run(int argc, char** argv) {
-  CLI::App app{
-      "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
-      "and write its CAN traffic (the default layout, docs/ARCHITECTURE.md section 4) as a candump -l log, with chosen sensor-chain effects.",
-      "resolver-sim"};  // the name in the usage line, not argv[0] (a build path)
-  app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText + "\n\n" +
-             resolver::format_effect_catalog());
-  app.set_version_flag("--version", resolver::version_line("resolver-sim"));
-  Options o;
+void add_options(CLI::App& app, Options& o) {
   app.add_option("--out,-o", o.out, "candump -l log file to write (required)");
   app.add_option("--rpm", o.rpm, "constant mechanical speed [r/min] (default 200)");
   app.add_option("--duration", o.duration, "run length with --rpm [s] (default 5)")->check(CLI::PositiveNumber);
@@ -239,11 +232,74 @@ int run(int argc, char** argv) {
   app.add_option("--truth", o.truth, "also write the true configuration and effect parameters as JSON");
   app.add_option("--config", o.config_file, "TOML file with the same options; the command line wins");
   app.add_flag("--list-effects", o.list_effects, "print the effect catalog and exit");
-  bool effects_markdown = false;
-  app.add_flag("--effects-markdown", effects_markdown, "print the effect catalog as Markdown (docs/EFFECTS.md) and exit");
+  app.add_flag("--effects-markdown", o.effects_markdown,
+               "print the effect catalog as Markdown (docs/EFFECTS.md) and exit");
+}
+
+/// A warning when the log has more frames per second than a real bus carries.
+void warn_if_over_bus_capacity(const SimConfig& config) {
+  const double fps = resolver::frames_per_second(config);
+  if (fps > kBusFramesPerSecond) {
+    fmt::print(stderr,
+               "resolver-sim: warning: {:.0f} frames/s exceed what a 1 Mbit/s classic CAN bus carries (~{:.0f}); "
+               "the log is fine, but replaying it in real time will not fit a real bus (lower --sample-rate or use "
+               "--no-reference)\n",
+               fps, kBusFramesPerSecond);
+  }
+}
+
+/// --truth FILE: the true configuration and effect parameters (exit 3 when it cannot be written).
+void write_truth(const resolver::BenchSimulator& sim, std::uint64_t total, const Options& o) {
+  std::ofstream truth(o.truth);
+  truth << resolver::sim_truth_json(sim.config(), total, o.out);
+  truth.close();
+  if (!truth) {
+    fail(fmt::format("--truth {}: cannot write the file; check the directory exists and is writable", o.truth),
+         resolver::exit_code::kIo);
+  }
+}
+
+/// Every sample's frames into the log (progress on stderr every 2 s), then the truth
+/// file and one summary line. A log that cannot be created or written throws
+/// std::system_error: exit 3.
+void write_log(resolver::BenchSimulator& sim, const Options& o) {
+  resolver::CandumpWriter writer(o.out);
+  resolver::SimSample s{};
+  std::vector<resolver::CanFrame> frames;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last_report = t0;
+  const std::uint64_t total = sim.total_samples();
+  while (sim.next(s)) {
+    frames.clear();
+    sim.append_frames(s, frames);
+    for (const resolver::CanFrame& f : frames) writer.write(f);
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_report > std::chrono::seconds(2)) {
+      last_report = now;
+      fmt::print(stderr, "resolver-sim: {:5.1f} % ({} of {} samples)\n", 100.0 * static_cast<double>(s.index + 1) /
+                 static_cast<double>(total), s.index + 1, total);
+    }
+  }
+  writer.close();
+  if (!o.truth.empty()) write_truth(sim, total, o);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  fmt::print(stderr, "resolver-sim: wrote {} frames ({} samples, {:.3g} s of bench time) to {} in {:.2f} s\n",
+             writer.frames_written(), total, sim.profile().duration(), o.out, wall);
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{
+      "resolver-sim: simulate the resolver bench (motor, resolver, R/D converter, inverter, reference encoder)\n"
+      "and write its CAN traffic (the default layout, docs/ARCHITECTURE.md section 4) as a candump -l log, with chosen sensor-chain effects.",
+      "resolver-sim"};  // the name in the usage line, not argv[0] (a build path)
+  app.footer(std::string(kExamples) + "\n" + resolver::exit_code::kHelpText + "\n\n" +
+             resolver::format_effect_catalog());
+  app.set_version_flag("--version", resolver::version_line("resolver-sim"));
+  Options o;
+  add_options(app, o);
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
 
-  if (effects_markdown) {
+  if (o.effects_markdown) {
     fmt::print("{}", resolver::effects_markdown());
     return 0;
   }
@@ -266,48 +322,8 @@ int run(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     fail(e.what());
   }
-  const double fps = resolver::frames_per_second(config);
-  if (fps > kBusFramesPerSecond) {
-    fmt::print(stderr,
-               "resolver-sim: warning: {:.0f} frames/s exceed what a 1 Mbit/s classic CAN bus carries (~{:.0f}); "
-               "the log is fine, but replaying it in real time will not fit a real bus (lower --sample-rate or use "
-               "--no-reference)\n",
-               fps, kBusFramesPerSecond);
-  }
-
-  // The log that cannot be created or written throws std::system_error: exit 3.
-  {
-    resolver::CandumpWriter writer(o.out);
-    resolver::SimSample s{};
-    std::vector<resolver::CanFrame> frames;
-    const auto t0 = std::chrono::steady_clock::now();
-    auto last_report = t0;
-    const std::uint64_t total = sim->total_samples();
-    while (sim->next(s)) {
-      frames.clear();
-      sim->append_frames(s, frames);
-      for (const resolver::CanFrame& f : frames) writer.write(f);
-      const auto now = std::chrono::steady_clock::now();
-      if (now - last_report > std::chrono::seconds(2)) {
-        last_report = now;
-        fmt::print(stderr, "resolver-sim: {:5.1f} % ({} of {} samples)\n", 100.0 * static_cast<double>(s.index + 1) /
-                   static_cast<double>(total), s.index + 1, total);
-      }
-    }
-    writer.close();
-    if (!o.truth.empty()) {
-      std::ofstream truth(o.truth);
-      truth << resolver::sim_truth_json(sim->config(), total, o.out);
-      truth.close();
-      if (!truth) {
-        fail(fmt::format("--truth {}: cannot write the file; check the directory exists and is writable", o.truth),
-             resolver::exit_code::kIo);
-      }
-    }
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    fmt::print(stderr, "resolver-sim: wrote {} frames ({} samples, {:.3g} s of bench time) to {} in {:.2f} s\n",
-               writer.frames_written(), total, sim->profile().duration(), o.out, wall);
-  }
+  warn_if_over_bus_capacity(config);
+  write_log(*sim, o);
   return 0;
 }
 

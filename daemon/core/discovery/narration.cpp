@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -165,8 +166,11 @@ std::vector<std::string> describe_failure(const PreparedLog& log, const ModelFit
   return out;
 }
 
-std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options,
-                           const std::string& name) {
+namespace {
+
+/// The terms a suggestion chooses from: the residual's strongest harmonics of theta and
+/// theta_m, a constant, their modulations by time and speed, and sign(omega).
+std::vector<std::string> term_dictionary(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
   const double se = amplitude_se(fit);
   const double floor = fit.noise_floor_rad;
   std::vector<std::string> dict;
@@ -218,15 +222,23 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
     if (varies(lo, hi, floor, options.explained_ratio)) modulated("omega");
   }
   if (fit.directions.size() == 2 && log.reference) dict.emplace_back("sign(omega)");
-  if (dict.empty()) return "";
-  // The envelopes: a time- or speed-varying gain or phase of the fundamental (a
-  // drifting alpha is a gain of the cos channel: t*cos(theta) on cos) that no
-  // position-error term describes, when the sin/cos signal fails too.
-  struct Block {
-    std::string name, signal;
-    std::vector<std::string> terms;
-  };
-  std::vector<Block> blocks{{name, "position_error", dict}};
+  return dict;
+}
+
+/// One [[model.custom]] block of a suggestion.
+struct SuggestedBlock {
+  std::string name, signal;
+  std::vector<std::string> terms;
+};
+
+/// The position-error block of the whole dictionary and, when the sin/cos signal fails
+/// too, the envelopes: a time- or speed-varying gain or phase of the fundamental (a
+/// drifting alpha is a gain of the cos channel: t*cos(theta) on cos) that no
+/// position-error term describes.
+std::vector<SuggestedBlock> candidate_blocks(const PreparedLog& log, const ModelFit& fit,
+                                             const DiscoveryOptions& options, const std::string& name,
+                                             const std::vector<std::string>& dict) {
+  std::vector<SuggestedBlock> blocks{{name, "position_error", dict}};
   bool sincos_fails = false;
   for (const SignalResidual& r : fit.signals) {
     if (r.signal == "sin_cos" && r.rms > options.explained_ratio * r.floor) sincos_fails = true;
@@ -238,20 +250,26 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
     }
     // The cos channel against the sin channel: its gain and its phase (a common
     // gain is the amplitude, a common rotation a position error: covered already).
-    Block env{name + "_cos", "cos", {}};
+    SuggestedBlock env{name + "_cos", "cos", {}};
     for (const std::string& m : by) {
       env.terms.push_back(m + "*cos(theta)");
       env.terms.push_back(m + "*sin(theta)");
     }
     if (!env.terms.empty()) blocks.push_back(std::move(env));
   }
-  // Forward selection on one pass of sufficient statistics: the model's columns
-  // plus every dictionary term's, accumulated once; then, term by term, the one
-  // that lowers the weighted residual most joins, while it lowers the BIC by more
-  // than 10 (Kass & Raftery: very strong evidence). Collinear terms (a cos-gain drift
-  // is also t sin 2theta in the angle) never both join.
+  return blocks;
+}
+
+/// Forward selection on one pass of sufficient statistics: the model's columns
+/// plus every dictionary term's, accumulated once; then, term by term, the one
+/// that lowers the weighted residual most joins, while it lowers the BIC by more
+/// than 10 (Kass & Raftery: very strong evidence). Collinear terms (a cos-gain drift
+/// is also t sin 2theta in the angle) never both join.
+/// Per block (those with terms), which terms joined; nullopt when the model alone has no solution.
+std::optional<std::vector<std::vector<bool>>> select_terms(const PreparedLog& log, const ModelFit& fit,
+                                                           const std::vector<SuggestedBlock>& blocks) {
   std::vector<CustomEffectSpec> specs;
-  for (const Block& bl : blocks) {
+  for (const SuggestedBlock& bl : blocks) {
     if (!bl.terms.empty()) specs.push_back({bl.name, bl.signal, bl.terms, "suggested by resolver-model explain", "suggestion"});
   }
   const CustomEffects customs(specs);
@@ -267,7 +285,7 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
   accumulate(d, log.rows, floors, stats);
   std::vector<int> chosen = model_columns(d);
   StepSolution current = solve_step(stats.all, floors, chosen);
-  if (!current.ok) return "";
+  if (!current.ok) return std::nullopt;
   std::vector<std::vector<bool>> keep(customs.all().size());
   for (std::size_t bi = 0; bi < customs.all().size(); ++bi) keep[bi].assign(customs.all()[bi]->params().size(), false);
   for (;;) {
@@ -295,6 +313,12 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
     keep[best_block][best_term] = true;
     current = best;
   }
+  return keep;
+}
+
+/// The blocks as TOML, each with the terms that joined; blocks left without terms are left out.
+std::string custom_blocks_toml(std::vector<SuggestedBlock> blocks, const std::vector<std::vector<bool>>& keep,
+                               const ModelFit& fit) {
   for (std::size_t bi = 0; bi < blocks.size() && bi < keep.size(); ++bi) {
     std::vector<std::string> kept;
     for (std::size_t ti = 0; ti < blocks[bi].terms.size(); ++ti) {
@@ -303,7 +327,7 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
     blocks[bi].terms = kept;
   }
   std::string toml;
-  for (const Block& bl : blocks) {
+  for (const SuggestedBlock& bl : blocks) {
     const std::vector<std::string>& kept = bl.terms;
     if (kept.empty()) continue;
     toml += fmt::format(
@@ -317,6 +341,18 @@ std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const Di
     toml += "]\n";
   }
   return toml;
+}
+
+}  // namespace
+
+std::string suggest_custom(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options,
+                           const std::string& name) {
+  const std::vector<std::string> dict = term_dictionary(log, fit, options);
+  if (dict.empty()) return "";
+  const std::vector<SuggestedBlock> blocks = candidate_blocks(log, fit, options, name, dict);
+  const auto keep = select_terms(log, fit, blocks);
+  if (!keep) return "";
+  return custom_blocks_toml(blocks, *keep, fit);
 }
 
 }  // namespace resolver

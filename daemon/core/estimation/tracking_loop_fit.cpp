@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -159,65 +160,46 @@ TrackingLoopEstimate failed(TrackingLoopEstimate e, std::string why) {
   return e;
 }
 
-}  // namespace
-
-std::complex<double> tracking_loop_response(const TrackingLoopConfig& loop, double omega) {
-  if (!loop.active()) return {1.0, 0.0};
-  return loop_response(loop.omega_n, loop.zeta, omega).h;
-}
-
-TrackingLoopEstimate fit_tracking_loop(std::complex<double> static_coefficient,
-                                       std::span<const RippleObservation> observations,
-                                       const TrackingLoopFitConfig& config) {
-  return fit_tracking_loop(StaticRipple{static_coefficient, 0.0}, observations, config);
-}
-
-TrackingLoopEstimate fit_tracking_loop(const StaticRipple& static_ripple,
-                                       std::span<const RippleObservation> observations,
-                                       const TrackingLoopFitConfig& config) {
-  validate(config);
-  TrackingLoopEstimate est;
-  est.order = config.order;
-  est.static_coefficient = static_ripple.value;
-  est.omega_n = std::numeric_limits<double>::quiet_NaN();
-  est.zeta = std::numeric_limits<double>::quiet_NaN();
-
+/// The problem of the inputs, its mode from the static ripple's std error.
+Problem make_problem(const StaticRipple& static_ripple, std::span<const RippleObservation> observations, int order) {
   Problem p;
   p.obs = observations;
-  p.order = config.order;
+  p.order = order;
   p.c0 = static_ripple.value;
   p.sigma_c = static_ripple.std_error;
-  if (!(static_ripple.std_error >= 0.0) || !std::isfinite(static_ripple.value.real()) ||
-      !std::isfinite(static_ripple.value.imag())) {
-    return failed(est, "static ripple: value must be finite and std_error >= 0 (0 exact, inf free)");
-  }
   p.mode = static_ripple.std_error == 0.0 ? StaticMode::kExact
            : std::isinf(static_ripple.std_error) ? StaticMode::kFree
                                                   : StaticMode::kPrior;
-  if (p.mode != StaticMode::kFree && std::abs(p.c0) == 0.0) {
-    return failed(est, "static ripple is zero: the loop cannot be seen through a zero ripple");
-  }
-  double f_min = kInf, f_max = 0.0;
+  return p;
+}
+
+/// The observed ripple frequencies n |omega_e| [rad/s]: the lowest non-zero one and the
+/// highest; or why an observation cannot be used.
+struct ObservedFrequencies {
+  double lo = kInf, hi = 0.0;
+  std::string problem;  ///< empty when every observation is usable
+};
+
+ObservedFrequencies observed_frequencies(std::span<const RippleObservation> observations, int order) {
+  ObservedFrequencies f;
   for (std::size_t k = 0; k < observations.size(); ++k) {
     const auto& o = observations[k];
     if (!std::isfinite(o.omega_e) || !std::isfinite(o.measured.real()) || !std::isfinite(o.measured.imag()) ||
         !(o.std_error > 0.0) || !std::isfinite(o.std_error)) {
-      return failed(est, "observation " + std::to_string(k) +
-                             ": omega_e and measured must be finite and std_error finite and > 0");
+      f.problem = "observation " + std::to_string(k) +
+                  ": omega_e and measured must be finite and std_error finite and > 0";
+      return f;
     }
-    const double f = std::abs(config.order * o.omega_e);
-    if (f > 0.0) f_min = std::min(f_min, f);
-    f_max = std::max(f_max, f);
+    const double freq = std::abs(order * o.omega_e);
+    if (freq > 0.0) f.lo = std::min(f.lo, freq);
+    f.hi = std::max(f.hi, freq);
   }
-  est.dof = static_cast<int>(p.residuals() - p.params());
-  if (est.dof < 1) {
-    return failed(est, std::to_string(observations.size()) + " observations give " + std::to_string(est.dof) +
-                           " degrees of freedom: need at least " +
-                           (p.mode == StaticMode::kFree ? "3" : "2") + " speeds");
-  }
-  if (!(f_max > 0.0)) return failed(est, "all observations at standstill: the ripple frequency is zero");
+  return f;
+}
 
-  // Coarse grid (log spaced) for the starting point.
+/// The starting point: the best of a coarse log-spaced grid of (omega_n, zeta) around the
+/// observed frequencies, C_static solved linearly at each point when it is fitted.
+Eigen::VectorXd grid_start(const Problem& p, double f_min, double f_max) {
   constexpr int kGridWn = 81, kGridZeta = 41;
   const double wn_lo = std::log(0.05 * f_min), wn_hi = std::log(20.0 * f_max);
   const double z_lo = std::log(0.05), z_hi = std::log(5.0);
@@ -240,8 +222,20 @@ TrackingLoopEstimate fit_tracking_loop(const StaticRipple& static_ripple,
       }
     }
   }
+  return q;
+}
 
-  // Levenberg-Marquardt (Marquardt's diagonal scaling).
+/// Where Levenberg-Marquardt stopped: the parameters q, the Jacobian there and the cost.
+struct Minimum {
+  Eigen::VectorXd q;
+  Eigen::MatrixXd jac;
+  double cost = 0.0;
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// Levenberg-Marquardt (Marquardt's diagonal scaling) from q.
+Minimum levenberg_marquardt(const Problem& p, Eigen::VectorXd q, int max_iterations) {
   Eigen::VectorXd r, r_new;
   Eigen::MatrixXd jac;
   p.evaluate(q, r, &jac);
@@ -249,7 +243,7 @@ TrackingLoopEstimate fit_tracking_loop(const StaticRipple& static_ripple,
   double lambda = 1e-3;
   bool converged = false;
   int it = 0;
-  for (; it < config.max_iterations && !converged; ++it) {
+  for (; it < max_iterations && !converged; ++it) {
     const Eigen::MatrixXd a = jac.transpose() * jac;
     const Eigen::VectorXd g = jac.transpose() * r;
     for (;;) {
@@ -275,30 +269,82 @@ TrackingLoopEstimate fit_tracking_loop(const StaticRipple& static_ripple,
       }
     }
   }
-  est.iterations = it;
-  est.omega_n = std::exp(q(0));
-  est.zeta = std::exp(q(1));
-  est.static_coefficient = p.coefficient(q);
-  est.chi2 = cost;
-  est.residual = cost / est.dof;
-  if (!converged) return failed(est, "Levenberg-Marquardt did not converge in max_iterations");
+  return {std::move(q), std::move(jac), cost, it, converged};
+}
 
-  // Covariance: (J^T J)^-1 x max(1, reduced chi^2), mapped from ln-parameters.
+/// Covariance: (J^T J)^-1 x max(1, reduced chi^2), mapped from ln-parameters to
+/// (omega_n, zeta[, Re C, Im C]); nullopt when the normal matrix is singular.
+std::optional<Eigen::MatrixXd> parameter_covariance(const Problem& p, const Eigen::MatrixXd& jac, double omega_n,
+                                                    double zeta, double reduced_chi2) {
   const Eigen::MatrixXd a = jac.transpose() * jac;
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(a);
   if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() > 1e-13 * eig.eigenvalues().maxCoeff())) {
-    return failed(est, "singular normal matrix: (omega_n, zeta) not identifiable from these speeds");
+    return std::nullopt;
   }
   const Eigen::MatrixXd cov_q = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() *
-                                eig.eigenvectors().transpose() * std::max(1.0, est.residual);
+                                eig.eigenvectors().transpose() * std::max(1.0, reduced_chi2);
   Eigen::VectorXd scale = Eigen::VectorXd::Ones(p.params());
-  scale(0) = est.omega_n;
-  scale(1) = est.zeta;
-  const Eigen::MatrixXd cov = scale.asDiagonal() * cov_q * scale.asDiagonal();
-  est.covariance.topLeftCorner(p.params(), p.params()) = cov;
-  est.omega_n_stderr = std::sqrt(cov(0, 0));
-  est.zeta_stderr = std::sqrt(cov(1, 1));
-  est.static_stderr = p.params() == 4 ? std::sqrt(0.5 * (cov(2, 2) + cov(3, 3))) : 0.0;
+  scale(0) = omega_n;
+  scale(1) = zeta;
+  return Eigen::MatrixXd(scale.asDiagonal() * cov_q * scale.asDiagonal());
+}
+
+}  // namespace
+
+std::complex<double> tracking_loop_response(const TrackingLoopConfig& loop, double omega) {
+  if (!loop.active()) return {1.0, 0.0};
+  return loop_response(loop.omega_n, loop.zeta, omega).h;
+}
+
+TrackingLoopEstimate fit_tracking_loop(std::complex<double> static_coefficient,
+                                       std::span<const RippleObservation> observations,
+                                       const TrackingLoopFitConfig& config) {
+  return fit_tracking_loop(StaticRipple{static_coefficient, 0.0}, observations, config);
+}
+
+TrackingLoopEstimate fit_tracking_loop(const StaticRipple& static_ripple,
+                                       std::span<const RippleObservation> observations,
+                                       const TrackingLoopFitConfig& config) {
+  validate(config);
+  TrackingLoopEstimate est;
+  est.order = config.order;
+  est.static_coefficient = static_ripple.value;
+  est.omega_n = std::numeric_limits<double>::quiet_NaN();
+  est.zeta = std::numeric_limits<double>::quiet_NaN();
+
+  const Problem p = make_problem(static_ripple, observations, config.order);
+  if (!(static_ripple.std_error >= 0.0) || !std::isfinite(static_ripple.value.real()) ||
+      !std::isfinite(static_ripple.value.imag())) {
+    return failed(est, "static ripple: value must be finite and std_error >= 0 (0 exact, inf free)");
+  }
+  if (p.mode != StaticMode::kFree && std::abs(p.c0) == 0.0) {
+    return failed(est, "static ripple is zero: the loop cannot be seen through a zero ripple");
+  }
+  const ObservedFrequencies f = observed_frequencies(observations, config.order);
+  if (!f.problem.empty()) return failed(est, f.problem);
+  est.dof = static_cast<int>(p.residuals() - p.params());
+  if (est.dof < 1) {
+    return failed(est, std::to_string(observations.size()) + " observations give " + std::to_string(est.dof) +
+                           " degrees of freedom: need at least " +
+                           (p.mode == StaticMode::kFree ? "3" : "2") + " speeds");
+  }
+  if (!(f.hi > 0.0)) return failed(est, "all observations at standstill: the ripple frequency is zero");
+
+  const Minimum m = levenberg_marquardt(p, grid_start(p, f.lo, f.hi), config.max_iterations);
+  est.iterations = m.iterations;
+  est.omega_n = std::exp(m.q(0));
+  est.zeta = std::exp(m.q(1));
+  est.static_coefficient = p.coefficient(m.q);
+  est.chi2 = m.cost;
+  est.residual = m.cost / est.dof;
+  if (!m.converged) return failed(est, "Levenberg-Marquardt did not converge in max_iterations");
+
+  const std::optional<Eigen::MatrixXd> cov = parameter_covariance(p, m.jac, est.omega_n, est.zeta, est.residual);
+  if (!cov) return failed(est, "singular normal matrix: (omega_n, zeta) not identifiable from these speeds");
+  est.covariance.topLeftCorner(p.params(), p.params()) = *cov;
+  est.omega_n_stderr = std::sqrt((*cov)(0, 0));
+  est.zeta_stderr = std::sqrt((*cov)(1, 1));
+  est.static_stderr = p.params() == 4 ? std::sqrt(0.5 * ((*cov)(2, 2) + (*cov)(3, 3))) : 0.0;
   if (!std::isfinite(est.omega_n) || !std::isfinite(est.zeta) || !std::isfinite(est.omega_n_stderr)) {
     return failed(est, "non-finite estimate");
   }
