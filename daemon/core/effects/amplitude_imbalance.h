@@ -18,7 +18,7 @@
 namespace resolver {
 
 struct AmplitudeImbalance {
-  /// [1] relative gain error of the cos channel; must be > -1.
+  /// [1] relative gain error of the cos channel (range: kParams in amplitude_imbalance.cpp).
   double alpha = 0.0;
   [[nodiscard]] bool active() const { return alpha != 0.0; }
 };

@@ -40,7 +40,7 @@ struct CurrentGainMismatch {
 /// [A] amplitude A_2 of the 2x theta_e ripple on i_d (and on i_q) at current (i_d, i_q) [A].
 [[nodiscard]] double current_gain_mismatch_ripple_2x(const CurrentGainMismatch& p, double i_d, double i_q);
 
-/// Compensation: undoes the gains on measured currents [A]. Gains must be > -1.
+/// Compensation: undoes the gains on measured currents [A] (gains: kParams in current_gain_mismatch.cpp).
 [[nodiscard]] PhaseCurrents compensate_current_gain_mismatch(const CurrentGainMismatch& p,
                                                              const PhaseCurrents& measured);
 

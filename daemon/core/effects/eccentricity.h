@@ -24,7 +24,7 @@
 namespace resolver {
 
 struct Eccentricity {
-  double e = 0.0;      ///< [rad, mechanical] amplitude of the 1x angle error; |e| < 1
+  double e = 0.0;      ///< [rad, mechanical] amplitude of the 1x angle error (range: kParams in eccentricity.cpp)
   double phase = 0.0;  ///< [rad, mechanical] phase of the 1x angle error
   [[nodiscard]] bool active() const { return e != 0.0; }
 };

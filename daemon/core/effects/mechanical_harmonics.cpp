@@ -19,14 +19,17 @@ constexpr std::array<std::string_view, 2 * kMaxMechanicalOrder> kNames{
     "a12", "b12", "a13", "b13", "a14", "b14", "a15", "b15", "a16", "b16"};
 
 /// Parameter order a1, b1, a2, b2, ...; a model that names the effect alone fits order 2.
+/// Range: the seen angle stays monotone while sum n (|a_n| + |b_n|) < 1 (validate()),
+/// so one order alone may reach 0.99 / n (and 0.5 rad at most, as before for n = 1, 2).
 constexpr std::array<ParamInfo, 2 * kMaxMechanicalOrder> make_params() {
   std::array<ParamInfo, 2 * kMaxMechanicalOrder> out{};
   for (std::size_t i = 0; i < out.size(); ++i) {
     const int order = static_cast<int>(i / 2) + 1;
+    const double limit = std::min(0.5, 0.99 / order);
     out[i] = ParamInfo{.name = kNames[i], .unit = "[rad]",
                        .description = i % 2 == 0 ? "sin(n theta_m) part of the seen-angle error (mechanical rad)"
                                                  : "cos(n theta_m) part of the seen-angle error (mechanical rad)",
-                       .min = -0.5, .max = 0.5, .listed = order <= 2, .default_fit = order == 2};
+                       .min = -limit, .max = limit, .listed = order <= 2, .default_fit = order == 2};
   }
   return out;
 }

@@ -14,8 +14,8 @@
 namespace resolver {
 
 struct Offsets {
-  double o_s = 0.0;  ///< [fraction of amplitude] offset of the sin channel; |o_s| < 1
-  double o_c = 0.0;  ///< [fraction of amplitude] offset of the cos channel; |o_c| < 1
+  double o_s = 0.0;  ///< [fraction of amplitude] offset of the sin channel (range: kParams in offsets.cpp)
+  double o_c = 0.0;  ///< [fraction of amplitude] offset of the cos channel (range: kParams in offsets.cpp)
   [[nodiscard]] bool active() const { return o_s != 0.0 || o_c != 0.0; }
 };
 

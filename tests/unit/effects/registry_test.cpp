@@ -448,5 +448,24 @@ TEST(EffectRegistry, ResolverSimListsTheRegistry) {
   EXPECT_EQ(md.out, effects_markdown());
 }
 
+// Issue 22: a parameter's range is listed once, in its ParamInfo. An effect's own
+// validate() checks only what one parameter's range cannot say (a whole set, a pair),
+// so every single value in the listed range, the others neutral, is valid.
+TEST(EffectRegistry, ValidateAcceptsEveryListedRangeEnd) {
+  for (const Effect* e : effect_registry()) {
+    std::vector<double> v;
+    for (const ParamInfo& p : e->params()) v.push_back(p.neutral);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const ParamInfo& p = e->params()[i];
+      for (const double x : {p.min, p.max}) {
+        std::vector<double> w = v;
+        w[i] = x;
+        EXPECT_NO_THROW(e->validate(w)) << e->name() << "." << p.name << " = " << x
+                                        << " is in its listed range but refused";
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace resolver
