@@ -88,12 +88,12 @@ class SinCosOnly(unittest.TestCase):
                 self.assertRegex(out, r"compensated from \d\.\d{3} s: \d+ of 30000 samples published compensated")
 
     def test_standard_errors_name_their_basis(self):
-        # The final estimate is the last model window's fit, not the whole run's: said once,
-        # in the text and the JSON alike.
+        # The final estimate is the whole run's (every window's model combined, issue 26):
+        # said once, in the text and the JSON alike.
         out, rep = replay(self.long)
         basis = rep["std_error_basis"]
-        self.assertRegex(basis, r"^the last model window's fit alone \(\d+ revolutions\), not the whole run; "
-                                r"(robust: revolution-to-revolution spread of |formal: residual variance \()\d+ revolutions")
+        self.assertRegex(basis, r"^the whole run: \d+ windows \(\d+ revolutions\) combined, inverse-variance weighted; "
+                                r"(robust: window-to-window spread of \d+ windows|formal: from the windows' own errors)")
         self.assertIn("             +- standard error: " + basis + "\n", out)
         _, rep = replay(self.long, '[estimator]\nmethod = "hwang_integral"\n')
         self.assertRegex(rep["std_error_basis"], r"^robust: revolution-to-revolution spread of \d+ revolutions \(the whole run\)$")
