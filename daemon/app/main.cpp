@@ -246,13 +246,17 @@ static int run(int argc, char** argv) {
                   << " records no layout (written by an older resolverd); it is applied unchecked and the next save "
                      "records this run's layout\n";
       } else if (saved.layout_id != here.id) {
-        std::string moved_to;
-        const auto not_moved = set_calibration_aside(state_dir, "refused-" + utc_now(true), moved_to);
+        std::string aside;
+        try {
+          aside = "kept aside as " + set_calibration_aside(state_dir, "refused-" + utc_now(true));
+        } catch (const std::exception& e) {
+          aside = std::string("and could not be kept aside (") + e.what() + ")";
+        }
         std::cerr << "resolverd: the saved calibration " << calibration_path(state_dir) << " was learned on another layout ("
                   << saved.layout << ", layout id " << saved.layout_id << ", from " << saved.source << " at "
                   << saved.saved_at << ") than this run's (" << here.description << ", layout id " << here.id
                   << "); it is NOT applied, "
-                  << (not_moved ? "and could not be kept aside (" + *not_moved + ")" : "kept aside as " + moved_to)
+                  << aside
                   << "; learning from scratch\n";
         loaded.status = LoadResult::Status::kMissing;
       }
@@ -353,13 +357,14 @@ static int run(int argc, char** argv) {
       pv.source = info.source;
       pv.saved_at = utc_now();
       pv.program = version_line("resolverd");
-      if (auto problem = save_calibration(state_dir, cal)) {
-        info.calibration.reason = *problem;
-        save_failed = true;
-        std::cerr << "resolverd: " << *problem << " (exit code 3)\n";
-      } else {
+      try {
+        save_calibration(state_dir, cal);
         info.calibration.saved = true;
         std::cerr << "resolverd: calibration saved to " << info.calibration.path << "\n";
+      } catch (const std::exception& e) {  // InputError or IoError: either way nothing was saved
+        info.calibration.reason = e.what();
+        save_failed = true;
+        std::cerr << "resolverd: " << e.what() << " (exit code 3)\n";
       }
     }
   } else {

@@ -1,4 +1,5 @@
 #include "daemon/service/calibration_store.h"
+#include "daemon/service/program_errors.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -112,30 +113,30 @@ std::string calibration_path(const std::string& dir) {
   return dir + "/" + kCalibrationFileName;
 }
 
-std::optional<std::string> format_calibration(const Calibration& c, std::string& text) {
+std::string format_calibration(const Calibration& c) {
   if (c.p_r < 1 || c.p_r > kMaxPolePairs || c.p < 1 || c.p > kMaxPolePairs) {
-    return "cannot save the calibration: pole pairs p_r=" + std::to_string(c.p_r) + ", p=" + std::to_string(c.p) +
-           " are outside 1..255; the bench identity must come from BENCH_INFO or the config";
+    throw InputError(Fault::kData, "cannot save the calibration: pole pairs p_r=" + std::to_string(c.p_r) + ", p=" + std::to_string(c.p) +
+           " are outside 1..255; the bench identity must come from BENCH_INFO or the config");
   }
   if (c.method.find_first_of("\r\n") != std::string::npos) {
-    return "cannot save the calibration: the method name contains a line break; use a one-line name";
+    throw InputError(Fault::kData, "cannot save the calibration: the method name contains a line break; use a one-line name");
   }
   if (c.samples < 0) {
-    return "cannot save the calibration: samples=" + std::to_string(c.samples) + " is negative";
+    throw InputError(Fault::kData, "cannot save the calibration: samples=" + std::to_string(c.samples) + " is negative");
   }
   std::set<std::string> seen;
   for (const auto& param : c.params) {
     if (!valid_name(param.name)) {
-      return "cannot save the calibration: parameter name '" + printable(param.name) +
-             "' is empty or has characters outside [A-Za-z0-9_.:-]; rename the parameter";
+      throw InputError(Fault::kData, "cannot save the calibration: parameter name '" + printable(param.name) +
+             "' is empty or has characters outside [A-Za-z0-9_.:-]; rename the parameter");
     }
     if (!seen.insert(param.name).second) {
-      return "cannot save the calibration: parameter '" + param.name + "' appears twice";
+      throw InputError(Fault::kData, "cannot save the calibration: parameter '" + param.name + "' appears twice");
     }
     if (!std::isfinite(param.value) || std::isinf(param.std_error) || param.std_error < 0.0) {
-      return "cannot save the calibration: parameter '" + param.name + "' has value " + shortest(param.value) +
+      throw InputError(Fault::kData, "cannot save the calibration: parameter '" + param.name + "' has value " + shortest(param.value) +
              " and std_error " + shortest(param.std_error) +
-             "; only finite values and a finite std_error >= 0 are saved (the estimate has not converged?)";
+             "; only finite values and a finite std_error >= 0 are saved (the estimate has not converged?)");
     }
   }
   std::string body;
@@ -150,7 +151,7 @@ std::optional<std::string> format_calibration(const Calibration& c, std::string&
     std::string line = "model";
     for (const auto& m : c.model) {
       if (m.empty() || m.find_first_of(" \t\r\n") != std::string::npos) {
-        return "cannot save the calibration: effect reference '" + printable(m) + "' is empty or contains blanks";
+        throw InputError(Fault::kData, "cannot save the calibration: effect reference '" + printable(m) + "' is empty or contains blanks");
       }
       line += " " + m;
     }
@@ -160,7 +161,7 @@ std::optional<std::string> format_calibration(const Calibration& c, std::string&
     std::string line = "custom " + cu.name + "\t" + cu.signal;
     for (const auto& t : cu.terms) {
       if (t.find_first_of("\t\r\n") != std::string::npos) {
-        return "cannot save the calibration: a term of custom effect '" + printable(cu.name) + "' contains a tab or line break";
+        throw InputError(Fault::kData, "cannot save the calibration: a term of custom effect '" + printable(cu.name) + "' contains a tab or line break");
       }
       line += "\t" + t;
     }
@@ -179,21 +180,17 @@ std::optional<std::string> format_calibration(const Calibration& c, std::string&
   }
   if (!pv.layout_id.empty()) {
     if (pv.layout_id.find_first_of(" \t\r\n") != std::string::npos) {
-      return "cannot save the calibration: layout id '" + printable(pv.layout_id) + "' contains blanks";
+      throw InputError(Fault::kData, "cannot save the calibration: layout id '" + printable(pv.layout_id) + "' contains blanks");
     }
     body += "layout " + pv.layout_id + " " + one_line(pv.layout) + "\n";
   }
   char crc[16];
   std::snprintf(crc, sizeof crc, "%08x", static_cast<unsigned>(crc32_ieee(body)));
-  text = body + std::string(kChecksumKey) + crc + "\n";
-  return std::nullopt;
+  return body + std::string(kChecksumKey) + crc + "\n";
 }
 
-std::optional<Calibration> parse_calibration(const std::string& text, const std::string& where, std::string& problem) {
-  auto fail = [&](const std::string& why) -> std::optional<Calibration> {
-    problem = where + ": " + why;
-    return std::nullopt;
-  };
+Calibration parse_calibration(const std::string& text, const std::string& where) {
+  auto fail = [&](const std::string& why) -> Calibration { throw InputError(Fault::kData, why, Where::at_file(where)); };
   if (text.empty()) return fail("empty file (an interrupted write by an old version?); it is ignored");
 
   // Identity and version first, so a foreign or future file is named as such
@@ -345,13 +342,11 @@ std::optional<Calibration> parse_calibration(const std::string& text, const std:
     return fail(std::string("the bench identity is incomplete (missing ") +
                 (!have_p_r ? "p_r" : !have_p ? "p" : !have_method ? "method" : "samples") + "); ignored");
   }
-  problem.clear();
   return c;
 }
 
-std::optional<std::string> save_calibration(const std::string& dir, const Calibration& calibration) {
-  std::string text;
-  if (auto bad = format_calibration(calibration, text)) return bad;
+void save_calibration(const std::string& dir, const Calibration& calibration) {
+  const std::string text = format_calibration(calibration);
   const std::string final_path = calibration_path(dir);
   const std::string temp_path = final_path + ".tmp";
   const std::string advice =
@@ -362,37 +357,36 @@ std::optional<std::string> save_calibration(const std::string& dir, const Calibr
   };
 
   const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return step_failed("creating", temp_path, errno);
+  if (fd < 0) throw IoError(step_failed("creating", temp_path, errno));
   if (!write_all(fd, text)) {
     const int err = errno;
     ::close(fd);
     ::unlink(temp_path.c_str());
-    return step_failed("writing", temp_path, err);
+    throw IoError(step_failed("writing", temp_path, err));
   }
   if (::fsync(fd) != 0) {
     const int err = errno;
     ::close(fd);
     ::unlink(temp_path.c_str());
-    return step_failed("fsync of", temp_path, err);
+    throw IoError(step_failed("fsync of", temp_path, err));
   }
   if (::close(fd) != 0) {
     const int err = errno;
     ::unlink(temp_path.c_str());
-    return step_failed("closing", temp_path, err);
+    throw IoError(step_failed("closing", temp_path, err));
   }
   if (::rename(temp_path.c_str(), final_path.c_str()) != 0) {
     const int err = errno;
     ::unlink(temp_path.c_str());
-    return step_failed("renaming the temp file over", final_path, err);
+    throw IoError(step_failed("renaming the temp file over", final_path, err));
   }
   // Make the rename itself durable.
   const int dfd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd < 0) return step_failed("opening the directory", dir, errno);
+  if (dfd < 0) throw IoError(step_failed("opening the directory", dir, errno));
   const int sync_rc = ::fsync(dfd);
   const int sync_err = errno;
   ::close(dfd);
-  if (sync_rc != 0) return step_failed("fsync of the directory", dir, sync_err);
-  return std::nullopt;
+  if (sync_rc != 0) throw IoError(step_failed("fsync of the directory", dir, sync_err));
 }
 
 LoadResult load_calibration(const std::string& dir) {
@@ -444,7 +438,11 @@ LoadResult load_calibration(const std::string& dir) {
   }
   ::close(fd);
   if (problem.empty()) {
-    result.calibration = parse_calibration(text, path, problem);
+    try {
+      result.calibration = parse_calibration(text, path);
+    } catch (const InputError& e) {
+      problem = e.what();
+    }
   }
   if (result.calibration) {
     result.status = LoadResult::Status::kLoaded;
@@ -456,14 +454,11 @@ LoadResult load_calibration(const std::string& dir) {
   return result;
 }
 
-std::optional<std::string> set_calibration_aside(const std::string& dir, const std::string& tag, std::string& moved_to) {
+std::string set_calibration_aside(const std::string& dir, const std::string& tag) {
   const std::string from = calibration_path(dir);
   const std::string to = from + "." + tag;
-  if (::rename(from.c_str(), to.c_str()) != 0) {
-    return "cannot move " + from + " aside to " + to + ": " + errno_text(errno);
-  }
-  moved_to = to;
-  return std::nullopt;
+  if (::rename(from.c_str(), to.c_str()) != 0) throw IoError("cannot move " + from + " aside to " + to + ": " + errno_text(errno));
+  return to;
 }
 
 }  // namespace resolver

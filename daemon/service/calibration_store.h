@@ -93,20 +93,26 @@ inline constexpr int kCalibrationFormatVersion = 3;
 /// Full path of the calibration file in `dir`.
 std::string calibration_path(const std::string& dir);
 
-/// Serialises `calibration` in format version 3 (with its checksum line).
-/// Returns an error text instead if a field cannot be written (bad name,
-/// non-finite value, p_r/p out of range, newline in method).
-std::optional<std::string> format_calibration(const Calibration& calibration, std::string& text);
+// Errors (the one rule, program_errors.h): a calibration that cannot be written or a
+// file that cannot be read as one is InputError (Fault::kData) naming the field or the
+// file and line; a failed file operation is IoError (a std::system_error: exit 3),
+// naming the path, the step, the errno text and what to do. Only load_calibration,
+// which runs at every start, reports instead of throwing (LoadResult).
 
-/// Parses file contents; `where` names the source in messages. On failure
-/// returns nullopt and sets `problem` to the reason.
-std::optional<Calibration> parse_calibration(const std::string& text, const std::string& where, std::string& problem);
+/// Serialises `calibration` in format version 3 (with its checksum line). Throws
+/// InputError when a field cannot be written (bad name, non-finite value, p_r/p out
+/// of range, newline in method).
+[[nodiscard]] std::string format_calibration(const Calibration& calibration);
+
+/// Parses file contents; `where` names the source in messages. Throws InputError
+/// (Fault::kData, Where::at_file(where)) saying why the text is not a calibration.
+[[nodiscard]] Calibration parse_calibration(const std::string& text, const std::string& where);
 
 /// Writes `calibration` atomically to calibration_path(dir). `dir` must exist
-/// (systemd's StateDirectory= creates it). Returns nullopt on success or an
-/// error text naming the path, the failing step, errno text and what to do.
-/// On failure the previous file, if any, is untouched.
-std::optional<std::string> save_calibration(const std::string& dir, const Calibration& calibration);
+/// (systemd's StateDirectory= creates it). Throws like format_calibration, or
+/// IoError naming the path, the failing step, errno text and what to do; on
+/// failure the previous file, if any, is untouched.
+void save_calibration(const std::string& dir, const Calibration& calibration);
 
 struct LoadResult {
   enum class Status {
@@ -125,8 +131,8 @@ LoadResult load_calibration(const std::string& dir);
 
 /// Renames calibration_path(dir) to `<that path>.<tag>` (e.g. tag "refused-20261126T014432Z"),
 /// so a refused file is kept for a person to look at and the next save does not
-/// overwrite it. Returns nullopt and sets `moved_to`, or an error text naming both paths.
-std::optional<std::string> set_calibration_aside(const std::string& dir, const std::string& tag, std::string& moved_to);
+/// overwrite it. Returns the new path; throws IoError naming both paths.
+std::string set_calibration_aside(const std::string& dir, const std::string& tag);
 
 /// CRC-32 (IEEE 802.3, reflected poly 0xEDB88320, init and final xor
 /// 0xFFFFFFFF); crc32("123456789") == 0xCBF43926.

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "daemon/service/calibration_store.h"
+#include "daemon/service/program_errors.h"
 #include "daemon/service/state_dir_lock.h"
 
 namespace resolver {
@@ -76,11 +77,18 @@ Calibration sample_calibration() {
   return c;
 }
 
-std::string formatted(const Calibration& c) {
-  std::string text;
-  const auto bad = format_calibration(c, text);
-  EXPECT_FALSE(bad) << *bad;
-  return text;
+std::string formatted(const Calibration& c) { return format_calibration(c); }
+
+/// What `f` threw as an E ("" and a test failure when it threw nothing).
+template <class E, class F>
+std::string thrown(F f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "nothing thrown";
+  return "";
 }
 
 /// Replaces the checksum line so a hand-edited text is internally consistent.
@@ -119,8 +127,7 @@ TEST(Crc32, CheckValue) {
 TEST(CalibrationStore, RoundTripIsExact) {
   TempDir dir;
   const Calibration c = sample_calibration();
-  const auto err = save_calibration(dir.path(), c);
-  ASSERT_FALSE(err) << *err;
+  ASSERT_NO_THROW(save_calibration(dir.path(), c));
   const LoadResult r = load_calibration(dir.path());
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
   ASSERT_TRUE(r.calibration);
@@ -150,7 +157,7 @@ TEST(CalibrationStore, RandomizedRoundTrip) {
       c.params.push_back(param("effect_" + std::to_string(i) + ".k", std::ldexp(mantissa(rng), exponent(rng)),
                                std::fabs(std::ldexp(mantissa(rng), exponent(rng)))));
     }
-    ASSERT_FALSE(save_calibration(dir.path(), c));
+    ASSERT_NO_THROW(save_calibration(dir.path(), c));
     const LoadResult r = load_calibration(dir.path());
     ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
     ASSERT_EQ(*r.calibration, c) << "trial " << trial;
@@ -179,7 +186,7 @@ TEST(CalibrationStore, MissingFileIsNotAnError) {
 TEST(CalibrationStore, LeftoverTempFileIsIgnoredAndReplaced) {
   TempDir dir;
   const Calibration old_cal = sample_calibration();
-  ASSERT_FALSE(save_calibration(dir.path(), old_cal));
+  ASSERT_NO_THROW(save_calibration(dir.path(), old_cal));
   // A crash between writing the temp file and the rename leaves this behind.
   Calibration newer = old_cal;
   newer.params[0].value = 0.5;
@@ -189,7 +196,7 @@ TEST(CalibrationStore, LeftoverTempFileIsIgnoredAndReplaced) {
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
   EXPECT_EQ(*r.calibration, old_cal);
   // The next save overwrites the stale temp file and leaves none behind.
-  ASSERT_FALSE(save_calibration(dir.path(), newer));
+  ASSERT_NO_THROW(save_calibration(dir.path(), newer));
   EXPECT_FALSE(fs::exists(temp));
   r = load_calibration(dir.path());
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
@@ -202,40 +209,35 @@ TEST(CalibrationStore, LeftoverTempFileIsIgnoredAndReplaced) {
 TEST(CalibrationStore, RefusedSaveKeepsThePreviousFile) {
   TempDir dir;
   const Calibration good = sample_calibration();
-  ASSERT_FALSE(save_calibration(dir.path(), good));
+  ASSERT_NO_THROW(save_calibration(dir.path(), good));
   const std::string before = read_file(calibration_path(dir.path()));
   Calibration bad = good;
   bad.params[1].value = std::nan("");
-  const auto err = save_calibration(dir.path(), bad);
-  ASSERT_TRUE(err);
-  EXPECT_NE(err->find("quadrature.beta"), std::string::npos) << *err;
-  EXPECT_NE(err->find("finite"), std::string::npos) << *err;
+  const std::string err = thrown<InputError>([&] { save_calibration(dir.path(), bad); });
+  EXPECT_NE(err.find("quadrature.beta"), std::string::npos) << err;
+  EXPECT_NE(err.find("finite"), std::string::npos) << err;
   EXPECT_EQ(read_file(calibration_path(dir.path())), before);
 }
 
 TEST(CalibrationStore, InvalidCalibrationsAreRefusedWithReason) {
-  std::string text;
   Calibration c = sample_calibration();
   c.p_r = 0;
-  ASSERT_TRUE(format_calibration(c, text));
-  EXPECT_NE(format_calibration(c, text)->find("p_r=0"), std::string::npos);
+  EXPECT_NE(thrown<InputError>([&] { (void)format_calibration(c); }).find("p_r=0"), std::string::npos);
   c = sample_calibration();
   c.params[0].name = "has space";
-  ASSERT_TRUE(format_calibration(c, text));
-  EXPECT_NE(format_calibration(c, text)->find("has space"), std::string::npos);
+  EXPECT_NE(thrown<InputError>([&] { (void)format_calibration(c); }).find("has space"), std::string::npos);
   c = sample_calibration();
   c.params[1].name = c.params[0].name;
-  ASSERT_TRUE(format_calibration(c, text));
-  EXPECT_NE(format_calibration(c, text)->find("twice"), std::string::npos);
+  EXPECT_NE(thrown<InputError>([&] { (void)format_calibration(c); }).find("twice"), std::string::npos);
   c = sample_calibration();
   c.params[0].std_error = -1.0;
-  EXPECT_TRUE(format_calibration(c, text));
+  EXPECT_THROW((void)format_calibration(c), InputError);
   c = sample_calibration();
   c.method = "two\nlines";
-  EXPECT_TRUE(format_calibration(c, text));
+  EXPECT_THROW((void)format_calibration(c), InputError);
   c = sample_calibration();
   c.samples = -1;
-  EXPECT_TRUE(format_calibration(c, text));
+  EXPECT_THROW((void)format_calibration(c), InputError);
 }
 
 TEST(CalibrationStore, CorruptFileRejected) {
@@ -309,7 +311,7 @@ TEST(CalibrationStore, TheWholeModelRoundTrips) {
   c.model = {"amplitude_imbalance", "harmonics(k5,k3_opp)", "drift"};
   c.custom = {{"drift", "position_error", {"t", "t*sin(2*theta)"}}};
   c.params.push_back(param("harmonics.k5", 1e-4, std::nan("")));  // not identifiable: kept as nan
-  ASSERT_FALSE(save_calibration(dir.path(), c));
+  ASSERT_NO_THROW(save_calibration(dir.path(), c));
   const LoadResult r = load_calibration(dir.path());
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
   EXPECT_EQ(r.calibration->model, c.model);
@@ -317,7 +319,7 @@ TEST(CalibrationStore, TheWholeModelRoundTrips) {
   ASSERT_EQ(r.calibration->params.size(), c.params.size());
   EXPECT_TRUE(std::isnan(r.calibration->params.back().std_error));
   c.model = {"bad reference"};
-  EXPECT_TRUE(save_calibration(dir.path(), c).has_value());
+  EXPECT_THROW(save_calibration(dir.path(), c), InputError);
 }
 
 TEST(CalibrationStore, ConsistentButInvalidContentRejected) {
@@ -350,7 +352,7 @@ TEST(CalibrationStore, AFifoInPlaceOfTheFileDoesNotBlock) {
   const LoadResult r = load_calibration(dir.path());
   expect_rejected(r, "not a regular file (a FIFO)");
   // The next save replaces it with a file.
-  ASSERT_FALSE(save_calibration(dir.path(), sample_calibration()));
+  ASSERT_NO_THROW(save_calibration(dir.path(), sample_calibration()));
   EXPECT_EQ(load_calibration(dir.path()).status, Status::kLoaded);
 }
 
@@ -359,13 +361,13 @@ TEST(CalibrationStore, ProvenanceRoundTripsOnOneLineEach) {
   Calibration c = sample_calibration();
   c.provenance = {"/etc/resolverd/bench 2.toml", "5e1f00aa", "0badcafe", "the default bench layout (x: y = z)",
                   "/var/log/run.log", "2026-11-26T01:44:32Z", "resolverd 0.1.0 (git 7d43eb5)"};
-  ASSERT_FALSE(save_calibration(dir.path(), c));
+  ASSERT_NO_THROW(save_calibration(dir.path(), c));
   const LoadResult r = load_calibration(dir.path());
   ASSERT_EQ(r.status, Status::kLoaded) << r.problem;
   EXPECT_EQ(r.calibration->provenance, c.provenance);
   // A line break in a path cannot split the record: it is saved as '?'.
   c.provenance.source = "/tmp/odd\nname.log";
-  ASSERT_FALSE(save_calibration(dir.path(), c));
+  ASSERT_NO_THROW(save_calibration(dir.path(), c));
   const LoadResult odd = load_calibration(dir.path());
   ASSERT_EQ(odd.status, Status::kLoaded) << odd.problem;
   EXPECT_EQ(odd.calibration->provenance.source, "/tmp/odd?name.log");
@@ -373,15 +375,14 @@ TEST(CalibrationStore, ProvenanceRoundTripsOnOneLineEach) {
 
 TEST(CalibrationStore, SetAsideKeepsTheFileUnderANewName) {
   TempDir dir;
-  ASSERT_FALSE(save_calibration(dir.path(), sample_calibration()));
+  ASSERT_NO_THROW(save_calibration(dir.path(), sample_calibration()));
   std::string moved;
-  ASSERT_FALSE(set_calibration_aside(dir.path(), "refused-x", moved));
+  ASSERT_NO_THROW(moved = set_calibration_aside(dir.path(), "refused-x"));
   EXPECT_EQ(moved, calibration_path(dir.path()) + ".refused-x");
   EXPECT_TRUE(fs::exists(moved));
   EXPECT_EQ(load_calibration(dir.path()).status, Status::kMissing);
-  const auto err = set_calibration_aside(dir.path(), "again", moved);
-  ASSERT_TRUE(err);
-  EXPECT_NE(err->find("No such file"), std::string::npos) << *err;
+  const std::string err = thrown<IoError>([&] { (void)set_calibration_aside(dir.path(), "again"); });
+  EXPECT_NE(err.find("No such file"), std::string::npos) << err;
 }
 
 TEST(StateDirLock, SecondHolderIsRefusedNamingThePid) {
@@ -413,35 +414,32 @@ TEST(StateDirLock, MissingDirectoryAndFifoAreRefusedWithoutBlocking) {
 TEST(CalibrationStore, MissingDirectoryErrorSaysWhatAndWhatToDo) {
   TempDir dir;
   const std::string missing = dir.path() + "/no-such-dir";
-  const auto err = save_calibration(missing, sample_calibration());
-  ASSERT_TRUE(err);
-  EXPECT_NE(err->find(missing + "/calibration.txt.tmp"), std::string::npos) << *err;
-  EXPECT_NE(err->find("No such file or directory"), std::string::npos) << *err;
-  EXPECT_NE(err->find("--state-dir"), std::string::npos) << *err;
+  const std::string err = thrown<IoError>([&] { save_calibration(missing, sample_calibration()); });
+  EXPECT_NE(err.find(missing + "/calibration.txt.tmp"), std::string::npos) << err;
+  EXPECT_NE(err.find("No such file or directory"), std::string::npos) << err;
+  EXPECT_NE(err.find("--state-dir"), std::string::npos) << err;
 }
 
 TEST(CalibrationStore, DirectoryThatIsAFileErrors) {
   TempDir dir;
   const std::string file = dir.path() + "/plain-file";
   write_file(file, "x");
-  const auto err = save_calibration(file, sample_calibration());
-  ASSERT_TRUE(err);
-  EXPECT_NE(err->find("Not a directory"), std::string::npos) << *err;
+  const std::string err = thrown<IoError>([&] { save_calibration(file, sample_calibration()); });
+  EXPECT_NE(err.find("Not a directory"), std::string::npos) << err;
 }
 
 TEST(CalibrationStore, ReadOnlyDirectoryErrors) {
   if (::geteuid() == 0) GTEST_SKIP() << "running as root: directory permissions do not stop root from writing";
   TempDir dir;
   ASSERT_EQ(::chmod(dir.path().c_str(), 0500), 0);
-  const auto err = save_calibration(dir.path(), sample_calibration());
-  ASSERT_TRUE(err);
-  EXPECT_NE(err->find("Permission denied"), std::string::npos) << *err;
-  EXPECT_NE(err->find("writable"), std::string::npos) << *err;
+  const std::string err = thrown<IoError>([&] { save_calibration(dir.path(), sample_calibration()); });
+  EXPECT_NE(err.find("Permission denied"), std::string::npos) << err;
+  EXPECT_NE(err.find("writable"), std::string::npos) << err;
 }
 
 TEST(CalibrationStore, TrailingSlashInDirectory) {
   TempDir dir;
-  ASSERT_FALSE(save_calibration(dir.path() + "/", sample_calibration()));
+  ASSERT_NO_THROW(save_calibration(dir.path() + "/", sample_calibration()));
   EXPECT_EQ(load_calibration(dir.path()).status, Status::kLoaded);
 }
 
