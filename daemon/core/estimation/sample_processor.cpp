@@ -77,11 +77,22 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   const double theta_meas = in.has_rd ? wrap_2pi(in.theta_rd) : out.theta_sincos;
   out.theta_rd = theta_meas;
   rd_unwrap_.update(theta_meas);
-
-  const double p_r = config_.p_r;
   ++samples_;
-  // Feed the active estimator. Hwang's integral runs beside every method (the
-  // seed's baseline the reports show next to the default).
+  feed_estimator(in, theta_meas, out);
+  count_revolution(out);
+  out.moving = update_motion_gate();
+  const double omega = speed_.update(in.t, theta_meas);
+  out.speed_mech = omega / config_.p_r;
+  compensate(in, theta_meas, omega, out);
+  reference_angles(in, theta_meas, out);
+  if (in.has_currents) dq_and_ripple(in, out);
+  return out;
+}
+
+void SampleProcessor::feed_estimator(const SampleInput& in, double theta_meas, SampleOutput& out) {
+  const double p_r = config_.p_r;
+  // Hwang's integral runs beside every method (the seed's baseline the reports show
+  // next to the default).
   if (config_.method != EstimatorMethod::kHwangIntegral) out.revolution = estimator_.update(in.t, theta_meas);
   switch (config_.method) {
     case EstimatorMethod::kModel:
@@ -110,6 +121,9 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
       if (in.has_ref) fourier_.add(p_r * in.theta_m_ref, theta_meas);
       break;
   }
+}
+
+void SampleProcessor::count_revolution(SampleOutput& out) {
   // The other estimators solve once per resolver electrical revolution: a
   // revolution is 2pi of travel from the last one's end (noise jittering across
   // a level at a standstill is not one).
@@ -121,29 +135,30 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
     ++revolutions_;
     close_revolution(out);
   }
+}
 
-  // Motion gate: travel over the last kTravelSpan samples against the noise of the
-  // angle's second differences (sigma = 1.2533 mean|d2| / sqrt 6 for Gaussian noise).
-  {
-    const double cont = rd_unwrap_.continuous;
-    const std::size_t cap = kTravelSpan + 1;
-    if (recent_n_ >= 2) {
-      const double a = recent_[(recent_n_ - 1) % cap], b = recent_[(recent_n_ - 2) % cap];
-      const double d2 = std::abs(cont - 2.0 * a + b);
-      second_diff_ema_ += (d2 - second_diff_ema_) * (recent_n_ < 64 ? 1.0 / static_cast<double>(recent_n_) : 1.0 / 64.0);
-    }
-    recent_[recent_n_ % cap] = cont;
-    ++recent_n_;
-    if (recent_n_ > kTravelSpan) {
-      const double travel = std::abs(cont - recent_[(recent_n_ - 1 - kTravelSpan) % cap]);
-      const double sigma = std::max(1.2533 * second_diff_ema_ / std::sqrt(6.0), 1e-9);
-      if (moving_ && travel < 3.0 * sigma) moving_ = false;
-      else if (!moving_ && travel > 6.0 * sigma) moving_ = true;
-    }
-    out.moving = moving_;
+bool SampleProcessor::update_motion_gate() {
+  // Travel over the last kTravelSpan samples against the noise of the angle's second
+  // differences (sigma = 1.2533 mean|d2| / sqrt 6 for Gaussian noise).
+  const double cont = rd_unwrap_.continuous;
+  const std::size_t cap = kTravelSpan + 1;
+  if (recent_n_ >= 2) {
+    const double a = recent_[(recent_n_ - 1) % cap], b = recent_[(recent_n_ - 2) % cap];
+    const double d2 = std::abs(cont - 2.0 * a + b);
+    second_diff_ema_ += (d2 - second_diff_ema_) * (recent_n_ < 64 ? 1.0 / static_cast<double>(recent_n_) : 1.0 / 64.0);
   }
-  const double omega = speed_.update(in.t, theta_meas);
-  out.speed_mech = omega / p_r;
+  recent_[recent_n_ % cap] = cont;
+  ++recent_n_;
+  if (recent_n_ > kTravelSpan) {
+    const double travel = std::abs(cont - recent_[(recent_n_ - 1 - kTravelSpan) % cap]);
+    const double sigma = std::max(1.2533 * second_diff_ema_ / std::sqrt(6.0), 1e-9);
+    if (moving_ && travel < 3.0 * sigma) moving_ = false;
+    else if (!moving_ && travel > 6.0 * sigma) moving_ = true;
+  }
+  return moving_;
+}
+
+void SampleProcessor::compensate(const SampleInput& in, double theta_meas, double omega, SampleOutput& out) {
   // Compensation (docs/ARCHITECTURE.md §3 sign): theta_c = theta_rd + eps_hat, one
   // path for every method: the exported table, else the Model inverted.
   if (table_ && config_.compensate) {
@@ -160,21 +175,24 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
     out.eps_hat = 0.0;
     out.theta_comp = theta_meas;
   }
+}
 
-  double theta_ref_cont = kNaN;
+void SampleProcessor::reference_angles(const SampleInput& in, double theta_meas, SampleOutput& out) {
   if (in.has_ref) {
-    theta_ref_cont = ref_unwrap_.update(in.theta_m_ref);
-    out.theta_ref = wrap_2pi(p_r * in.theta_m_ref);
+    ref_cont_ = ref_unwrap_.update(in.theta_m_ref);
+    out.theta_ref = wrap_2pi(config_.p_r * in.theta_m_ref);
     out.eps_ref = wrap_pi(out.theta_ref - theta_meas);
   } else {
+    ref_cont_ = kNaN;
     out.theta_ref = kNaN;
     out.eps_ref = kNaN;
   }
+}
 
+void SampleProcessor::dq_and_ripple(const SampleInput& in, SampleOutput& out) {
   const double rd_cont = rd_unwrap_.continuous;
-  if (!in.has_currents) return out;
   out.has_dq = true;
-  const double ratio = static_cast<double>(config_.p) / p_r;  // theta_e = (p/p_r) theta (Hwang eq. 19)
+  const double ratio = static_cast<double>(config_.p) / config_.p_r;  // theta_e = (p/p_r) theta (Hwang eq. 19)
   out.electrical_freq_hz = config_.p * out.speed_mech / kTwoPi;
   const ClarkeTransform ab(in.i_a, in.i_b, in.i_c);
 
@@ -197,13 +215,12 @@ SampleOutput SampleProcessor::process(const SampleInput& in) {
   out.ripple_comp_updated = dq_with(ratio * (rd_cont + out.eps_hat), ripple_comp_, ripple_.comp, ripple_.comp_valid,
                                     out.i_d_comp, out.i_q_comp);
   if (in.has_ref) {
-    out.ripple_ref_updated = dq_with(config_.p * theta_ref_cont, ripple_ref_, ripple_.ref, ripple_.ref_valid,
+    out.ripple_ref_updated = dq_with(config_.p * ref_cont_, ripple_ref_, ripple_.ref, ripple_.ref_valid,
                                      out.i_d_ref, out.i_q_ref);
   } else {
     out.i_d_ref = kNaN;
     out.i_q_ref = kNaN;
   }
-  return out;
 }
 
 void SampleProcessor::set_model(Model model, std::int64_t samples, double revolutions) {

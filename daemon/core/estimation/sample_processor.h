@@ -144,6 +144,13 @@ class SampleProcessor {
   [[nodiscard]] const HwangIntegralEstimator& hwang() const { return estimator_; }
 
  private:
+  // process(), step by step.
+  void feed_estimator(const SampleInput& in, double theta_meas, SampleOutput& out);
+  void count_revolution(SampleOutput& out);
+  [[nodiscard]] bool update_motion_gate();
+  void compensate(const SampleInput& in, double theta_meas, double omega, SampleOutput& out);
+  void reference_angles(const SampleInput& in, double theta_meas, SampleOutput& out);
+  void dq_and_ripple(const SampleInput& in, SampleOutput& out);
   /// Compensates with `model` from now on (when compensation is on).
   void adopt(Model model);
   /// Solves the sin/cos or Fourier fit at the end of a resolver revolution.
@@ -162,6 +169,7 @@ class SampleProcessor {
   SpeedEstimator speed_;
   AngleUnwrapper rd_unwrap_;
   AngleUnwrapper ref_unwrap_;
+  double ref_cont_ = 0.0;  ///< [rad, mechanical] the reference unwrapped at the current sample (NaN without)
   RevolutionRipple ripple_raw_, ripple_comp_, ripple_ref_;
   // Motion gate (SampleOutput::moving).
   static constexpr std::size_t kTravelSpan = 10;
