@@ -120,73 +120,241 @@ bool is_udpm(const std::string& url) {
 
 }  // namespace
 
-static int run(int argc, char** argv) {
-  using namespace resolver;
-  CLI::App app{kDescription, "resolverd"};
-  app.set_version_flag("--version", resolver::version_line("resolverd"));
-  std::string config_path, replay_path, can_iface, report_path;
+namespace {
+
+/// resolverd's command line.
+struct Options {
+  std::string config_path, replay_path, can_iface, report_path, format_name, calibration_file, state_dir;
   std::optional<std::string> lcm_url;
   bool once = false, fast = false, quiet = false;
   double rate = 1.0;
+  resolver::SampleSlice slice;
+};
+
+/// Parses the command line into `o`; an exit code when the program ends here (--help,
+/// --version, a usage error).
+std::optional<int> parse_options(int argc, char** argv, Options& o) {
+  using namespace resolver;
+  CLI::App app{kDescription, "resolverd"};
+  app.set_version_flag("--version", resolver::version_line("resolverd"));
   app.footer(exit_code::kHelpText);
-  app.add_option("--config", config_path, "TOML config file (see README; every key optional)");
-  auto* replay = app.add_option("--replay", replay_path,
+  app.add_option("--config", o.config_path, "TOML config file (see README; every key optional)");
+  auto* replay = app.add_option("--replay", o.replay_path,
                                 "replay a log file instead of reading CAN: candump -l, Vector ASC or a CSV/scope export");
-  auto* can = app.add_option("--can", can_iface, "read live frames from this SocketCAN interface (can0, vcan0)");
+  auto* can = app.add_option("--can", o.can_iface, "read live frames from this SocketCAN interface (can0, vcan0)");
   replay->excludes(can);
-  app.add_flag("--once", once, "with --replay: stop at the end of the log (default: loop it)")->needs(replay);
+  app.add_flag("--once", o.once, "with --replay: stop at the end of the log (default: loop it)")->needs(replay);
   auto* fast_opt =
-      app.add_flag("--fast", fast, "with --replay: as fast as possible instead of the log's timing")->needs(replay);
-  app.add_option("--rate", rate,
+      app.add_flag("--fast", o.fast, "with --replay: as fast as possible instead of the log's timing")->needs(replay);
+  app.add_option("--rate", o.rate,
                  "with --replay: play at RATE times the log's own speed (default 1 = real time); "
                  "paces udpm for listeners that drop at --fast")
       ->needs(replay)
       ->excludes(fast_opt)
       ->check(CLI::PositiveNumber);
-  std::string format_name;
-  SampleSlice slice;
-  app.add_option("--format", format_name,
+  app.add_option("--format", o.format_name,
                  "with --replay: candump, asc (Vector ASC) or csv (scope export, [input.csv] in --config); "
                  "default: [input] format, else the extension (.asc, .csv/.txt, else candump)")
       ->check(CLI::IsMember({"candump", "asc", "csv"}))
       ->needs(replay);
-  app.add_option("--from", slice.from_s, "with --replay: process samples from this time on [s, 0 = the log's first sample]")
+  app.add_option("--from", o.slice.from_s, "with --replay: process samples from this time on [s, 0 = the log's first sample]")
       ->check(CLI::NonNegativeNumber)
       ->needs(replay);
-  app.add_option("--to", slice.to_s, "with --replay: stop after this time [s, from the log's first sample]")
+  app.add_option("--to", o.slice.to_s, "with --replay: stop after this time [s, from the log's first sample]")
       ->check(CLI::NonNegativeNumber)
       ->needs(replay);
-  app.add_option("--lcm", lcm_url,
+  app.add_option("--lcm", o.lcm_url,
                  "LCM URL, overrides the config (default: LCM's udpm multicast; "
                  "'file:///path.lcmlog?mode=w' writes a log file, 'memq://' stays in-process)");
-  app.add_option("--report", report_path, "also write the end-of-run report as JSON to this file");
-  app.add_flag("--quiet", quiet, "no progress lines on stderr");
-  std::string calibration_file;
-  app.add_option("--calibration", calibration_file,
+  app.add_option("--report", o.report_path, "also write the end-of-run report as JSON to this file");
+  app.add_flag("--quiet", o.quiet, "no progress lines on stderr");
+  app.add_option("--calibration", o.calibration_file,
                  "compensate with a table exported by 'resolver-model export LOG --table-format csv' instead of the live "
                  "estimate (the estimator still runs and publishes)")
       ->check(CLI::ExistingFile);
-  std::string state_dir;
-  app.add_option("--state-dir", state_dir,
+  app.add_option("--state-dir", o.state_dir,
                  "directory for the persisted calibration (systemd: $STATE_DIRECTORY); loaded at start unless it "
                  "was learned on another layout (then moved aside), saved at exit only from a healthy run (estimate "
                  "converged, model fit not unexplained, no lasting signal fault; else the reason is printed). "
                  "Locked while resolverd runs: a second resolverd on the same directory exits 3 naming the first's pid; "
                  "a save that fails exits 3");
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
-  if (slice.to_s < slice.from_s) {
-    std::cerr << "resolverd: --to " << slice.to_s << " s is before --from " << slice.from_s << " s\n";
+  if (o.slice.to_s < o.slice.from_s) {
+    std::cerr << "resolverd: --to " << o.slice.to_s << " s is before --from " << o.slice.from_s << " s\n";
     return exit_code::kUsage;
   }
+  return std::nullopt;
+}
+
+/// --calibration TABLE.csv: compensate with an exported table.
+void use_calibration_table(const std::string& calibration_file, resolver::Pipeline& pipeline) {
+  using namespace resolver;
+  try {
+    CalibrationTable table = read_table_csv(calibration_file);
+    std::cerr << "resolverd: compensating with the table " << calibration_file << " (" << table.correction.size()
+              << " points, p_r " << table.p_r << ", interpolation error " << table.interpolation_error << " rad)\n";
+    pipeline.use_table(std::move(table));
+  } catch (const std::runtime_error& e) {  // not a table, a bad number, rows out of order
+    throw InputError(Fault::kUsage, e.what(), Where::at_option("--calibration"));
+  }
+}
+
+/// The state dir's calibration at start: refused and moved aside when learned on
+/// another layout, else its Model compensates until this run has its own estimate.
+void seed_from_state_dir(const std::string& state_dir, const resolver::DaemonConfig& config,
+                         resolver::Pipeline& pipeline) {
+  using namespace resolver;
+  LoadResult loaded = load_calibration(state_dir);
+  if (loaded.status == LoadResult::Status::kLoaded) {
+    const Calibration::Provenance& saved = loaded.calibration->provenance;
+    const LayoutIdentity here = layout_identity(config);  // ConfigError (the DBC): exit 2
+    if (saved.layout_id.empty()) {
+      std::cerr << "resolverd: " << calibration_path(state_dir)
+                << " records no layout (written by an older resolverd); it is applied unchecked and the next save "
+                   "records this run's layout\n";
+    } else if (saved.layout_id != here.id) {
+      std::string aside;
+      try {
+        aside = "kept aside as " + set_calibration_aside(state_dir, "refused-" + utc_now(true));
+      } catch (const std::exception& e) {
+        aside = std::string("and could not be kept aside (") + e.what() + ")";
+      }
+      std::cerr << "resolverd: the saved calibration " << calibration_path(state_dir) << " was learned on another layout ("
+                << saved.layout << ", layout id " << saved.layout_id << ", from " << saved.source << " at "
+                << saved.saved_at << ") than this run's (" << here.description << ", layout id " << here.id
+                << "); it is NOT applied, "
+                << aside
+                << "; learning from scratch\n";
+      loaded.status = LoadResult::Status::kMissing;
+    }
+  }
+  if (loaded.status == LoadResult::Status::kLoaded) {
+    const Calibration& cal = *loaded.calibration;
+    // Every method compensates with the saved Model until this run has its own estimate.
+    try {
+      Model saved = model_from_calibration(cal, config);
+      if (!saved.empty()) {
+        std::cerr << "resolverd: compensating with the saved model ("
+                  << fmt::format("{}", fmt::join(saved.spec().references(), ", ")) << ") from "
+                  << calibration_path(state_dir) << " until this run's "
+                  << (config.method == EstimatorMethod::kModel ? "first window is fitted" : "estimate converges")
+                  << "\n";
+        pipeline.seed_model(std::move(saved));
+      }
+    } catch (const std::exception& e) {
+      std::cerr << "resolverd: the saved model in " << calibration_path(state_dir) << " is not used: " << e.what()
+                << "\n";
+    }
+  } else if (loaded.status == LoadResult::Status::kRejected) {
+    std::cerr << "resolverd: " << loaded.problem << "\n";
+  }
+}
+
+/// What the run's calibration needs beyond the pipeline: where it is saved and the provenance.
+struct SaveContext {
+  std::string state_dir, config_path, config_crc;
+  const resolver::DaemonConfig* config = nullptr;
+};
+
+/// The calibration at exit: judged, saved or not, and why (into info); false when a
+/// save failed (exit 3).
+bool save_run_calibration(const SaveContext& ctx, const resolver::Pipeline& pipeline, resolver::RunInfo& info) {
+  using namespace resolver;
+  const std::string& state_dir = ctx.state_dir;
+  if (state_dir.empty()) {
+    info.calibration.reason = "no --state-dir given";
+    return true;
+  }
+  info.calibration.path = calibration_path(state_dir);
+  const CalibrationJudgement judged = judge_calibration(pipeline);
+  if (!judged.trusted) {
+    info.calibration.reason = judged.reason;
+    std::cerr << "resolverd: calibration not saved to " << info.calibration.path << ": " << judged.reason
+              << "; the file there, if any, is unchanged\n";
+    return true;
+  }
+  const ModelEstimate model = pipeline.processor().estimate();
+  Calibration cal;
+  cal.p_r = pipeline.processor().config().p_r;
+  cal.p = pipeline.processor().config().p;
+  cal.method = model.method;
+  cal.samples = model.samples;
+  cal.params = model.params;
+  describe_model(pipeline.processor().estimated_model(), cal);
+  Calibration::Provenance& pv = cal.provenance;
+  pv.config = ctx.config_path;
+  pv.config_crc32 = ctx.config_crc;
+  try {
+    const LayoutIdentity layout = layout_identity(*ctx.config);
+    pv.layout_id = layout.id;
+    pv.layout = layout.description;
+  } catch (const std::exception& e) {  // the DBC vanished since the start: save without it
+    std::cerr << "resolverd: " << e.what() << "; the calibration is saved without its layout\n";
+  }
+  pv.source = info.source;
+  pv.saved_at = utc_now();
+  pv.program = version_line("resolverd");
+  try {
+    save_calibration(state_dir, cal);
+    info.calibration.saved = true;
+    std::cerr << "resolverd: calibration saved to " << info.calibration.path << "\n";
+    return true;
+  } catch (const std::exception& e) {  // InputError or IoError: either way nothing was saved
+    info.calibration.reason = e.what();
+    std::cerr << "resolverd: " << e.what() << " (exit code 3)\n";
+    return false;
+  }
+}
+
+/// The report (stdout and --report), the LCM output flushed, and the exit code.
+int finish_outputs(const Options& o, resolver::LcmOutput& output, const resolver::Pipeline& pipeline,
+                   const resolver::RunInfo& info, bool saved_or_not_asked) {
+  using namespace resolver;
+  print_run_report(std::cout, pipeline, info);
+  int code = exit_code::kDone;
+  (void)output.flush();
+  if (output.publish_failures() > 0) {
+    std::cerr << "resolverd: " << output.publish_failures() << " LCM publish calls failed";
+    if (!output.write_error().empty()) std::cerr << " (" << output.write_error() << ")";
+    std::cerr << "\n";
+    if (!output.write_error().empty()) code = exit_code::kIo;  // the LCM log file is incomplete
+  }
+  if (!o.report_path.empty()) {
+    std::ofstream out(o.report_path);
+    out << run_report_json(pipeline, info);
+    out.close();
+    if (!out) {
+      std::cerr << "resolverd: cannot write report " << o.report_path << ": " << std::strerror(errno) << "\n";
+      return exit_code::kIo;
+    }
+  }
+  if (!saved_or_not_asked) code = exit_code::kIo;
+  if (code == exit_code::kDone && !o.replay_path.empty() && pipeline.samples() == 0) {
+    std::cerr << "resolverd: " << o.replay_path << ": no sample decoded ("
+              << pipeline.intake().stats().frames_seen << " frames seen); nothing was estimated or published "
+                 "from it (exit code 1)\n";
+    code = exit_code::kNoUsableData;
+  }
+  return code;
+}
+
+}  // namespace
+
+static int run(int argc, char** argv) {
+  using namespace resolver;
+  Options o;
+  if (auto code = parse_options(argc, argv, o)) return *code;
+  const std::string& config_path = o.config_path;
+  const std::optional<std::string>& lcm_url = o.lcm_url;
   // From here a SIGTERM is a request the run loop honours (it finds the flag set at
   // its first look), not the default death by signal, however early it comes.
   StopFlags flags;
   install_signal_handlers(flags);
-  if (replay_path.empty() && can_iface.empty()) {
+  if (o.replay_path.empty() && o.can_iface.empty()) {
     std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
     return exit_code::kUsage;
   }
-  for (const auto& [option, path] : {std::pair{"--config", config_path}, std::pair{"--replay", replay_path}}) {
+  for (const auto& [option, path] : {std::pair{"--config", config_path}, std::pair{"--replay", o.replay_path}}) {
     if (path.empty()) continue;
     if (auto problem = exit_code::unreadable(option, path)) {
       std::cerr << "resolverd: " << *problem << "\n";
@@ -200,9 +368,9 @@ static int run(int argc, char** argv) {
   std::string config_crc = file_crc32(config_path);  // provenance of a saved calibration
   // Held for the whole run (see state_dir_lock.h); taken before anything is read from the directory.
   std::optional<StateDirLock> state_lock;
-  if (!state_dir.empty()) {
+  if (!o.state_dir.empty()) {
     std::string problem;
-    state_lock = StateDirLock::acquire(state_dir, problem);
+    state_lock = StateDirLock::acquire(o.state_dir, problem);
     if (!state_lock) {
       std::cerr << "resolverd: " << problem << "\n";
       return exit_code::kIo;
@@ -218,70 +386,16 @@ static int run(int argc, char** argv) {
   // LCM that cannot start throws std::system_error (exit 3); a DBC or signal map that
   // does not fit, ConfigError or std::invalid_argument (exit 2).
   const auto output = std::make_unique<LcmOutput>(config.lcm_url, config.channels);
-  const auto pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !can_iface.empty(), slice);
-  if (fast && is_udpm(config.lcm_url)) {
+  const auto pipeline = std::make_unique<Pipeline>(config, *output, std::cerr, !o.can_iface.empty(), o.slice);
+  if (o.fast && is_udpm(config.lcm_url)) {
     std::cerr << "resolverd: --fast on udpm publishes as fast as the CPU allows (hundreds of thousands of messages/s); "
                  "listeners such as lcm-logger and lcm-spy drop what their socket buffers cannot hold. "
                  "To keep every message: pace it with --rate X (X times real time) instead of --fast, "
                  "or write a log with --lcm 'file:///PATH.lcmlog?mode=w' (stamped with bench time)\n";
   }
 
-  if (!calibration_file.empty()) {
-    try {
-      CalibrationTable table = read_table_csv(calibration_file);
-      std::cerr << "resolverd: compensating with the table " << calibration_file << " (" << table.correction.size()
-                << " points, p_r " << table.p_r << ", interpolation error " << table.interpolation_error << " rad)\n";
-      pipeline->use_table(std::move(table));
-    } catch (const std::runtime_error& e) {  // not a table, a bad number, rows out of order
-      throw InputError(Fault::kUsage, e.what(), Where::at_option("--calibration"));
-    }
-  }
-  if (!state_dir.empty()) {
-    LoadResult loaded = load_calibration(state_dir);
-    if (loaded.status == LoadResult::Status::kLoaded) {
-      const Calibration::Provenance& saved = loaded.calibration->provenance;
-      const LayoutIdentity here = layout_identity(config);  // ConfigError (the DBC): exit 2
-      if (saved.layout_id.empty()) {
-        std::cerr << "resolverd: " << calibration_path(state_dir)
-                  << " records no layout (written by an older resolverd); it is applied unchecked and the next save "
-                     "records this run's layout\n";
-      } else if (saved.layout_id != here.id) {
-        std::string aside;
-        try {
-          aside = "kept aside as " + set_calibration_aside(state_dir, "refused-" + utc_now(true));
-        } catch (const std::exception& e) {
-          aside = std::string("and could not be kept aside (") + e.what() + ")";
-        }
-        std::cerr << "resolverd: the saved calibration " << calibration_path(state_dir) << " was learned on another layout ("
-                  << saved.layout << ", layout id " << saved.layout_id << ", from " << saved.source << " at "
-                  << saved.saved_at << ") than this run's (" << here.description << ", layout id " << here.id
-                  << "); it is NOT applied, "
-                  << aside
-                  << "; learning from scratch\n";
-        loaded.status = LoadResult::Status::kMissing;
-      }
-    }
-    if (loaded.status == LoadResult::Status::kLoaded) {
-      const Calibration& cal = *loaded.calibration;
-      // Every method compensates with the saved Model until this run has its own estimate.
-      try {
-        Model saved = model_from_calibration(cal, config);
-        if (!saved.empty()) {
-          std::cerr << "resolverd: compensating with the saved model ("
-                    << fmt::format("{}", fmt::join(saved.spec().references(), ", ")) << ") from "
-                    << calibration_path(state_dir) << " until this run's "
-                    << (config.method == EstimatorMethod::kModel ? "first window is fitted" : "estimate converges")
-                    << "\n";
-          pipeline->seed_model(std::move(saved));
-        }
-      } catch (const std::exception& e) {
-        std::cerr << "resolverd: the saved model in " << calibration_path(state_dir) << " is not used: " << e.what()
-                  << "\n";
-      }
-    } else if (loaded.status == LoadResult::Status::kRejected) {
-      std::cerr << "resolverd: " << loaded.problem << "\n";
-    }
-  }
+  if (!o.calibration_file.empty()) use_calibration_table(o.calibration_file, *pipeline);
+  if (!o.state_dir.empty()) seed_from_state_dir(o.state_dir, config, *pipeline);
   SdNotifier notifier = SdNotifier::from_environment();
   if (!notifier.last_error().empty()) std::cerr << "resolverd: " << notifier.last_error() << "\n";
 
@@ -307,95 +421,27 @@ static int run(int argc, char** argv) {
   // Opening or reading the input fails with std::system_error (exit 3), a CSV column
   // map that does not fit the export with ConfigError (exit 2): program_errors.h.
   {
-    if (!replay_path.empty()) {
+    if (!o.replay_path.empty()) {
       ReplayOptions ro;
-      ro.path = replay_path;
-      ro.format = log_format_from_name(format_name);
-      ro.fast = fast;
-      ro.once = once;
-      ro.rate = rate;
-      ro.progress = !quiet;
+      ro.path = o.replay_path;
+      ro.format = log_format_from_name(o.format_name);
+      ro.fast = o.fast;
+      ro.once = o.once;
+      ro.rate = o.rate;
+      ro.progress = !o.quiet;
       const ReplayResult rr = run_replay(ro, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
-      info.source = replay_path;
+      info.source = o.replay_path;
       info.wall_seconds = rr.wall_seconds;
     } else {
       const auto live_start = std::chrono::steady_clock::now();
-      run_live(LiveOptions{can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes, config.can.wake_auto, config.can.wake_ids}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
-      info.source = can_iface;
+      run_live(LiveOptions{o.can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes, config.can.wake_auto, config.can.wake_ids}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
+      info.source = o.can_iface;
       info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
     }
   }
 
-  // The calibration: judged, saved or not, before the report so the report says which.
-  bool save_failed = false;
-  if (!state_dir.empty()) {
-    info.calibration.path = calibration_path(state_dir);
-    const CalibrationJudgement judged = judge_calibration(*pipeline);
-    if (!judged.trusted) {
-      info.calibration.reason = judged.reason;
-      std::cerr << "resolverd: calibration not saved to " << info.calibration.path << ": " << judged.reason
-                << "; the file there, if any, is unchanged\n";
-    } else {
-      const ModelEstimate model = pipeline->processor().estimate();
-      Calibration cal;
-      cal.p_r = pipeline->processor().config().p_r;
-      cal.p = pipeline->processor().config().p;
-      cal.method = model.method;
-      cal.samples = model.samples;
-      cal.params = model.params;
-      describe_model(pipeline->processor().estimated_model(), cal);
-      Calibration::Provenance& pv = cal.provenance;
-      pv.config = config_path;
-      pv.config_crc32 = config_crc;
-      try {
-        const LayoutIdentity layout = layout_identity(config);
-        pv.layout_id = layout.id;
-        pv.layout = layout.description;
-      } catch (const std::exception& e) {  // the DBC vanished since the start: save without it
-        std::cerr << "resolverd: " << e.what() << "; the calibration is saved without its layout\n";
-      }
-      pv.source = info.source;
-      pv.saved_at = utc_now();
-      pv.program = version_line("resolverd");
-      try {
-        save_calibration(state_dir, cal);
-        info.calibration.saved = true;
-        std::cerr << "resolverd: calibration saved to " << info.calibration.path << "\n";
-      } catch (const std::exception& e) {  // InputError or IoError: either way nothing was saved
-        info.calibration.reason = e.what();
-        save_failed = true;
-        std::cerr << "resolverd: " << e.what() << " (exit code 3)\n";
-      }
-    }
-  } else {
-    info.calibration.reason = "no --state-dir given";
-  }
-  print_run_report(std::cout, *pipeline, info);
-  int code = exit_code::kDone;
-  (void)output->flush();
-  if (output->publish_failures() > 0) {
-    std::cerr << "resolverd: " << output->publish_failures() << " LCM publish calls failed";
-    if (!output->write_error().empty()) std::cerr << " (" << output->write_error() << ")";
-    std::cerr << "\n";
-    if (!output->write_error().empty()) code = exit_code::kIo;  // the LCM log file is incomplete
-  }
-  if (!report_path.empty()) {
-    std::ofstream out(report_path);
-    out << run_report_json(*pipeline, info);
-    out.close();
-    if (!out) {
-      std::cerr << "resolverd: cannot write report " << report_path << ": " << std::strerror(errno) << "\n";
-      return exit_code::kIo;
-    }
-  }
-  if (save_failed) code = exit_code::kIo;
-  if (code == exit_code::kDone && !replay_path.empty() && pipeline->samples() == 0) {
-    std::cerr << "resolverd: " << replay_path << ": no sample decoded ("
-              << pipeline->intake().stats().frames_seen << " frames seen); nothing was estimated or published "
-                 "from it (exit code 1)\n";
-    code = exit_code::kNoUsableData;
-  }
-  return code;
+  const bool saved_or_not_asked = save_run_calibration({o.state_dir, config_path, config_crc, &config}, *pipeline, info);
+  return finish_outputs(o, *output, *pipeline, info, saved_or_not_asked);
 }
 
 // Every failure that is an exception gets its exit code from the one rule
