@@ -38,6 +38,13 @@ class Hidden:
     # profile -> (reference, parameters, why): part of the effect is the default model's
     # already, so the tool names the rest.
     part: dict = field(default_factory=dict)
+    # parameter -> (true value, tolerance beyond 5 standard errors, why): the refit with the
+    # hidden effect added must find it there.
+    truth: dict = field(default_factory=dict)
+    # Control: on the logs without it (control_alpha_only, every profile) its candidate's BIC
+    # drop stays at or below the proposal threshold (it would not be proposed even if the
+    # log were not already explained), or it is not evaluated there.
+    quiet_in_control: bool = False
 
 
 def _h(key, spec, refs, params, profiles, twins=None, **kw):
