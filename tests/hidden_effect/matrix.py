@@ -38,6 +38,13 @@ class Hidden:
     # profile -> (reference, parameters, why): part of the effect is the default model's
     # already, so the tool names the rest.
     part: dict = field(default_factory=dict)
+    # parameter -> (true value, tolerance beyond 5 standard errors, why): the refit with the
+    # hidden effect added must find it there.
+    truth: dict = field(default_factory=dict)
+    # Control: on the logs without it (control_alpha_only, every profile) its candidate's BIC
+    # drop stays at or below the proposal threshold (it would not be proposed even if the
+    # log were not already explained), or it is not evaluated there.
+    quiet_in_control: bool = False
 
 
 def _h(key, spec, refs, params, profiles, twins=None, **kw):
@@ -138,6 +145,20 @@ HIDDEN = {h.key: h for h in [
     _h("current_gain_mismatch", "current_gain_mismatch:gain_a=0.01,gain_b=-0.005", ["current_gain_mismatch"],
        ["current_gain_mismatch.gain_a", "current_gain_mismatch.gain_b"], ("const", "oab3", "steps")),
     _h("dead_time", "dead_time:t_d=1e-6", ["dead_time"], ["dead_time.t_d"], ("const", "oab3", "steps")),
+    # The excitation warming up: both envelopes x (1 + g t). Only the sin/cos radius shows
+    # it (no angle moves), so no profile of an angle-only log (angle1); 1e-3 /s (a fast
+    # warm-up) moves the radius by 3e-3 over a 3 s log, g T / sqrt 12 = 8.7e-4 rms about
+    # its mean (the mean is the unknown amplitude), 11x the sin/cos floor (2 counts /
+    # 26000 = 7.7e-5); the cross term with the 0.3 % imbalance (g t alpha / 2 <= 4.5e-6) is
+    # far below it. No twin: no other catalog effect changes the radius in time.
+    # The fit's radius is r + g t (envelope_drift.h), the chain's (1 + g t)(1 + r) - 1: the
+    # mean of r (alpha/2 = 1.5e-3 for the imbalance) multiplies the slope, so the refit
+    # finds g (1 + alpha/2), 1.5e-6 above g.
+    _h("envelope_drift", "envelope_drift:g=1e-3", ["envelope_drift"], ["envelope_drift.g"],
+       ("const", "oab3", "oab1", "steps", "ramps", "reversals"),
+       truth={"envelope_drift.g": (1e-3, 1e-3 * 0.003 / 2,
+                                   "the radius' cross term g t alpha/2, first order in the fit")},
+       quiet_in_control=True),
     # K2 with sin/cos: the envelopes tell it from offsets (named alone); without them
     # (angle1) both fit.
     _h("k2", "harmonics:k2=0.001", ["harmonics(k2)"], ["harmonics.k2"], ("const", "oab1", "angle1"),

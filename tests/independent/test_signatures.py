@@ -119,6 +119,18 @@ class WindingTest(SignatureCase):
             k = -0.003
             self.check(f"harmonics:k{n}_opp={k}", lambda th: -k * np.sin((n + 1) * th), abs(k))
 
+    def test_envelope_drift(self):
+        # Both windings x (1 + g t): atan2 ignores a common positive factor, so neither
+        # angle moves (eps = 0 to the floor), and the radius grows by g t: whole counts
+        # move it by at most sqrt(2) 0.5 count, 2.7e-5 of the amplitude.
+        for g in (0.004, -0.004):
+            log, _, _ = run([f"envelope_drift:g={g}"], profile="200:3")
+            self.assertLessEqual(np.max(np.abs(log.eps())), FLOOR, f"g={g} (R/D)")
+            self.assertLessEqual(np.max(np.abs(log.eps_sincos())), FLOOR + sincos_floor(26000.0 * (1 - 3 * abs(g))),
+                                 f"g={g} (sin/cos)")
+            radius = np.hypot(log.sin, log.cos) / 26000.0 - 1.0
+            self.assertSignature(radius, g * log.t, np.sqrt(2.0) * 0.5 / 26000.0, f"envelope_drift:g={g} (radius)")
+
 
 class MechanicalTest(SignatureCase):
     def test_eccentricity(self):

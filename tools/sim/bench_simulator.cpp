@@ -85,16 +85,33 @@ SimConfig validated(SimConfig c) {
                         "must stay in (-1, 0.2)",
                         c.alpha_drift_per_s, end));
   }
-  // The envelopes must stay inside the ADC: check the peak over a fine theta grid.
+  // The envelopes must stay inside the ADC: check the peak over a fine theta grid, at
+  // times through the run (an effect may change them in time: envelope_drift). A
+  // drift is monotone over the run, so its ends and kTimeSteps between check it.
+  // They must also keep encoding the angle: against the start, no envelope pair may
+  // turn by 90 degrees or more (a gain 1 + g t through zero reverses them).
+  constexpr int kTimeSteps = 16;
+  const double duration = SpeedProfile(c.profile).duration();
   double peak = 0.0;
-  for (int i = 0; i < 3600; ++i) {
-    const SinCos sc = chain.envelopes(kTwoPi * i / 3600.0);
-    peak = std::max({peak, std::abs(sc.s), std::abs(sc.c)});
+  for (int k = 0; k <= kTimeSteps; ++k) {
+    const double t = duration * k / kTimeSteps;
+    for (int i = 0; i < 3600; ++i) {
+      const double theta = kTwoPi * i / 3600.0;
+      const SinCos sc = chain.envelopes(theta, t);
+      peak = std::max({peak, std::abs(sc.s), std::abs(sc.c)});
+      if (k == 0) continue;
+      const SinCos start = chain.envelopes(theta, 0.0);
+      require(sc.s * start.s + sc.c * start.c > 0.0 || (start.s == 0.0 && start.c == 0.0),
+              fmt::format("SimConfig profile ({} s): with the chosen effects the sin/cos envelopes at t = {:.3g} s are "
+                          "reversed against those at the start (a drifting gain reaches 0); shorten the run or lower "
+                          "the drift",
+                          duration, t));
+    }
   }
   const double peak_counts = c.amplitude_counts * peak + 5.0 * chain.impairments().sigma_sc;
   require(peak_counts <= bench::kSinCosFullScale,
           fmt::format("SimConfig amplitude_counts (--amplitude) = {}: with the chosen effects the sin/cos peak reaches {:.0f} counts "
-                      "(incl. 5 sigma noise) > 32767; lower --amplitude",
+                      "(incl. 5 sigma noise, over the whole run) > 32767; lower --amplitude",
                       c.amplitude_counts, peak_counts));
   return c;
 }
@@ -141,10 +158,10 @@ double BenchSimulator::seen_angle(double t, bool commit) {
 }
 
 SinCos BenchSimulator::converter_envelopes(double t) {
-  const SinCos at_sin = chain_.envelopes(seen_angle(t, false));
+  const SinCos at_sin = chain_.envelopes(seen_angle(t, false), t);
   const double cos_dt = chain_.timing().converter_cos_dt;
   if (cos_dt == 0.0) return at_sin;
-  return {at_sin.s, chain_.envelopes(seen_angle(t + cos_dt, false)).c};
+  return {at_sin.s, chain_.envelopes(seen_angle(t + cos_dt, false), t + cos_dt).c};
 }
 
 bool BenchSimulator::next(SimSample& out) {
@@ -175,7 +192,7 @@ bool BenchSimulator::next(SimSample& out) {
   const double theta_seen = seen_angle(t, true);  // the sample instant: motion states advance here
   const double dsp_cos_dt = chain_.timing().dsp_cos_dt;
   const double theta_seen_cos = dsp_cos_dt != 0.0 ? seen_angle(t + dsp_cos_dt, false) : theta_seen;
-  const SinCos sc{chain_.envelopes(theta_seen).s, chain_.envelopes(theta_seen_cos).c};
+  const SinCos sc{chain_.envelopes(theta_seen, t).s, chain_.envelopes(theta_seen_cos, t + dsp_cos_dt).c};
   double sin_counts = config_.amplitude_counts * sc.s + gaussian_noise(engine_, imp.sigma_sc);
   const double cos_counts = config_.amplitude_counts * sc.c + gaussian_noise(engine_, imp.sigma_sc);
   s.rd_counts = quantize_rd_angle(loop_.state().phi, config_.rd_bits);

@@ -8,7 +8,8 @@
 //                 (daemon/core/effects/forward_chain.h) at t - delay, through the
 //                 motion effects (backlash, eccentricity, mechanical harmonics, mounting)
 //   sin/cos     = amplitude_counts * envelopes: sin of theta_s(t_k), cos of
-//                 theta_s(t_k + dsp_cos_dt) (channel delay, sampling skew) + noise,
+//                 theta_s(t_k + dsp_cos_dt) (channel delay, sampling skew), each at
+//                 its own time (drifting windings: envelope_drift) + noise,
 //                 outliers                                             -> i16 counts
 //   rd_angle    = the tracking loop, integrated continuously from t_{k-1} to t_k on
 //                 the noise-free envelopes with the converter's own channel timing

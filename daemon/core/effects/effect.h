@@ -11,7 +11,8 @@
 //   ├─ forward hooks:     the simulator's chain calls them at the stage where the
 //   │                     effect acts (forward_chain.h):
 //   │                       motion      what the resolver sees of the true angle (delay, eccentricity, backlash)
-//   │                       windings    the envelopes of the resolver angle (quadrature, harmonics, gain, offsets)
+//   │                       windings    the envelopes of the resolver angle (quadrature, harmonics, gain, offsets),
+//   │                                   and of time for those that drift (envelope_drift)
 //   │                       channels    when each channel is taken (channel delay, sampling skew)
 //   │                       converter   the R/D loop and its resolution
 //   │                       currents    drive frame, inverter, current sensors
@@ -268,6 +269,15 @@ class Effect {
   [[nodiscard]] virtual double resolver_angle_shift(Values /*v*/, int /*p_r*/, int /*p*/) const { return 0.0; }
   /// Modifies the unit envelopes at resolver angle theta [rad] at one sub-stage.
   virtual void windings(Values /*v*/, WindingStage /*stage*/, double /*theta*/, SinCos& /*env*/) const {}
+  /// The same hook for windings that change in time (envelope_drift): t [s] is the
+  /// time since the log's first sample (the simulator's sample time, the fit's
+  /// SignatureRow::t). The forward chain calls this one; the default is the
+  /// time-invariant windings() above. An effect that overrides it must not be
+  /// envelope_only() (the fit's envelope spectrum is a function of the angle alone:
+  /// a generic registry test checks that) and gives its time dependence in signature().
+  virtual void windings_in_time(Values v, WindingStage stage, double theta, double /*t*/, SinCos& env) const {
+    windings(v, stage, theta, env);
+  }
   /// Adds to the channel timing.
   virtual void channel_timing(Values /*v*/, ChannelTiming& /*timing*/) const {}
   /// Sets the converter's dynamics or resolution.

@@ -51,11 +51,11 @@ double ForwardChain::resolver_angle(double theta_m, double omega_m, bool commit)
   return static_cast<double>(p_r_) * seen + shift;
 }
 
-SinCos ForwardChain::envelopes(double theta) const {
+SinCos ForwardChain::envelopes(double theta, double t) const {
   SinCos env = ideal_envelopes(theta);
   for (WindingStage stage : {WindingStage::kFundamental, WindingStage::kAdditive, WindingStage::kGain,
                              WindingStage::kOffset}) {
-    for (const Active& a : active_) a.effect->windings(a.values, stage, theta, env);
+    for (const Active& a : active_) a.effect->windings_in_time(a.values, stage, theta, t, env);
   }
   return env;
 }

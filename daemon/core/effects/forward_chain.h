@@ -3,7 +3,7 @@
 // differentiates. Pure maths; the only state is the motion effects' (backlash).
 //
 //   true theta_m(t) ──time shift (delay)──► theta_m(t - d) ──motion hooks──► seen theta_m
-//     ──x p_r + angle shift (mounting)──► theta ──windings: fundamental, additive, gain, offset──► envelopes
+//     ──x p_r + angle shift (mounting)──► theta ──windings at time t: fundamental, additive, gain, offset──► envelopes
 //     envelopes ──channel timing──► converter input (cos at t + converter_cos_dt) ──R/D loop, rd_bits──► rd_angle
 //               └─────────────────► DSP samples   (cos at t + dsp_cos_dt) ──+ noise──► sin/cos counts
 //   theta_e = p theta_m ──drive frame (mounting)──► machine currents ──inverter──► ──sensors: gain, offset──► i_a, i_b, i_c
@@ -29,8 +29,11 @@ class ForwardChain {
   /// mechanical angle (already at t - time_shift) is theta_m [rad] at speed omega_m
   /// [rad/s]. `commit`: a sample instant (motion effects with a state update it).
   [[nodiscard]] double resolver_angle(double theta_m, double omega_m, bool commit);
-  /// Unit-amplitude envelopes at resolver angle theta [rad], before noise.
-  [[nodiscard]] SinCos envelopes(double theta) const;
+  /// Unit-amplitude envelopes at resolver angle theta [rad] and time t [s] since the
+  /// log's first sample, before noise. Only effects that change in time
+  /// (Effect::windings_in_time: envelope_drift) read t; for a chain without them
+  /// the default t = 0 is every time.
+  [[nodiscard]] SinCos envelopes(double theta, double t = 0.0) const;
   [[nodiscard]] const ChannelTiming& timing() const { return timing_; }
   [[nodiscard]] const ConverterSpec& converter() const { return converter_; }
   [[nodiscard]] const Impairments& impairments() const { return impairments_; }

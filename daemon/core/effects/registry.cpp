@@ -13,6 +13,7 @@
 #include "daemon/core/effects/dead_time.h"
 #include "daemon/core/effects/delay.h"
 #include "daemon/core/effects/eccentricity.h"
+#include "daemon/core/effects/envelope_drift.h"
 #include "daemon/core/effects/harmonics.h"
 #include "daemon/core/effects/mechanical_harmonics.h"
 #include "daemon/core/effects/mounting_offset.h"
@@ -37,6 +38,7 @@ const std::vector<const Effect*>& registry() {
       &quadrature_effect(),
       &offsets_effect(),
       &harmonics_effect(),
+      &envelope_drift_effect(),
       &sampling_skew_effect(),
       &channel_delay_effect(),
       &tracking_loop_effect(),

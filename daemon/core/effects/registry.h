@@ -4,9 +4,16 @@
 // discovery's candidates and docs/EFFECTS.md all come from this list.
 //
 // Adding an effect: one file pair in this folder (an Effect subclass, see
-// effect.h), one line in registry.cpp, one hidden-effect row in
-// tests/hidden_effect. Effect and parameter names are part of the project's
-// interface (CLI, TOML, truth files, reports, scripts): keep them stable.
+// effect.h; the library takes every .cpp here), one line in registry.cpp (and its
+// #include), one hidden-effect row in tests/hidden_effect/matrix.py (the ctest
+// cases are read from it). The registry's consistency tests then ask, on purpose,
+// for what no code can decide: the names in registry_test's stable_names() (they
+// become interface), the signals it reaches in sim_effects_test's table,
+// docs/EFFECTS.md regenerated (resolver-sim --effects-markdown) and its row in
+// docs/ARCHITECTURE.md section 7; the matrix also runs the independent generator
+// (tests/independent/benchgen), which learns the effect from that row's physics.
+// Effect and parameter names are part of the project's interface (CLI, TOML,
+// truth files, reports, scripts): keep them stable.
 #pragma once
 
 #include <span>

@@ -74,6 +74,10 @@ CATALOG = {e.name: e for e in (
     EffectDef("harmonics", "resolver", _harmonic_params(),
               "eps ~ -sqrt2 K_0 cos(theta + pi/4) - K_n sin((n-1) theta) (Hanselman eq. 8-9); "
               "opposite sign: eps ~ -K sin((n+1) theta)"),
+    EffectDef("envelope_drift", "resolver",
+              (Param("g", "1/s", None, -0.01, 0.01,
+                     "excitation amplitude drifting: both windings x (1 + g t), t from the first sample"),),
+              "eps = 0 (atan2 ignores a common gain); envelope radius x (1 + g t)"),
     EffectDef("eccentricity", "resolver",
               (Param("e", "rad", None, -0.5, 0.5, "1x mechanical angle error amplitude [mech rad]"),
                Param("phase", "rad", 0.0, -10.0, 10.0, "its phase [mech rad]")),

@@ -1,7 +1,8 @@
 """Resolver windings: unit-amplitude demodulated envelopes S(theta), C(theta).
 
 Hanselman eq. 8 (inductance harmonics, in phase on both windings) and eq. 16 (amplitude
-imbalance multiplies the whole cos winding), eq. 6 (quadrature: cos(theta + beta)), plus:
+imbalance multiplies the whole cos winding), eq. 6 (quadrature: cos(theta + beta)), eq. 1's common amplitude V_1 drifting in time
+(envelope_drift: both windings x (1 + g t), the excitation warming up), plus:
   - harmonics of opposite sign (an odd nonlinearity of both inputs):
         s += K sin(n theta), c -= K cos(n theta)
   - additive offsets o_s, o_c after the gains (the amplifier/ADC path).
@@ -15,6 +16,7 @@ class Windings:
     def __init__(self, effects):
         self.alpha = effects.param("amplitude_imbalance", "alpha")
         self.alpha_rate = effects.param("alpha_drift", "rate")
+        self.excitation_rate = effects.param("envelope_drift", "g")
         self.beta = effects.param("quadrature", "beta")
         self.o_s = effects.param("offsets", "o_s")
         self.o_c = effects.param("offsets", "o_c")
@@ -40,7 +42,7 @@ class Windings:
         cos_gain = 1.0 + self.alpha + self.alpha_rate * t
         if self.speed_k:
             cos_gain = cos_gain * (1.0 + self.speed_k * np.abs(omega))
-        both_gain = 1.0
+        both_gain = 1.0 + self.excitation_rate * np.asarray(t)
         for step in self.steps:
             after = np.asarray(t) >= step["at"]
             both_gain = both_gain * np.where(after, 1.0 + step["gain"], 1.0)

@@ -56,10 +56,12 @@ SignalValues forward_signals(const ChainValues& values, const Bench& b, int i) {
   const double theta_true = b.p_r * theta_m_at(b, t);
   auto seen = [&](double tt) { return chain.resolver_angle(theta_m_at(b, tt), b.omega_m, false); };
   const double tr = t - chain.time_shift();
+  // Each channel at its own time (windings that drift in time: envelope_drift), as the simulator takes them.
   auto converter_env = [&](double tt) {
     const double a = tt - chain.time_shift();
-    const SinCos at_sin = chain.envelopes(seen(a));
-    return SinCos{at_sin.s, chain.envelopes(seen(a + chain.timing().converter_cos_dt)).c};
+    const double cos_dt = chain.timing().converter_cos_dt;
+    const SinCos at_sin = chain.envelopes(seen(a), tt);
+    return SinCos{at_sin.s, chain.envelopes(seen(a + cos_dt), tt + cos_dt).c};
   };
   double phi = 0.0;
   const ConverterSpec conv = chain.converter();
@@ -78,8 +80,9 @@ SignalValues forward_signals(const ChainValues& values, const Bench& b, int i) {
   }
   SignalValues out;
   out.rd = wrap_pi(theta_true - phi);
-  const SinCos s_at = chain.envelopes(seen(tr));
-  const SinCos c_at = chain.envelopes(seen(tr + chain.timing().dsp_cos_dt));
+  const double dsp_cos_dt = chain.timing().dsp_cos_dt;
+  const SinCos s_at = chain.envelopes(seen(tr), t);
+  const SinCos c_at = chain.envelopes(seen(tr + dsp_cos_dt), t + dsp_cos_dt);
   out.sa = wrap_pi(theta_true - std::atan2(s_at.s, c_at.c));
   out.sr = std::hypot(s_at.s, c_at.c) - 1.0;
   const double theta_e = b.p * theta_m_at(b, t);
@@ -204,6 +207,30 @@ TEST(RegistrySignatures, EveryLinearParameterMatchesTheForwardChainDerivative) {
   // a new effect is covered without editing this test. The bound only guards
   // against the loop silently checking nothing.
   EXPECT_GE(checked, 3 * 80);
+}
+
+TEST(RegistrySignatures, EnvelopeOnlyEffectsDoNotChangeInTime) {
+  // The fit evaluates the envelope_only() effects jointly as a Fourier series of the
+  // angle alone (envelope_spectrum.h): an effect whose windings drift in time
+  // (Effect::windings_in_time) must describe itself through signature() instead.
+  // Every parameter at 1 % of its range from neutral, the chain at two times.
+  int checked = 0;
+  for (const Effect* e : effect_registry()) {
+    if (!e->envelope_only()) continue;
+    for (const ParamInfo& p : e->params()) {
+      ChainValues v;
+      v.set(e->name(), p.name, p.neutral < p.max ? p.neutral + 0.01 * (p.max - p.neutral) : p.neutral - 0.01 * (p.neutral - p.min));
+      const ForwardChain chain(v, 3, 3);
+      for (int i = 0; i < kGrid; ++i) {
+        const double theta = kTwoPi * (i + 0.37) / kGrid;
+        const SinCos a = chain.envelopes(theta, 0.0), b = chain.envelopes(theta, 123.4);
+        ASSERT_EQ(a.s, b.s) << e->name() << "." << p.name << " changes in time but is envelope_only()";
+        ASSERT_EQ(a.c, b.c) << e->name() << "." << p.name << " changes in time but is envelope_only()";
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 4) << "amplitude_imbalance, quadrature, offsets and harmonics are envelope_only()";
 }
 
 /// The model's prediction of the rd/s/c signals for `values` (all effects), as the fit builds it.

@@ -39,6 +39,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& stable_name
       {"quadrature", {"beta"}},
       {"offsets", {"o_s", "o_c"}},
       {"harmonics", {"k0", "k2", "k3", "k4", "k5"}},
+      {"envelope_drift", {"g"}},
       {"sampling_skew", {"tau"}},
       {"channel_delay", {"tau"}},
       {"tracking_loop", {"omega_n", "zeta"}},
@@ -171,6 +172,7 @@ TEST(ChainValues, SpecsSetTheParameters) {
   c.apply_spec("noise:sigma_sc=2");
   c.apply_spec("quantization:rd_bits=12");
   c.apply_spec("harmonics:k0=0.001,k3=-2e-4,k16=1e-5,k3_opp=3e-4");
+  c.apply_spec("envelope_drift:g=-2e-4");
   EXPECT_DOUBLE_EQ(c.get("amplitude_imbalance", "alpha"), 0.003);
   EXPECT_DOUBLE_EQ(c.get("quadrature", "beta"), 0.004);
   EXPECT_DOUBLE_EQ(c.get("offsets", "o_s"), 0.001);
@@ -183,6 +185,7 @@ TEST(ChainValues, SpecsSetTheParameters) {
   EXPECT_DOUBLE_EQ(c.get("harmonics", "k3"), -2e-4);
   EXPECT_DOUBLE_EQ(c.get("harmonics", "k16"), 1e-5);
   EXPECT_DOUBLE_EQ(c.get("harmonics", "k3_opp"), 3e-4);
+  EXPECT_DOUBLE_EQ(c.get("envelope_drift", "g"), -2e-4);
   c.apply_spec("sampling_skew:tau=2e-6");
   c.apply_spec("channel_delay:tau=-3e-6");
   c.apply_spec("backlash:h=0.01");
@@ -359,6 +362,7 @@ TEST(ChainValues, BadSpecsSayWhatIsWrong) {
   expect_error("current_gain_mismatch:gain_a=-0.7", {"gain_a"});
   expect_error("dead_time:t_d=-1e-6", {"t_d", "[s]"});
   expect_error("backlash:h=-0.01", {"'h'", "backlash", "[rad]"});
+  expect_error("envelope_drift:g=0.1", {"'g'", "envelope_drift", "[1/s]"});
   expect_error("outliers:rate=-1", {"rate", "[1/s]"});
   // Grammar.
   expect_error("amplitude_imbalance", {"no parameters", "alpha"});

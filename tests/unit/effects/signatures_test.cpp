@@ -10,6 +10,7 @@
 
 #include "daemon/core/angles.h"
 #include "daemon/core/effects/amplitude_imbalance.h"
+#include "daemon/core/effects/envelope_drift.h"
 #include "daemon/core/effects/harmonics.h"
 #include "daemon/core/effects/offsets.h"
 #include "daemon/core/effects/quadrature.h"
@@ -155,6 +156,48 @@ TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
   const SinCos a = forward_chain({{"amplitude_imbalance", "alpha", 0.004}}).envelopes(0.3);
   const SinCos k = forward_chain({{"harmonics", "k3", -0.002}}).envelopes(0.3);
   EXPECT_GT(std::abs(a.c - k.c) + std::abs(a.s - k.s), 1e-3);
+}
+
+TEST(EffectsSignatures, EnvelopeDriftScalesTheRadiusAndNoAngle) {
+  // Both envelopes x (1 + g t) (envelope_drift.h): atan2 of a common positive factor is
+  // the same angle, so the exact position error is 0 to rounding at every time, and
+  // the radius is exactly 1 + g t.
+  for (const double g : {-1e-3, 2e-4, 1e-3}) {
+    const ForwardChain chain = forward_chain({{"envelope_drift", "g", g}});
+    for (const double t : {0.0, 0.37, 3.0, 60.0}) {
+      for (int i = 0; i < 360; ++i) {
+        const double theta = kTwoPi * (i + 0.37) / 360.0;
+        const SinCos sc = chain.envelopes(theta, t);
+        ASSERT_NEAR(wrap_pi(theta - std::atan2(sc.s, sc.c)), 0.0, 1e-15) << "g=" << g << " t=" << t;
+        ASSERT_NEAR(std::hypot(sc.s, sc.c) - 1.0, envelope_drift_radius({g}, t), 1e-15) << "g=" << g << " t=" << t;
+      }
+    }
+    // The radius moves by g t: at t = 3 s that is 3|g|, far above the rounding bound above.
+    EXPECT_NEAR(envelope_drift_radius({g}, 3.0), 3.0 * g, 1e-18);
+  }
+  // Common to both channels: with an imbalance the angle error is the imbalance's alone
+  // at every time (the drift scales s and (1 + alpha) c alike), and the gain multiplies
+  // the imbalance's radius: (1 + g t) hypot(s, (1 + alpha) c).
+  const double alpha = 0.02, g = 1e-3, t = 2.5;
+  const ForwardChain both = forward_chain({{"amplitude_imbalance", "alpha", alpha}, {"envelope_drift", "g", g}});
+  const ForwardChain imbalance = forward_chain({{"amplitude_imbalance", "alpha", alpha}});
+  for (int i = 0; i < 360; ++i) {
+    const double theta = kTwoPi * (i + 0.37) / 360.0;
+    const SinCos a = both.envelopes(theta, t), b = imbalance.envelopes(theta, t);
+    ASSERT_NEAR(std::atan2(a.s, a.c), std::atan2(b.s, b.c), 1e-15) << theta;
+    ASSERT_NEAR(std::hypot(a.s, a.c), (1.0 + g * t) * std::hypot(b.s, b.c), 1e-15) << theta;
+  }
+  // Time origin (envelope_drift.h): a log starting t0 later sees
+  // (1 + g (t0 + t)) = (1 + g t0)(1 + g' t), g' = g / (1 + g t0): a constant gain (the
+  // fit's amplitude nuisance) times the same kind of drift.
+  const double t0 = 40.0, g_late = g / (1.0 + g * t0);
+  const ForwardChain late = forward_chain({{"envelope_drift", "g", g_late}});
+  for (const double tt : {0.0, 1.0, 3.0}) {
+    const SinCos a = forward_chain({{"envelope_drift", "g", g}}).envelopes(0.7, t0 + tt);
+    const SinCos b = late.envelopes(0.7, tt);
+    EXPECT_NEAR(a.s, (1.0 + g * t0) * b.s, 1e-15) << tt;
+    EXPECT_NEAR(a.c, (1.0 + g * t0) * b.c, 1e-15) << tt;
+  }
 }
 
 TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {

@@ -41,6 +41,9 @@ TEST(SimEffects, EverySpecChangesExactlyTheSignalsItReaches) {
       {"quadrature", {"quadrature:beta=0.01", kSinCos | kRd}},
       {"offsets", {"offsets:o_s=0.01", kSinCos | kRd}},
       {"harmonics", {"harmonics:k3=0.005", kSinCos | kRd}},
+      // Both channels x (1 + g t): the radius, never the angle (the converter's atan2 and
+      // its loop's error signal keep their zero; 0.1 s reaches 1e-3 = 26 counts).
+      {"envelope_drift", {"envelope_drift:g=0.01", kSinCos}},
       {"sampling_skew", {"sampling_skew:tau=2e-5", kSinCos}},  // the DSP's sampling, not the converter
       {"channel_delay", {"channel_delay:tau=2e-5", kSinCos | kRd}},  // the analog path: both see it
       {"tracking_loop", {"tracking_loop:omega_n=1000", kRd}},
@@ -106,6 +109,30 @@ TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
     peaks.push_back(peak);
   }
   EXPECT_GT(peaks[1], 2.5 * peaks[0]) << "three times the speed, about three times the error";
+}
+
+TEST(SimEffects, EnvelopeDriftScalesBothChannelsInTimeAndNoAngle) {
+  // Both channels x (1 + g t), t from the first sample (envelope_drift.h): the radius in
+  // counts follows A (1 + g t), the sampled angle and the R/D angle stay at the floor.
+  // Bounds: rounding each channel to whole counts moves the radius by <= 0.5 sqrt2
+  // counts and atan2 by <= 0.71 / (A (1 - |g| T)); the R/D angle by half a 16-bit LSB.
+  for (const double g : {1e-3, -1e-3}) {
+    SimConfig c = quiet(200.0, 3.0);
+    c.chain.set("envelope_drift", "g", g);
+    const double a = c.amplitude_counts;
+    double first = 0.0, last = 0.0;
+    for (const SimSample& s : run(c)) {
+      const double t = static_cast<double>(s.index) / c.sample_rate_hz;
+      const double radius = std::hypot(static_cast<double>(s.sin_counts), static_cast<double>(s.cos_counts));
+      ASSERT_NEAR(radius, a * (1.0 + g * t), 0.5 * std::numbers::sqrt2 + 1e-9) << "g=" << g << " t=" << t;
+      ASSERT_NEAR(wrap_pi(s.theta - std::atan2(s.sin_counts, s.cos_counts)), 0.0, 0.71 / (a * (1.0 - 3.0 * std::abs(g))))
+          << "g=" << g << " t=" << t;
+      ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), 0.0, 0.5 * quantization_lsb(16) + 1e-12) << "g=" << g << " t=" << t;
+      (s.index == 0 ? first : last) = radius;
+    }
+    // Over the 3 s the radius moved by 3 g A = 78 counts, far above the rounding.
+    EXPECT_NEAR(last - first, 3.0 * g * a, 2.0) << "g=" << g;
+  }
 }
 
 TEST(SimEffects, EccentricityIsOneTimesMechanicalInBothAngles) {
@@ -208,6 +235,24 @@ TEST(SimEffects, BadEffectParametersNameTheField) {
     ADD_FAILURE() << "accepted a non-monotone seen angle";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("mechanical_harmonics"), std::string::npos) << e.what();
+  }
+  // A drifting envelope gain is checked over the whole run, not at its start: 1 + g t
+  // reaches 1.3 after 30 s (33800 counts: clips) and 0 after 100 s (reverses the envelopes).
+  c = quiet(200.0, 30.0);
+  c.chain.set("envelope_drift", "g", 0.01);
+  try {
+    BenchSimulator sim(c);
+    ADD_FAILURE() << "accepted envelopes that clip at the end of the run";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("over the whole run"), std::string::npos) << e.what();
+  }
+  c = quiet(200.0, 120.0);
+  c.chain.set("envelope_drift", "g", -0.01);
+  try {
+    BenchSimulator sim(c);
+    ADD_FAILURE() << "accepted envelopes whose gain goes through zero";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("reversed"), std::string::npos) << e.what();
   }
   c = quiet(200.0, 0.01);
   c.i_q_cmd = 32.0;  // fits the i16 mA range alone...
