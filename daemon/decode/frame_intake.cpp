@@ -4,6 +4,20 @@
 
 namespace resolver {
 
+namespace {
+/// How to read interface `name` instead: resolverd and resolver-model read one
+/// interface of a log, the first with a frame of the layout.
+std::string how_to_read(const std::string& name) {
+  std::string asc;
+  if (name.size() > 3 && name.compare(0, 3, "can") == 0 &&
+      name.find_first_not_of("0123456789", 3) == std::string::npos && name.size() < 8) {
+    asc = "; a Vector ASC log: the lines of channel " + std::to_string(std::stoi(name.substr(3)) + 1);
+  }
+  return "To read " + name + " instead, replay a log of its lines only (candump -l: grep ' " + name + " ' LOG > " +
+         name + ".log" + asc + ")";
+}
+}  // namespace
+
 std::string describe_frame_time(std::int64_t timestamp_us) {
   char buf[48];
   const auto sec = timestamp_us / 1000000;
@@ -88,8 +102,49 @@ void FrameIntake::report_absent_roles(const CanFrame& frame, std::uint64_t line)
                                                "; missing from this frame (not decoded from another page's bits)");
 }
 
+bool FrameIntake::from_read_interface(const CanFrame& frame, std::uint64_t line) {
+  const std::string_view name = frame.iface_name();
+  if (last_interface_ >= interfaces_.size() || interfaces_[last_interface_].name != name) {
+    last_interface_ = 0;
+    while (last_interface_ < interfaces_.size() && interfaces_[last_interface_].name != name) ++last_interface_;
+    if (last_interface_ == interfaces_.size()) interfaces_.push_back(InterfaceFrames{std::string(name), 0, 0, false});
+  }
+  InterfaceFrames& iface = interfaces_[last_interface_];
+  ++iface.frames;
+  if (read_interface_ < 0 || static_cast<std::size_t>(read_interface_) == last_interface_) return true;
+  rejects_.add("other_interface");
+  ++iface.left_out;
+  if (!callbacks_.on_problem) return false;
+  const std::string& read = interfaces_[static_cast<std::size_t>(read_interface_)].name;
+  std::string msg = (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) + describe_frame(frame) + " on " +
+                    iface.name + ": ";
+  if (iface.left_out == 1) {
+    msg += "the log holds frames of more than one CAN interface; only " + read +
+           "'s are read (the first interface with a frame of the layout), " + iface.name +
+           "'s are counted as other_interface and left out (two buses' counters cannot be joined into one sample "
+           "stream). " + how_to_read(iface.name);
+  } else {
+    msg += "not the interface read (" + read + "): left out";
+  }
+  callbacks_.on_problem("other_interface", msg);
+  return false;
+}
+
+std::string FrameIntake::interface_note() const {
+  if (interfaces_.size() < 2) return {};
+  std::string list, other;
+  for (const InterfaceFrames& i : interfaces_) {
+    list += (list.empty() ? "" : ", ") + i.name + " " + std::to_string(i.frames) + " frames" +
+            (i.read ? " (read)" : i.left_out > 0 ? " (" + std::to_string(i.left_out) + " left out: other_interface)" : "");
+    if (!i.read && other.empty()) other = i.name;
+  }
+  return "the log holds frames of " + std::to_string(interfaces_.size()) + " CAN interfaces: " + list +
+         "; one interface's frames make one sample stream. " + how_to_read(other);
+}
+
 void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
   ++stats_.frames_seen;
+  if (!frame.iface_name().empty() && !from_read_interface(frame, line)) return;
   if (frame.error) {
     ++stats_.bus_errors;
     return;
@@ -107,6 +162,10 @@ void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
     }
     reject(to_string(r.reject), frame, line, detail);
     return;
+  }
+  if (read_interface_ < 0 && !frame.iface_name().empty()) {
+    read_interface_ = static_cast<int>(last_interface_);
+    interfaces_[last_interface_].read = true;
   }
   if (r.status == DecodeStatus::kBenchInfo) {
     ++stats_.frames_decoded;

@@ -1,6 +1,7 @@
 // Front half of the pipeline: CAN frames in, joined bench samples out.
 //
-//   frame ─► error frame? ─► bus_errors
+//   frame ─► another interface than the one read? ─► other_interface (per interface)
+//         └► error frame? ─► bus_errors
 //         └► FrameDecoder (ID, DLC, CRC, units) ─► reject counters
 //              └► CounterCheck per message (repeated / some lost / wrong sequence)
 //                   └► SampleJoiner ─► on_sample(BenchSample)
@@ -9,6 +10,15 @@
 //
 // No I/O: problems are reported through the Diagnostics callback with a
 // message that names the frame (and log line when the caller knows it).
+//
+// One interface: a log can hold several buses (candump -l any, two benches on
+// can0 and can1, the same frames seen on both). Their counters are unrelated, so
+// joining them made one nonsense stream (counter jumps read as hundreds of seconds
+// of a standing rotor). The frames of the first interface that carries a frame of
+// the layout are read; every other interface's are counted (other_interface, and
+// per interface in interfaces()) and left out, the first of each with a message
+// that says how to read it instead. Frames without an interface name (SocketCAN,
+// CSV rows) are always read.
 #pragma once
 
 #include <cstdint>
@@ -32,6 +42,14 @@ struct IntakeStats {
   std::int64_t samples_complete = 0;
   std::int64_t samples_incomplete = 0;
   std::int64_t frames_lost = 0;      ///< frames missing according to counter gaps
+};
+
+/// Frames of one CAN interface of a log (CanFrame::iface_name()).
+struct InterfaceFrames {
+  std::string name;
+  std::int64_t frames = 0;    ///< every frame of the interface
+  std::int64_t left_out = 0;  ///< of them, counted as other_interface (not the interface read)
+  bool read = false;          ///< the interface whose frames are joined
 };
 
 class FrameIntake {
@@ -75,9 +93,17 @@ class FrameIntake {
   [[nodiscard]] std::shared_ptr<const FrameDecoder> decoder_ptr() const { return decoder_; }
   /// Counter of the last frame decoded (valid once one was).
   [[nodiscard]] std::uint8_t last_frame_counter() const { return part_.counter; }
+  /// Every interface named by a frame so far, in order of appearance (empty live).
+  [[nodiscard]] const std::vector<InterfaceFrames>& interfaces() const { return interfaces_; }
+  /// With frames of more than one interface: one sentence naming each with its frames,
+  /// which was read and how to read another; "" otherwise.
+  [[nodiscard]] std::string interface_note() const;
 
  private:
   void reject(std::string_view reason, const CanFrame& frame, std::uint64_t line, const std::string& detail);
+  /// Counts the frame under its interface; false when it belongs to another interface
+  /// than the one read (counted as other_interface, reported once per interface).
+  bool from_read_interface(const CanFrame& frame, std::uint64_t line);
   void on_joined(const BenchSample& sample);
   /// The message for a kMuxPageUnmapped reject: switch value and where the roles are.
   [[nodiscard]] std::string mux_page_detail(const CanFrame& frame, std::uint64_t mux_value) const;
@@ -94,6 +120,9 @@ class FrameIntake {
   IntakeStats stats_;
   DecodedPart part_;
   BenchInfo info_;
+  std::vector<InterfaceFrames> interfaces_;
+  std::size_t last_interface_ = 0;  ///< index into interfaces_ of the previous frame's
+  int read_interface_ = -1;         ///< index into interfaces_; -1 until a frame of the layout came
 };
 
 /// "frame 100 at (1700000000.123456)": how messages name a frame (ID in hex, time as candump prints it).

@@ -306,6 +306,21 @@ def main():
              also={"counter_gap": 1, "frames_lost": 1},
              note="PHASE_CURRENTS' counter also jumps 9 -> 11 (one frame lost)")
 
+    # ---- issue 25 ("Trust"): a second interface in the log
+    second = []
+    for k in range(N_SAMPLES):  # a second bench on can1, its counter 100 further, 130 us after can0's frames
+        for l in sample_lines(k + 100):
+            t, rest = l[1:].split(")", 1)
+            us = round(float(t) * 1e6) - PERIOD_US * 100 + 130
+            second.append("(%d.%06d)%s" % (us // 1_000_000, us % 1_000_000, rest.replace(" can0 ", " can1 ")))
+    mixed = sorted(base + second, key=lambda l: float(l[1:l.index(")")]))
+    log_case("other_interface", mixed, "other_interface", 3 * N_SAMPLES,
+             "on can1: the log holds frames of more than one CAN interface; only can0's are read (the first "
+             "interface with a frame of the layout), can1's are counted as other_interface and left out",
+             samples=N_SAMPLES,
+             note="a second bench on can1 interleaved: before, its counters were joined with can0's (hundreds of "
+                  "seconds of a standing rotor in a 12 ms log)")
+
     # ---- signal faults (issue 16): the frames are fine, the signals are not
     health_case("dead_excitation", clean_log(1000, amplitude=0, rd_follows=False), {"loss_of_signal": 1.0},
                 "signal fault loss_of_signal started 0.000 s into the input (sample 0): sin/cos amplitude 0.0",

@@ -31,6 +31,11 @@ now are refused or counted with a message naming the file, line, column or optio
                   r/min ramp raised "signal fault outliers started ... 7 impulsive
                   sample(s)" and "... ended 0.000 s (sample 0)" at every pass's joint;
                   the joint is no fault now (the log's own faults still show per pass)
+  MixedInterfaces a candump log of two benches (can0, and can1 whose counter runs 100
+                  periods ahead) was joined into one stream: "the rotor hardly moves"
+                  over 501 s of a 2 s log; now can0 (the first interface with a bench
+                  frame) is read, can1's frames are counted per interface
+                  (other_interface) and the message says how to read can1 (grep)
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -356,6 +361,96 @@ class LoopJoints(unittest.TestCase):
         once, err = self.replay("ramp_once", "--once")
         self.assertEqual({k: v["samples"] for k, v in once["signal_health"]["faults"].items() if v["samples"]}, {})
         self.assertNotIn("signal fault", err)
+
+
+def candump_frames(path):
+    """(time [us], interface, frame) of every line of a candump -l log."""
+    out = []
+    with open(path) as f:
+        for line in f:
+            t, iface, frame = line.split()
+            out.append((round(float(t[1:-1]) * 1e6), iface, frame))
+    return out
+
+
+def write_candump(name, frames):
+    return write(name, "".join("(%d.%06d) %s %s\n" % (t // 1_000_000, t % 1_000_000, i, fr) for t, i, fr in frames))
+
+
+def simulate(name, *args):
+    path = work(name)
+    proc = run([os.path.join(ARGS.bin, "resolver-sim"), "--out", path, *args])
+    if proc.returncode != 0:
+        raise AssertionError(proc.stderr)
+    return path
+
+
+def replay_log(log, name, *extra):
+    """resolverd --replay LOG into NAME.lcmlog: the --report JSON and stderr."""
+    report = work(name + ".json")
+    if os.path.exists(report):
+        os.remove(report)
+    proc = run([os.path.join(ARGS.bin, "resolverd"), "--replay", log, "--once", "--fast", "--report", report,
+                "--lcm", "file://" + work(name + ".lcmlog") + "?mode=w", *extra])
+    if proc.returncode != 0:
+        raise AssertionError(f"resolverd exited {proc.returncode}:\n{proc.stderr[-3000:]}")
+    with open(report) as f:
+        return json.load(f), proc.stderr
+
+
+class MixedInterfaces(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.can0 = candump_frames(sim_log())
+        # A second bench on can1 (600 r/min), started 100 periods (50 ms) earlier: its counter runs 100 ahead.
+        other = candump_frames(simulate("bench_can1.log", "--duration", "2", "--rpm", "600", "--seed", "7",
+                                        "--iface", "can1"))
+        t0 = other[0][0]
+        cls.can1 = [(t - 50_000 + 130, i, fr) for t, i, fr in other if t >= t0 + 50_000]
+        cls.log = write_candump("two_benches.log", sorted(cls.can0 + cls.can1, key=lambda f: f[0]))
+        # The same frames seen on two interfaces.
+        twice = []
+        for t, _, fr in cls.can0:
+            twice += [(t, "can0", fr), (t + 10, "can1", fr)]
+        cls.twice = write_candump("same_frames_twice.log", twice)
+
+    def test_only_the_first_interface_is_read_and_the_other_counted(self):
+        report, err = replay_log(self.log, "two_benches")
+        n1 = len(self.can1)
+        self.assertEqual(report["rejects"], {"other_interface": n1})
+        self.assertEqual(report["samples_complete"], 4000)
+        self.assertLess(report["span_s"], 2.01)  # was 501.2 s, "the rotor hardly moves"
+        self.assertEqual(report["interfaces"], [
+            {"name": "can0", "frames": len(self.can0), "left_out": 0, "read": True},
+            {"name": "can1", "frames": n1, "left_out": n1, "read": False}])
+        self.assertIn("on can1: the log holds frames of more than one CAN interface; only can0's are read (the first "
+                      "interface with a frame of the layout), can1's are counted as other_interface and left out", err)
+        self.assertIn("To read can1 instead, replay a log of its lines only (candump -l: grep ' can1 ' LOG > can1.log",
+                      err)
+        self.assertNotIn("hardly moves", err)
+
+    def test_resolver_model_names_the_interfaces(self):
+        proc = model("explain", self.log)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("covers: 4000 of 4000 samples fitted", proc.stdout)
+        self.assertIn("note: the log holds frames of 2 CAN interfaces: can0 %d frames (read), can1 %d frames (%d left "
+                      "out: other_interface)" % (len(self.can0), len(self.can1), len(self.can1)), proc.stdout)
+
+    def test_the_grep_it_suggests_reads_the_other_bench(self):
+        with open(self.log) as f:
+            only = write("can1.log", "".join(line for line in f if " can1 " in line))
+        report, err = replay_log(only, "can1_only")
+        self.assertEqual(report["rejects"], {})
+        self.assertEqual(report["samples_complete"], sum(not f[2].startswith("1F0") for f in self.can1) // 3)
+        self.assertNotIn("interface", err)
+        proc = model("explain", only)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("600 r/min", proc.stdout)
+
+    def test_the_same_frames_on_two_interfaces(self):
+        report, _ = replay_log(self.twice, "twice")
+        self.assertEqual(report["rejects"], {"other_interface": len(self.can0)})  # was counter_repeated
+        self.assertEqual(report["samples_complete"], 4000)
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <string>
 #include <variant>
 #include <vector>
 
@@ -134,6 +135,72 @@ TEST(FrameIntake, BadFramesAreCountedAndNeverCorruptNeighbours) {
   EXPECT_EQ(rec.samples.back().index - rec.samples.front().index, 9);
   EXPECT_FALSE(rec.problems.empty());
   EXPECT_NE(rec.problems.front().find("frame 100"), std::string::npos) << rec.problems.front();
+}
+
+std::vector<CanFrame> periods(int first, int count) {
+  std::vector<CanFrame> f;
+  for (int k = first; k < first + count; ++k) push_sample(f, k);
+  return f;
+}
+
+// Issue 25 ("Trust"): two benches (or two buses) in one candump log were joined
+// into one stream; their unrelated counters read as 500 s of a standing rotor.
+TEST(FrameIntake, OnlyTheFirstInterfaceWithABenchFrameIsRead) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames;
+  CanFrame noise = bench::encode_phase_currents(999'000, 0, 0, 0, 0);
+  noise.id = 0x321;  // another ECU on can1 first: not a frame of the layout, reads no interface yet
+  noise.set_iface("can1");
+  frames.push_back(noise);
+  std::vector<CanFrame> a = periods(1, 40);
+  std::vector<CanFrame> b = periods(101, 40);  // a second bench, its counter elsewhere
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    a[i].set_iface("can0");
+    b[i].set_iface("can1");
+    b[i].timestamp_us = a[i].timestamp_us + 130;
+    frames.push_back(a[i]);
+    frames.push_back(b[i]);
+  }
+  for (const CanFrame& f : frames) intake.feed(f, 0);
+  intake.flush();
+  ASSERT_EQ(rec.samples.size(), 40U);
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) {
+    EXPECT_EQ(rec.samples[i].index, static_cast<std::int64_t>(i) + 1);
+    EXPECT_TRUE(rec.samples[i].complete());
+  }
+  EXPECT_EQ(intake.rejects().get("other_interface"), 120);
+  EXPECT_EQ(intake.rejects().get("unknown_id"), 1);
+  EXPECT_EQ(intake.rejects().total(), 121);
+  ASSERT_EQ(intake.interfaces().size(), 2U);
+  EXPECT_EQ(intake.interfaces()[0].name, "can1");
+  EXPECT_EQ(intake.interfaces()[0].frames, 121);
+  EXPECT_EQ(intake.interfaces()[0].left_out, 120);
+  EXPECT_FALSE(intake.interfaces()[0].read);
+  EXPECT_EQ(intake.interfaces()[1].name, "can0");
+  EXPECT_TRUE(intake.interfaces()[1].read);
+  const auto it = std::find_if(rec.problems.begin(), rec.problems.end(),
+                               [](const std::string& p) { return p.rfind("other_interface", 0) == 0; });
+  ASSERT_NE(it, rec.problems.end());
+  EXPECT_NE(it->find("frame 100 at (1.000630) on can1: the log holds frames of more than one CAN interface; "
+                     "only can0's are read"),
+            std::string::npos)
+      << *it;
+  EXPECT_NE(it->find("grep ' can1 ' LOG > can1.log"), std::string::npos) << *it;
+  EXPECT_EQ(intake.interface_note(),
+            "the log holds frames of 2 CAN interfaces: can1 121 frames (120 left out: other_interface), can0 120 "
+            "frames (read); one interface's frames make one sample stream. To read can1 instead, replay a log of "
+            "its lines only (candump -l: grep ' can1 ' LOG > can1.log; a Vector ASC log: the lines of channel 2)");
+}
+
+TEST(FrameIntake, FramesWithoutAnInterfaceNameAreAlwaysRead) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  for (const CanFrame& f : periods(1, 10)) intake.feed(f);  // live SocketCAN: no name
+  intake.flush();
+  EXPECT_EQ(rec.samples.size(), 10U);
+  EXPECT_TRUE(intake.interfaces().empty());
+  EXPECT_EQ(intake.interface_note(), "");
 }
 
 TEST(FrameDecoder, SignalMapErrorsNameTheProblem) {
