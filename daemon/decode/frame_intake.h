@@ -3,8 +3,10 @@
 //   frame ─► another interface than the one read? ─► other_interface (per interface)
 //         └► error frame? ─► bus_errors
 //         └► FrameDecoder (ID, DLC, CRC, units) ─► reject counters
-//              └► CounterCheck per message (repeated / some lost / wrong sequence)
-//                   └► SampleJoiner ─► on_sample(BenchSample)
+//              └► counter outside the reorder window? held until the next frames say
+//                 whether a new sequence starts with it or it was a stray (late) frame
+//                   └► SampleJoiner (reorder window, repeated / reordered / late,
+//                      frames lost as the gaps samples leave) ─► on_sample(BenchSample)
 //              └► (layout without a counter) LeadingFrameJoiner ─► on_sample
 //   BENCH_INFO ─► on_bench_info(BenchInfo)
 //
@@ -27,7 +29,6 @@
 #include <string>
 #include <vector>
 
-#include "daemon/decode/counter_check.h"
 #include "daemon/decode/frame_decoder.h"
 #include "daemon/decode/leading_frame_joiner.h"
 #include "daemon/decode/reject_counters.h"
@@ -78,6 +79,7 @@ class FrameIntake {
   void count_problem_silently(std::string_view reason, std::int64_t n = 1) { rejects_.add(reason, n); }
   /// Emits the sample still open (end of input).
   void flush() {
+    drop_held();  // no frames after them to start a sequence with
     joiner_.flush();
     order_joiner_.flush();
   }
@@ -101,6 +103,17 @@ class FrameIntake {
 
  private:
   void reject(std::string_view reason, const CanFrame& frame, std::uint64_t line, const std::string& detail);
+  /// A part of a layout with a counter: held, joined or dropped (see the drawing above).
+  void feed_counted(const CanFrame& frame, std::uint64_t line);
+  /// Joins `part` (of `frame`, at `line`) and counts what the joiner says of it.
+  void join(const DecodedPart& part, const CanFrame& frame, std::uint64_t line);
+  /// The held out-of-window frames did not start a sequence: counted and dropped.
+  void drop_held();
+  /// SampleJoiner: `slot` missing from `frames` periods came back in `sample`.
+  void on_lost(int slot, std::int64_t frames, const BenchSample& sample);
+  [[nodiscard]] const std::string& slot_name(int slot) const {
+    return decoder_->slots()[static_cast<std::size_t>(slot)].message->name;
+  }
   /// Counts the frame under its interface; false when it belongs to another interface
   /// than the one read (counted as other_interface, reported once per interface).
   bool from_read_interface(const CanFrame& frame, std::uint64_t line);
@@ -113,13 +126,24 @@ class FrameIntake {
   std::shared_ptr<const FrameDecoder> decoder_;
   int max_counter_delta_;
   Callbacks callbacks_;
-  std::vector<CounterCheck> counters_;
   SampleJoiner joiner_;             ///< layouts with a counter
   LeadingFrameJoiner order_joiner_;  ///< layouts without one
   RejectCounters rejects_;
   IntakeStats stats_;
   DecodedPart part_;
   BenchInfo info_;
+  /// Parts whose counter is outside the joiner's window, until the next parts say
+  /// whether a new sequence starts with them (joined) or they were strays (dropped):
+  /// a frame of the current window drops them; a sequence ahead is confirmed by a
+  /// second frame near it, one behind (a restart, logs appended, or frames later than
+  /// the window) by 64 frames in a row (feed_counted()).
+  struct Held {
+    DecodedPart part;
+    CanFrame frame;
+    std::uint64_t line = 0;
+  };
+  std::vector<Held> held_;
+  std::uint8_t held_newest_ = 0;  ///< the newest counter of the held frames
   std::vector<InterfaceFrames> interfaces_;
   std::size_t last_interface_ = 0;  ///< index into interfaces_ of the previous frame's
   int read_interface_ = -1;         ///< index into interfaces_; -1 until a frame of the layout came
