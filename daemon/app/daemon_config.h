@@ -33,7 +33,7 @@
 //   bench_info_message = "BENCH_INFO"
 //   max_counter_delta = 8      # counter steps of one sequence: frames up to this many periods out of
 //                              # order join their sample (a sample waits as long for a missing frame);
-//                              # a bigger jump starts a new sequence
+//                              # a bigger jump starts a new sequence. Timed CSV rows: the reorder window
 //   [layout.signals]           # role = "MESSAGE.signal"
 //   sin = "RESOLVER_SAMPLE.sin"
 //   [estimator]

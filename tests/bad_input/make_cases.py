@@ -406,6 +406,13 @@ def main():
              "line %d: sample 15 at (1704067199.007500): the timestamp goes back 0.999500 s" % (row_at + 1),
              samples=N_SAMPLES, ext=".csv", config="scope.toml",
              note="rows from 15 on are 1 s earlier: counted, re-anchored, every row used")
+    swapped = list(rows)
+    swapped[row_at], swapped[row_at + 1] = swapped[row_at + 1], swapped[row_at]
+    log_case("csv_rows_swapped", swapped, "rows_reordered", 1,
+             "line %d: row at (1704067200.007500) comes before line %d's (1704067200.008000) in time: rows out of "
+             "order, used in time order (not lost)" % (row_at + 2, row_at + 1),
+             samples=N_SAMPLES, ext=".csv", config="scope.toml",
+             note="rows 15 and 16 swapped: before, a step back and two gaps (samples_lost = 2) of nothing missing")
     text_case("csv_unknown_column", ".toml", "config", SCOPE_TOML.replace('"Encoder"', '"Encoder2"'),
               "no column named 'Encoder2' (the columns are 'Time', 'Resolver', 'Encoder')")
     cases[-1]["replay"] = "cases/csv_clean.csv"

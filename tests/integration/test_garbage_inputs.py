@@ -41,6 +41,8 @@ now are refused or counted with a message naming the file, line, column or optio
                   and with frames deleted the count lost is the count deleted
   LateFrame       one frame after the next period's: angle_t's sample_index jumped
                   11 -> 268 with no gap counted; now it steps by one
+  SwappedRows     two neighbouring CSV rows in the wrong time order: "samples_lost=2"
+                  (and a step back); now rows_reordered = 1 naming both lines
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -520,6 +522,21 @@ class LateFrame(unittest.TestCase):
         self.assertEqual(jumps, [], "was [(11, 268)] with no gap counted")
         self.assertEqual(len(index), 4000)
         self.assertEqual(report["rejects"], {"frames_reordered": 1})
+
+
+class SwappedRows(unittest.TestCase):
+    def test_counted_as_reordered_with_both_lines(self):
+        names, rows = sweep_rows()
+        rows[999], rows[1000] = rows[1000], rows[999]  # data rows 999 and 1000: lines 1001 and 1002
+        csv = write("swapped.csv", "\n".join([names] + rows) + "\n")
+        clean = write("unswapped.csv", "\n".join([names] + sweep_rows()[1]) + "\n")
+        config = write("swapped.toml", SWEEP_TOML % 'delimiter = ";"\ndecimal = ","')
+        report, err = replay(csv, config, "swapped")
+        self.assertEqual(report["rejects"], {"rows_reordered": 1})  # was sample_gap 2, samples_lost 2, step back 1
+        self.assertEqual(report["samples_complete"], len(rows))
+        self.assertIn("line 1002: row at (0.999000) comes before line 1001's (1.000000) in time: rows out of order, "
+                      "used in time order (not lost) [rows_reordered]", err)
+        self.assertEqual(fit_params(csv, "--config", config), fit_params(clean, "--config", config))
 
 
 if __name__ == "__main__":
