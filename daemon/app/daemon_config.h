@@ -31,7 +31,9 @@
 //   crc_signal = "crc"
 //   crc = "j1850_bench"        # or "none"
 //   bench_info_message = "BENCH_INFO"
-//   max_counter_delta = 8
+//   max_counter_delta = 8      # counter steps of one sequence: frames up to this many periods out of
+//                              # order join their sample (a sample waits as long for a missing frame);
+//                              # a bigger jump starts a new sequence. Timed CSV rows: the reorder window
 //   [layout.signals]           # role = "MESSAGE.signal"
 //   sin = "RESOLVER_SAMPLE.sin"
 //   [estimator]

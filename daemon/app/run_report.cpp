@@ -140,6 +140,7 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     for (const auto& [reason, n] : p.intake().rejects().all()) out << fmt::format(" {}={}", reason, n);
     out << "\n";
   }
+  if (const std::string note = p.intake().interface_note(); !note.empty()) out << "  interfaces " << note << "\n";
   const ProcessorConfig& pc = p.processor().config();
   out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
   print_signal_health(out, p.signal_health().summary(), p.signal_health().monitor().config());
@@ -250,7 +251,13 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
     j += fmt::format("{}{}:{}", first ? "" : ",", json_string(reason), n);
     first = false;
   }
-  j += "},";
+  j += "},\"interfaces\":[";
+  for (std::size_t i = 0; i < p.intake().interfaces().size(); ++i) {
+    const InterfaceFrames& f = p.intake().interfaces()[i];
+    j += fmt::format("{}{{\"name\":{},\"frames\":{},\"left_out\":{},\"read\":{}}}", i ? "," : "", json_string(f.name),
+                     f.frames, f.left_out, f.read ? "true" : "false");
+  }
+  j += "],";
   j += fmt::format("\"p_r\":{},\"p\":{},", p.processor().config().p_r, p.processor().config().p);
   const ModelEstimate model = p.processor().estimate();
   double alpha = est.alpha(), alpha_se = est.alpha_stderr();

@@ -1,8 +1,23 @@
 #include "daemon/decode/frame_intake.h"
 
 #include <cstdio>
+#include <cstdlib>
 
 namespace resolver {
+
+namespace {
+/// How to read interface `name` instead: resolverd and resolver-model read one
+/// interface of a log, the first with a frame of the layout.
+std::string how_to_read(const std::string& name) {
+  std::string asc;
+  if (name.size() > 3 && name.compare(0, 3, "can") == 0 &&
+      name.find_first_not_of("0123456789", 3) == std::string::npos && name.size() < 8) {
+    asc = "; a Vector ASC log: the lines of channel " + std::to_string(std::stoi(name.substr(3)) + 1);
+  }
+  return "To read " + name + " instead, replay a log of its lines only (candump -l: grep ' " + name + " ' LOG > " +
+         name + ".log" + asc + ")";
+}
+}  // namespace
 
 std::string describe_frame_time(std::int64_t timestamp_us) {
   char buf[48];
@@ -23,22 +38,22 @@ FrameIntake::FrameIntake(std::shared_ptr<const FrameDecoder> decoder, int max_co
     : decoder_(std::move(decoder)),
       max_counter_delta_(max_counter_delta),
       callbacks_(std::move(callbacks)),
-      counters_(decoder_->slots().size(), CounterCheck(max_counter_delta)),
-      joiner_([this](const BenchSample& s) { on_joined(s); }),
+      joiner_([this](const BenchSample& s) { on_joined(s); },
+              [this](int slot, std::int64_t frames, const BenchSample& s) { on_lost(slot, frames, s); },
+              max_counter_delta),
       order_joiner_([this](const BenchSample& s) { on_joined(s); }) {}
 
 void FrameIntake::restart_sequence() {
   flush();
   joiner_.reset();
   order_joiner_.reset();
-  for (auto& c : counters_) c.reset();
 }
 
 void FrameIntake::change_decoder(std::shared_ptr<const FrameDecoder> decoder, int max_counter_delta) {
   flush();
   decoder_ = std::move(decoder);
   max_counter_delta_ = max_counter_delta;
-  counters_.assign(decoder_->slots().size(), CounterCheck(max_counter_delta));
+  joiner_.set_window(max_counter_delta);
   joiner_.reset();
   order_joiner_.reset();
 }
@@ -88,8 +103,49 @@ void FrameIntake::report_absent_roles(const CanFrame& frame, std::uint64_t line)
                                                "; missing from this frame (not decoded from another page's bits)");
 }
 
+bool FrameIntake::from_read_interface(const CanFrame& frame, std::uint64_t line) {
+  const std::string_view name = frame.iface_name();
+  if (last_interface_ >= interfaces_.size() || interfaces_[last_interface_].name != name) {
+    last_interface_ = 0;
+    while (last_interface_ < interfaces_.size() && interfaces_[last_interface_].name != name) ++last_interface_;
+    if (last_interface_ == interfaces_.size()) interfaces_.push_back(InterfaceFrames{std::string(name), 0, 0, false});
+  }
+  InterfaceFrames& iface = interfaces_[last_interface_];
+  ++iface.frames;
+  if (read_interface_ < 0 || static_cast<std::size_t>(read_interface_) == last_interface_) return true;
+  rejects_.add("other_interface");
+  ++iface.left_out;
+  if (!callbacks_.on_problem) return false;
+  const std::string& read = interfaces_[static_cast<std::size_t>(read_interface_)].name;
+  std::string msg = (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) + describe_frame(frame) + " on " +
+                    iface.name + ": ";
+  if (iface.left_out == 1) {
+    msg += "the log holds frames of more than one CAN interface; only " + read +
+           "'s are read (the first interface with a frame of the layout), " + iface.name +
+           "'s are counted as other_interface and left out (two buses' counters cannot be joined into one sample "
+           "stream). " + how_to_read(iface.name);
+  } else {
+    msg += "not the interface read (" + read + "): left out";
+  }
+  callbacks_.on_problem("other_interface", msg);
+  return false;
+}
+
+std::string FrameIntake::interface_note() const {
+  if (interfaces_.size() < 2) return {};
+  std::string list, other;
+  for (const InterfaceFrames& i : interfaces_) {
+    list += (list.empty() ? "" : ", ") + i.name + " " + std::to_string(i.frames) + " frames" +
+            (i.read ? " (read)" : i.left_out > 0 ? " (" + std::to_string(i.left_out) + " left out: other_interface)" : "");
+    if (!i.read && other.empty()) other = i.name;
+  }
+  return "the log holds frames of " + std::to_string(interfaces_.size()) + " CAN interfaces: " + list +
+         "; one interface's frames make one sample stream. " + how_to_read(other);
+}
+
 void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
   ++stats_.frames_seen;
+  if (!frame.iface_name().empty() && !from_read_interface(frame, line)) return;
   if (frame.error) {
     ++stats_.bus_errors;
     return;
@@ -108,6 +164,10 @@ void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
     reject(to_string(r.reject), frame, line, detail);
     return;
   }
+  if (read_interface_ < 0 && !frame.iface_name().empty()) {
+    read_interface_ = static_cast<int>(last_interface_);
+    interfaces_[last_interface_].read = true;
+  }
   if (r.status == DecodeStatus::kBenchInfo) {
     ++stats_.frames_decoded;
     if (callbacks_.on_bench_info) callbacks_.on_bench_info(info_);
@@ -119,41 +179,114 @@ void FrameIntake::feed(const CanFrame& frame, std::uint64_t line) {
     ++stats_.frames_decoded;
     return;
   }
-  CounterCheck& check = counters_[static_cast<std::size_t>(part_.slot)];
-  const std::string& name = decoder_->slots()[static_cast<std::size_t>(part_.slot)].message->name;
-  switch (check.check(part_.counter)) {
-    case CounterStatus::kInitial:
-    case CounterStatus::kOk: break;
-    case CounterStatus::kRepeated:
-      reject("counter_repeated", frame, line,
-             name + " counter " + std::to_string(part_.counter) + " repeated: duplicate frame dropped");
-      return;
-    case CounterStatus::kSomeLost:
-      stats_.frames_lost += check.lost();
-      rejects_.add("counter_gap");
-      rejects_.add("frames_lost", check.lost());
-      if (callbacks_.on_problem) {
-        callbacks_.on_problem("counter_gap", (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) +
-                                                 describe_frame(frame) + ": " + name + " counter jumped to " +
-                                                 std::to_string(part_.counter) + ", " + std::to_string(check.lost()) +
-                                                 " frame(s) lost");
-      }
-      break;
-    case CounterStatus::kWrongSequence:
-      rejects_.add("counter_wrong_sequence");
-      if (callbacks_.on_problem) {
-        callbacks_.on_problem("counter_wrong_sequence",
-                              (line > 0 ? "line " + std::to_string(line) + ": " : std::string()) + describe_frame(frame) +
-                                  ": " + name + " counter jumped to " + std::to_string(part_.counter) +
-                                  " (more than " + std::to_string(max_counter_delta_) + " lost): resynchronised");
-      }
-      break;
-  }
-  if (joiner_.add(part_) == JoinResult::kDuplicate) {
-    reject("duplicate_in_sample", frame, line, name + " appeared twice for counter " + std::to_string(part_.counter));
+  feed_counted(frame, line);
+}
+
+void FrameIntake::feed_counted(const CanFrame& frame, std::uint64_t line) {
+  const auto step = [](std::uint8_t from, std::uint8_t to) {
+    return static_cast<int>(static_cast<std::int8_t>(static_cast<std::uint8_t>(to - from)));
+  };
+  const bool near_held = !held_.empty() && std::abs(step(held_newest_, part_.counter)) <= joiner_.window();
+  // In the window: the sequence goes on (what was held were strays), unless the frame
+  // repeats a slot its period has while a sequence behind is held: that sequence goes
+  // on into the window (logs appended, a restart a few periods back).
+  if (joiner_.in_window(part_.counter) && !(near_held && joiner_.has_slot(part_))) {
+    drop_held();
+    join(part_, frame, line);
     return;
   }
+  if (!held_.empty()) {
+    const int from_held = step(held_newest_, part_.counter);
+    if (from_held > joiner_.window() || from_held < -joiner_.window()) drop_held();
+  }
+  if (held_.empty() || step(held_newest_, part_.counter) > 0) held_newest_ = part_.counter;
+  held_.push_back(Held{part_, frame, line});
+  // Ahead of the window (more periods lost than it spans): a second frame near it
+  // confirms the new sequence. Behind it: frames later than the window look the
+  // same, and they come between frames of the current window; a new sequence (a
+  // restart, logs appended) is confirmed by kConfirmBehind frames in a row.
+  constexpr std::size_t kConfirmBehind = 64;
+  const bool ahead = joiner_.counter_step(held_.front().part.counter) > 0;
+  if (held_.size() < (ahead ? 2 : kConfirmBehind)) return;
+  std::vector<Held> sequence = std::move(held_);
+  held_.clear();
+  for (const Held& h : sequence) join(h.part, h.frame, h.line);
+}
+
+void FrameIntake::drop_held() {
+  for (const Held& h : held_) {
+    const int step = joiner_.counter_step(h.part.counter);
+    const std::string& name = slot_name(h.part.slot);
+    const std::string where = " counter " + std::to_string(h.part.counter) + " is " + std::to_string(step < 0 ? -step : step) +
+                              " periods " + (step < 0 ? "behind" : "ahead of") + " the newest (" +
+                              std::to_string(joiner_.newest_counter()) + "), more than [layout] max_counter_delta = " +
+                              std::to_string(joiner_.window());
+    if (step >= 0) {
+      reject("counter_wrong_sequence", h.frame, h.line,
+             name + where + ", and the frames after it went on from " + std::to_string(joiner_.newest_counter()) +
+                 ": a stray frame, dropped");
+    } else if (joiner_.note_late(h.part)) {
+      reject("frames_late", h.frame, h.line,
+             name + where + ": it came after its sample was used, dropped (not lost; raise max_counter_delta if the " +
+                 "adapter reorders frames this far)");
+    } else {
+      reject("duplicate_in_sample", h.frame, h.line,
+             name + where + " and its sample has it already: a repeated frame, dropped");
+    }
+  }
+  held_.clear();
+}
+
+void FrameIntake::join(const DecodedPart& part, const CanFrame& frame, std::uint64_t line) {
+  const std::string& name = slot_name(part.slot);
+  const std::uint8_t newest = joiner_.newest_counter();
+  const std::string counter = std::to_string(part.counter);
+  switch (joiner_.add(part)) {
+    case JoinResult::kAccepted: break;
+    case JoinResult::kReordered:
+      reject("frames_reordered", frame, line,
+             name + " counter " + counter + " came after a frame of counter " + std::to_string(newest) +
+                 ": reordered, joined into its own sample (not lost)");
+      break;
+    case JoinResult::kRepeated:
+      reject("counter_repeated", frame, line, name + " counter " + counter + " repeated: duplicate frame dropped");
+      return;
+    case JoinResult::kDuplicate:
+      reject("duplicate_in_sample", frame, line, name + " appeared twice for counter " + counter);
+      return;
+    case JoinResult::kLate:
+      reject("frames_late", frame, line,
+             name + " counter " + counter + " came after its sample was used (the newest counter is " +
+                 std::to_string(newest) + "): dropped (not lost)");
+      return;
+    case JoinResult::kResync:
+      reject("counter_wrong_sequence", frame, line,
+             name + " counter jumped to " + counter + " from " + std::to_string(newest) + ": " +
+                 std::to_string(joiner_.resync_step() - 1) + " periods missing as the 8-bit counter counts, more " +
+                 "than [layout] max_counter_delta = " + std::to_string(max_counter_delta_) +
+                 ", or a new sequence (a restart, logs appended): resynchronised, the sample index advances by " +
+                 std::to_string(joiner_.resync_step()));
+      break;
+  }
   ++stats_.frames_decoded;
+}
+
+void FrameIntake::on_lost(int slot, std::int64_t frames, const BenchSample& sample) {
+  stats_.frames_lost += frames;
+  rejects_.add("counter_gap");
+  rejects_.add("frames_lost", frames);
+  if (!callbacks_.on_problem) return;
+  const auto first = static_cast<std::uint8_t>(sample.counter - frames);
+  const auto last = static_cast<std::uint8_t>(sample.counter - 1);
+  callbacks_.on_problem("counter_gap", "sample counter " + std::to_string(sample.counter) + " (index " +
+                                           std::to_string(sample.index) + ") at " +
+                                           describe_frame_time(sample.timestamp_us) + ": " + slot_name(slot) +
+                                           " counter jumped to " + std::to_string(sample.counter) + ", " +
+                                           std::to_string(frames) + " frame(s) lost (" +
+                                           (frames == 1 ? "counter " + std::to_string(first)
+                                                        : "counters " + std::to_string(first) + ".." +
+                                                              std::to_string(last)) +
+                                           " missing)");
 }
 
 void FrameIntake::on_joined(const BenchSample& sample) {

@@ -66,7 +66,11 @@ ClockReading SampleClock::read(std::int64_t stamp_us, std::optional<std::int64_t
     const bool consecutive = !counter_index || r.index_step <= config_.max_counter_delta;
     const double expected_s = static_cast<double>(r.index_step) * period;
     if (r.step_s < 0.0) {
-      r.event = ClockEvent::kStepBack;
+      // A stamp a little behind the previous one while the counter goes on and sets
+      // the time: the previous sample's frames came late (an adapter's buffering), no event.
+      const bool delivery_jitter =
+          counter_time && consecutive && -r.step_s <= kMaxUnexplainedPeriods * period;
+      if (!delivery_jitter) r.event = ClockEvent::kStepBack;
     } else if (!counter_index) {
       if (r.step_s > kMaxGapSeconds) {
         r.event = ClockEvent::kJump;

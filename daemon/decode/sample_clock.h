@@ -15,6 +15,10 @@
 //   kStepBack  the stamp went back. With a counter that continues, time
 //              continues from the counter; else t continues one period after
 //              the previous sample (the two pieces are joined end to end).
+//              (With counter time and a consecutive counter, a step back of
+//              up to kMaxUnexplainedPeriods periods is delivery jitter: the
+//              previous sample's frames came late, e.g. a USB adapter's
+//              buffering; the counter gives the time, nothing to count.)
 //   kJump      the stamp jumped forward by more than kMinJumpSeconds (and
 //              kMaxUnexplainedPeriods periods) while the counter says the
 //              samples are consecutive: a clock set, or a sender that paused;

@@ -1,6 +1,8 @@
 #include "daemon/decode/sample_stream.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include <fmt/format.h>
 
@@ -41,12 +43,15 @@ SampleStream::SampleStream(std::shared_ptr<const FrameDecoder> decoder, const Sa
       clock_(config.clock) {}
 
 void SampleStream::restart_sequence() {
+  release_rows();
+  row_passed_ = false;  // the next pass starts over in time
   intake_.restart_sequence();
   clock_.restart();
 }
 
 void SampleStream::reconfigure(std::shared_ptr<const FrameDecoder> decoder, const SampleStreamConfig& config) {
   const SampleSlice slice = config_.slice;
+  release_rows();
   if (decoder || config.clock.max_counter_delta != config_.clock.max_counter_delta) {
     intake_.change_decoder(decoder ? std::move(decoder) : intake_.decoder_ptr(), config.clock.max_counter_delta);
   }
@@ -56,7 +61,46 @@ void SampleStream::reconfigure(std::shared_ptr<const FrameDecoder> decoder, cons
 }
 
 void SampleStream::feed_row(const RowSample& row, std::uint64_t line) {
+  if (!row.has_time) {
+    pass_row(row, line);  // the row number is the sample number: nothing to reorder
+    return;
+  }
+  if (row_passed_ && row.time_us < last_row_us_) {
+    // Before a row already passed on: a step back (the clock counts it), not a swap.
+    release_rows();
+    pass_row(row, line);
+    return;
+  }
+  auto at = waiting_rows_.end();
+  while (at != waiting_rows_.begin() && std::prev(at)->row.time_us > row.time_us) --at;
+  if (at != waiting_rows_.end()) {
+    intake_.count_problem(
+        "rows_reordered",
+        fmt::format("line {}: row at {} comes before line {}'s {} in time: rows out of order, used in time order "
+                    "(not lost)",
+                    line, describe_frame_time(row.time_us), at->line, describe_frame_time(at->row.time_us)));
+  }
+  waiting_rows_.insert(at, WaitingRow{row, line});
+  const auto window = static_cast<std::size_t>(std::max(1, config_.clock.max_counter_delta));
+  if (waiting_rows_.size() > window) {
+    const WaitingRow first = waiting_rows_.front();
+    waiting_rows_.erase(waiting_rows_.begin());
+    pass_row(first.row, first.line);
+  }
+}
+
+void SampleStream::release_rows() {
+  std::vector<WaitingRow> rows = std::move(waiting_rows_);
+  waiting_rows_.clear();
+  for (const WaitingRow& w : rows) pass_row(w.row, w.line);
+}
+
+void SampleStream::pass_row(const RowSample& row, std::uint64_t line) {
   line_ = line;
+  if (row.has_time) {
+    row_passed_ = true;
+    last_row_us_ = row.time_us;
+  }
   BenchSample s;
   s.roles = row.roles;
   s.values = row.values;

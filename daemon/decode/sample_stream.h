@@ -10,7 +10,10 @@
 // Odd time is never a reason to lose samples: a stamp that steps back or
 // jumps is counted (timestamp_step_back, timestamp_jump, sample_clock_reanchored)
 // and the clock re-anchors (sample_clock.h); without a counter, gaps found from
-// time are counted (sample_gap, samples_lost). Pure: no I/O.
+// time are counted (sample_gap, samples_lost). Rows with a time column wait in a
+// window of max_counter_delta rows and go on in time order: a row that comes
+// before one it follows in time (two rows swapped) is counted as rows_reordered,
+// naming both lines, never as a step back and a gap. Pure: no I/O.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +21,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "daemon/core/sample.h"
 #include "daemon/decode/frame_intake.h"
@@ -61,8 +65,11 @@ class SampleStream {
   void feed_row(const RowSample& row, std::uint64_t line = 0);
   /// Counts a problem found before decoding (a malformed line or row).
   void count_problem(std::string_view reason, const std::string& message) { intake_.count_problem(reason, message); }
-  /// End of input: the open sample.
-  void flush() { intake_.flush(); }
+  /// End of input: the rows waiting and the open sample.
+  void flush() {
+    release_rows();
+    intake_.flush();
+  }
   /// Log loop: counters and joins restart; time and index continue.
   void restart_sequence();
   /// A config reload: `config` (its slice is ignored: the command line's stays) and,
@@ -79,6 +86,10 @@ class SampleStream {
 
  private:
   void on_joined(const BenchSample& joined);
+  /// A row on to the intake (line_ its line).
+  void pass_row(const RowSample& row, std::uint64_t line);
+  /// Passes every row waiting in the reorder window on, in time order.
+  void release_rows();
   void report_clock_event(const BenchSample& joined, const ClockReading& r);
 
   SampleStreamConfig config_;
@@ -88,6 +99,14 @@ class SampleStream {
   std::uint64_t line_ = 0;  ///< line of the frame or row being fed (messages)
   bool past_slice_end_ = false;
   std::int64_t outside_slice_ = 0;
+  /// Timed rows waiting for a row that belongs before them, sorted by time.
+  struct WaitingRow {
+    RowSample row;
+    std::uint64_t line = 0;
+  };
+  std::vector<WaitingRow> waiting_rows_;
+  bool row_passed_ = false;           ///< a timed row went on (its time in last_row_us_)
+  std::int64_t last_row_us_ = 0;
 };
 
 }  // namespace resolver

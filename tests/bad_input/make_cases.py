@@ -242,8 +242,9 @@ def main():
              note="every frame from period 12 on is a day later; the counter goes on: all samples used")
     log_case("logs_appended", base + base[1:], "timestamp_step_back", 1,
              "time continues one sample period after the previous sample (logs appended?)",
-             also={"counter_wrong_sequence": 3}, samples=2 * N_SAMPLES,
-             note="the clean log twice: time and counter both restart; the second copy joins one period on")
+             also={"counter_wrong_sequence": 1}, samples=2 * N_SAMPLES,
+             note="the clean log twice: time and counter both restart (one new sequence); the second copy joins "
+                  "one period on")
     log_case("bad_fd_flags", inserted(after, t5 + " can0 101##80A3200CEFF4C01E8"), "bad_fd_flags", 1,
              "expected the CAN FD flags nibble 0-7")
     log_case("bad_fd_length", inserted(after, t5 + " can0 101##10A3200CEFF4C01E8AA"), "dlc_too_long", 1,
@@ -285,7 +286,7 @@ def main():
     log_case("remote_frame", inserted(after, replace_data(last5, "101#R")),
              "remote_frame", 1, "line %d: frame 101 at (1700000000.003002): remote (RTR) frame" % (after + 1))
 
-    # ---- counter supervision (counter_check.h) and joining (sample_joiner.h)
+    # ---- counter supervision and joining (sample_joiner.h)
     dup = clean_log()
     dup.insert(index_of(6, 1) + 1, dup[index_of(6, 1)])  # exact copy right after the original
     log_case("counter_repeated", dup, "counter_repeated", 1,
@@ -297,14 +298,55 @@ def main():
              note="each of the three sample messages sees its counter jump 6 -> 9 once; frames_lost = 6")
     jump = clean_log()
     del jump[index_of(7, 0): index_of(18, 2) + 1]  # 12 periods lost: more than max_counter_delta = 8
-    log_case("counter_wrong_sequence", jump, "counter_wrong_sequence", 3,
-             "RESOLVER_SAMPLE counter jumped to 19 (more than 8 lost): resynchronised",
-             note="12 periods lost, more than max_counter_delta = 8: each message resynchronises once")
+    log_case("counter_wrong_sequence", jump, "counter_wrong_sequence", 1,
+             "RESOLVER_SAMPLE counter jumped to 19 from 6: 12 periods missing as the 8-bit counter counts, more than "
+             "[layout] max_counter_delta = 8, or a new sequence (a restart, logs appended): resynchronised, the "
+             "sample index advances by 13",
+             note="12 periods lost, more than max_counter_delta = 8: one new sequence, its index step named")
     missing = clean_log()
     del missing[index_of(10, 1)]  # period 10 without its PHASE_CURRENTS frame
     log_case("sample_missing_frame", missing, "sample_incomplete", 1, "sample counter 10 (index 10) is missing PHASE_CURRENTS",
              also={"counter_gap": 1, "frames_lost": 1},
              note="PHASE_CURRENTS' counter also jumps 9 -> 11 (one frame lost)")
+
+    # ---- issue 25 ("Trust"): frames out of order as a USB-CAN adapter's buffering delivers them
+    # (reordered within [layout] max_counter_delta periods: joined, not lost), and a second interface
+    shuffled = clean_log()
+    shuffled.insert(index_of(6, 1), shuffled.pop(index_of(7, 0)))  # period 7's first frame before 6's other two
+    log_case("frames_reordered", shuffled, "frames_reordered", 2,
+             "line %d: frame 101 at %s: PHASE_CURRENTS counter 6 came after a frame of counter 7: reordered, joined "
+             "into its own sample (not lost)" % (index_of(6, 1) + 2, time_of(base[index_of(6, 1)])),
+             samples=N_SAMPLES,
+             note="period 7's RESOLVER_SAMPLE arrives before period 6's PHASE_CURRENTS and REFERENCE_ANGLE: before, "
+                  "counter_gap, frames_lost, counter_wrong_sequence and two incomplete samples")
+    late = clean_log()
+    late.insert(index_of(11, 2), late.pop(index_of(10, 2)))  # period 10's REFERENCE_ANGLE after period 11's frames
+    log_case("frame_late_by_one_period", late, "frames_reordered", 1,
+             "REFERENCE_ANGLE counter 10 came after a frame of counter 11: reordered, joined into its own sample",
+             samples=N_SAMPLES,
+             note="before, the sample index jumped by 257 (10, 266, 268: the counter read as wrapped) with no gap "
+                  "counted, and 2 frames were counted lost")
+    too_late = clean_log()
+    too_late.insert(index_of(15, 2), too_late.pop(index_of(5, 1)))  # period 5's PHASE_CURRENTS after period 15's frames
+    log_case("frame_later_than_the_window", too_late, "frames_late", 1,
+             "PHASE_CURRENTS counter 5 is 10 periods behind the newest (15), more than [layout] max_counter_delta = "
+             "8: it came after its sample was used, dropped (not lost",
+             also={"sample_incomplete": 1}, samples=N_SAMPLES,
+             note="10 periods late, more than the window: its sample went out without it (incomplete); it is counted "
+                  "late, not lost, and the index does not move")
+    second = []
+    for k in range(N_SAMPLES):  # a second bench on can1, its counter 100 further, 130 us after can0's frames
+        for l in sample_lines(k + 100):
+            t, rest = l[1:].split(")", 1)
+            us = round(float(t) * 1e6) - PERIOD_US * 100 + 130
+            second.append("(%d.%06d)%s" % (us // 1_000_000, us % 1_000_000, rest.replace(" can0 ", " can1 ")))
+    mixed = sorted(base + second, key=lambda l: float(l[1:l.index(")")]))
+    log_case("other_interface", mixed, "other_interface", 3 * N_SAMPLES,
+             "on can1: the log holds frames of more than one CAN interface; only can0's are read (the first "
+             "interface with a frame of the layout), can1's are counted as other_interface and left out",
+             samples=N_SAMPLES,
+             note="a second bench on can1 interleaved: before, its counters were joined with can0's (hundreds of "
+                  "seconds of a standing rotor in a 12 ms log)")
 
     # ---- signal faults (issue 16): the frames are fine, the signals are not
     health_case("dead_excitation", clean_log(1000, amplitude=0, rd_follows=False), {"loss_of_signal": 1.0},
@@ -364,6 +406,13 @@ def main():
              "line %d: sample 15 at (1704067199.007500): the timestamp goes back 0.999500 s" % (row_at + 1),
              samples=N_SAMPLES, ext=".csv", config="scope.toml",
              note="rows from 15 on are 1 s earlier: counted, re-anchored, every row used")
+    swapped = list(rows)
+    swapped[row_at], swapped[row_at + 1] = swapped[row_at + 1], swapped[row_at]
+    log_case("csv_rows_swapped", swapped, "rows_reordered", 1,
+             "line %d: row at (1704067200.007500) comes before line %d's (1704067200.008000) in time: rows out of "
+             "order, used in time order (not lost)" % (row_at + 2, row_at + 1),
+             samples=N_SAMPLES, ext=".csv", config="scope.toml",
+             note="rows 15 and 16 swapped: before, a step back and two gaps (samples_lost = 2) of nothing missing")
     text_case("csv_unknown_column", ".toml", "config", SCOPE_TOML.replace('"Encoder"', '"Encoder2"'),
               "no column named 'Encoder2' (the columns are 'Time', 'Resolver', 'Encoder')")
     cases[-1]["replay"] = "cases/csv_clean.csv"

@@ -31,6 +31,18 @@ now are refused or counted with a message naming the file, line, column or optio
                   r/min ramp raised "signal fault outliers started ... 7 impulsive
                   sample(s)" and "... ended 0.000 s (sample 0)" at every pass's joint;
                   the joint is no fault now (the log's own faults still show per pass)
+  MixedInterfaces a candump log of two benches (can0, and can1 whose counter runs 100
+                  periods ahead) was joined into one stream: "the rotor hardly moves"
+                  over 501 s of a 2 s log; now can0 (the first interface with a bench
+                  frame) is read, can1's frames are counted per interface
+                  (other_interface) and the message says how to read can1 (grep)
+  ShuffledFrames  frames delayed by up to 3 ms (a USB-CAN adapter's buffering): "13077
+                  frames lost" of 12020 in the log, 601 s; now reordered, nothing lost,
+                  and with frames deleted the count lost is the count deleted
+  LateFrame       one frame after the next period's: angle_t's sample_index jumped
+                  11 -> 268 with no gap counted; now it steps by one
+  SwappedRows     two neighbouring CSV rows in the wrong time order: "samples_lost=2"
+                  (and a step back); now rows_reordered = 1 naming both lines
 
 Every bad input is made from tools/examples/scope_sweep.csv (a real-looking scope
 export, semicolons and decimal commas), so each case has its clean control.
@@ -40,6 +52,7 @@ export, semicolons and decimal commas), so each case has its clean control.
 import argparse
 import json
 import os
+import random
 import signal
 import time
 import subprocess
@@ -356,6 +369,174 @@ class LoopJoints(unittest.TestCase):
         once, err = self.replay("ramp_once", "--once")
         self.assertEqual({k: v["samples"] for k, v in once["signal_health"]["faults"].items() if v["samples"]}, {})
         self.assertNotIn("signal fault", err)
+
+
+def candump_frames(path):
+    """(time [us], interface, frame) of every line of a candump -l log."""
+    out = []
+    with open(path) as f:
+        for line in f:
+            t, iface, frame = line.split()
+            out.append((round(float(t[1:-1]) * 1e6), iface, frame))
+    return out
+
+
+def write_candump(name, frames):
+    return write(name, "".join("(%d.%06d) %s %s\n" % (t // 1_000_000, t % 1_000_000, i, fr) for t, i, fr in frames))
+
+
+def simulate(name, *args):
+    path = work(name)
+    proc = run([os.path.join(ARGS.bin, "resolver-sim"), "--out", path, *args])
+    if proc.returncode != 0:
+        raise AssertionError(proc.stderr)
+    return path
+
+
+def replay_log(log, name, *extra):
+    """resolverd --replay LOG into NAME.lcmlog: the --report JSON and stderr."""
+    report = work(name + ".json")
+    if os.path.exists(report):
+        os.remove(report)
+    proc = run([os.path.join(ARGS.bin, "resolverd"), "--replay", log, "--once", "--fast", "--report", report,
+                "--lcm", "file://" + work(name + ".lcmlog") + "?mode=w", *extra])
+    if proc.returncode != 0:
+        raise AssertionError(f"resolverd exited {proc.returncode}:\n{proc.stderr[-3000:]}")
+    with open(report) as f:
+        return json.load(f), proc.stderr
+
+
+def fit_params(log, *extra):
+    proc = model("fit", log, "--json", *extra)
+    if proc.returncode != 0:
+        raise AssertionError(proc.stderr)
+    return json.loads(proc.stdout)["params"]
+
+
+class MixedInterfaces(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.can0 = candump_frames(sim_log())
+        # A second bench on can1 (600 r/min), started 100 periods (50 ms) earlier: its counter runs 100 ahead.
+        other = candump_frames(simulate("bench_can1.log", "--duration", "2", "--rpm", "600", "--seed", "7",
+                                        "--iface", "can1"))
+        t0 = other[0][0]
+        cls.can1 = [(t - 50_000 + 130, i, fr) for t, i, fr in other if t >= t0 + 50_000]
+        cls.log = write_candump("two_benches.log", sorted(cls.can0 + cls.can1, key=lambda f: f[0]))
+        # The same frames seen on two interfaces.
+        twice = []
+        for t, _, fr in cls.can0:
+            twice += [(t, "can0", fr), (t + 10, "can1", fr)]
+        cls.twice = write_candump("same_frames_twice.log", twice)
+
+    def test_only_the_first_interface_is_read_and_the_other_counted(self):
+        report, err = replay_log(self.log, "two_benches")
+        n1 = len(self.can1)
+        self.assertEqual(report["rejects"], {"other_interface": n1})
+        self.assertEqual(report["samples_complete"], 4000)
+        self.assertLess(report["span_s"], 2.01)  # was 501.2 s, "the rotor hardly moves"
+        self.assertEqual(report["interfaces"], [
+            {"name": "can0", "frames": len(self.can0), "left_out": 0, "read": True},
+            {"name": "can1", "frames": n1, "left_out": n1, "read": False}])
+        self.assertIn("on can1: the log holds frames of more than one CAN interface; only can0's are read (the first "
+                      "interface with a frame of the layout), can1's are counted as other_interface and left out", err)
+        self.assertIn("To read can1 instead, replay a log of its lines only (candump -l: grep ' can1 ' LOG > can1.log",
+                      err)
+        self.assertNotIn("hardly moves", err)
+
+    def test_resolver_model_names_the_interfaces(self):
+        proc = model("explain", self.log)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("covers: 4000 of 4000 samples fitted", proc.stdout)
+        self.assertIn("note: the log holds frames of 2 CAN interfaces: can0 %d frames (read), can1 %d frames (%d left "
+                      "out: other_interface)" % (len(self.can0), len(self.can1), len(self.can1)), proc.stdout)
+
+    def test_the_grep_it_suggests_reads_the_other_bench(self):
+        with open(self.log) as f:
+            only = write("can1.log", "".join(line for line in f if " can1 " in line))
+        report, err = replay_log(only, "can1_only")
+        self.assertEqual(report["rejects"], {})
+        self.assertEqual(report["samples_complete"], sum(not f[2].startswith("1F0") for f in self.can1) // 3)
+        self.assertNotIn("interface", err)
+        proc = model("explain", only)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("600 r/min", proc.stdout)
+
+    def test_the_same_frames_on_two_interfaces(self):
+        report, _ = replay_log(self.twice, "twice")
+        self.assertEqual(report["rejects"], {"other_interface": len(self.can0)})  # was counter_repeated
+        self.assertEqual(report["samples_complete"], 4000)
+
+
+class ShuffledFrames(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.clean = sim_log()
+        frames = candump_frames(cls.clean)
+        rng = random.Random(25)
+        # Each frame arrives up to 3 ms (6 periods) late; the log holds the arrival order and time.
+        cls.log = write_candump("shuffled.log", sorted(((t + rng.randrange(3000), i, fr) for t, i, fr in frames),
+                                                       key=lambda f: f[0]))
+        kept = []
+        cls.deleted = 0
+        for n, f in enumerate(frames):
+            if not f[2].startswith("1F0") and 100 < n < len(frames) - 100 and rng.random() < 0.01:
+                cls.deleted += 1  # lost on the bus
+            else:
+                kept.append((f[0] + rng.randrange(3000), f[1], f[2]))
+        cls.lossy = write_candump("shuffled_lossy.log", sorted(kept, key=lambda f: f[0]))
+
+    def test_reordered_frames_are_not_lost(self):
+        report, err = replay_log(self.log, "shuffled")
+        self.assertEqual(set(report["rejects"]), {"frames_reordered"})  # was frames_lost 13077 of 12020 frames
+        self.assertGreater(report["rejects"]["frames_reordered"], 1000)
+        self.assertEqual(report["samples_complete"], 4000)
+        self.assertEqual(report["samples_incomplete"], 0)
+        self.assertLess(report["span_s"], 2.01)  # was 602 s
+        self.assertIn("came after a frame of counter", err)
+        self.assertIn("reordered, joined into its own sample (not lost)", err)
+
+    def test_lost_is_what_is_missing(self):
+        report, _ = replay_log(self.lossy, "shuffled_lossy")
+        self.assertGreater(self.deleted, 50)
+        self.assertEqual(report["rejects"]["frames_lost"], self.deleted)
+        self.assertEqual(report["rejects"]["sample_incomplete"], report["samples_incomplete"])
+        self.assertNotIn("counter_wrong_sequence", report["rejects"])
+        self.assertLess(report["span_s"], 2.01)
+
+    def test_resolver_model_fits_what_the_clean_log_gives(self):
+        self.assertEqual(fit_params(self.log), fit_params(self.clean))
+
+
+class LateFrame(unittest.TestCase):
+    def test_the_sample_index_steps_by_one(self):
+        frames = candump_frames(sim_log())
+        late = next(n for n, f in enumerate(frames) if f[2].startswith("102#0A"))  # period 10's REFERENCE_ANGLE
+        frame = frames.pop(late)
+        frames.insert(next(n for n, f in enumerate(frames) if f[2].startswith("102#0B")) + 1, frame)
+        report, _ = replay_log(write_candump("late_frame.log", frames), "late_frame")
+        proc = run([os.path.join(ARGS.bin, "resolver-echo"), "--log", work("late_frame.lcmlog"), "--channel",
+                    "RESOLVER_ANGLE"])
+        index = [json.loads(line)["sample_index"] for line in proc.stdout.splitlines() if line.strip()]
+        jumps = [(a, b) for a, b in zip(index, index[1:]) if b - a != 1]
+        self.assertEqual(jumps, [], "was [(11, 268)] with no gap counted")
+        self.assertEqual(len(index), 4000)
+        self.assertEqual(report["rejects"], {"frames_reordered": 1})
+
+
+class SwappedRows(unittest.TestCase):
+    def test_counted_as_reordered_with_both_lines(self):
+        names, rows = sweep_rows()
+        rows[999], rows[1000] = rows[1000], rows[999]  # data rows 999 and 1000: lines 1001 and 1002
+        csv = write("swapped.csv", "\n".join([names] + rows) + "\n")
+        clean = write("unswapped.csv", "\n".join([names] + sweep_rows()[1]) + "\n")
+        config = write("swapped.toml", SWEEP_TOML % 'delimiter = ";"\ndecimal = ","')
+        report, err = replay(csv, config, "swapped")
+        self.assertEqual(report["rejects"], {"rows_reordered": 1})  # was sample_gap 2, samples_lost 2, step back 1
+        self.assertEqual(report["samples_complete"], len(rows))
+        self.assertIn("line 1002: row at (0.999000) comes before line 1001's (1.000000) in time: rows out of order, "
+                      "used in time order (not lost) [rows_reordered]", err)
+        self.assertEqual(fit_params(csv, "--config", config), fit_params(clean, "--config", config))
 
 
 if __name__ == "__main__":

@@ -172,6 +172,7 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
   out.faults = health.faults();
   out.health_samples = health.samples();
   out.outside_slice = stream.samples_outside_slice();
+  if (std::string note = stream.intake().interface_note(); !note.empty()) out.notes.push_back(std::move(note));
   if (progress) {
     progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
                              static_cast<std::int64_t>(out.input.samples.size()), true});

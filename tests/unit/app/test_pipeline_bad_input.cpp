@@ -119,18 +119,19 @@ TEST(PipelineWakeIds, CountsSamplesCompletedByAFrameOutsideWakeIds) {
     pipeline.set_wake_ids({wake});  // what run_live does
     CanFrame info = bench::encode_bench_info(1'000'000, 3, 3, 16, 2000);
     pipeline.feed_untimed(info, 0);
-    for (int k = 0; k < 12; ++k) {
+    for (int k = 0; k < 40; ++k) {
       const auto c = static_cast<std::uint8_t>(k);
       const std::int64_t t = 1'000'100 + 500LL * k;
       pipeline.feed_untimed(bench::encode_resolver_sample(t, c, 0, 26000, static_cast<std::uint16_t>(100 * k)), 0);
       pipeline.feed_untimed(bench::encode_phase_currents(t + 1, c, 100, -50, -50), 0);
     }
     const CompletingFrames& done = pipeline.completing_frames();
-    // The joiner learns the layout on the first samples and emits them when
-    // the next counter begins: those are not counted as completed by a frame.
+    // The joiner learns the layout on the first two samples and emits them when
+    // they leave its reorder window, max_counter_delta periods on; the samples
+    // waiting behind them go out at once: none of these is completed by a frame.
     ASSERT_EQ(done.size(), 1U);
     EXPECT_EQ(done.at(0).first, 0x101U);
-    EXPECT_EQ(done.at(0).second, pipeline.intake().stats().samples_complete - 2);
+    EXPECT_EQ(done.at(0).second, pipeline.intake().stats().samples_complete - (config.max_counter_delta + 2));
     const std::int64_t quiet = pipeline.intake().rejects().get("completed_by_quiet_frame");
     if (wake == 0x102U) {
       EXPECT_EQ(quiet, done.at(0).second);

@@ -1,10 +1,9 @@
-// CRC-8 SAE J1850 and the E2E-style counter states.
+// CRC-8 SAE J1850 (the counters are the joiner's: test_frame_intake.cpp).
 #include <gtest/gtest.h>
 
 #include <array>
 #include <string_view>
 
-#include "daemon/decode/counter_check.h"
 #include "daemon/decode/crc8_j1850.h"
 
 namespace resolver {
@@ -35,27 +34,6 @@ TEST(Crc8J1850, BenchFrameCrcCoversIdLowByte) {
   EXPECT_NE(a, b);
   std::array<std::uint8_t, 8> with_id{1, 2, 3, 4, 5, 6, 7, 0x00};
   EXPECT_EQ(a, crc8_j1850(std::span<const std::uint8_t>(with_id.data(), 8)));
-}
-
-TEST(CounterCheck, States) {
-  CounterCheck c(3);
-  EXPECT_EQ(c.check(10), CounterStatus::kInitial);
-  EXPECT_EQ(c.check(11), CounterStatus::kOk);
-  EXPECT_EQ(c.check(11), CounterStatus::kRepeated);
-  EXPECT_EQ(c.check(13), CounterStatus::kSomeLost);
-  EXPECT_EQ(c.lost(), 1);
-  EXPECT_EQ(c.check(16), CounterStatus::kSomeLost);
-  EXPECT_EQ(c.lost(), 2);
-  EXPECT_EQ(c.check(30), CounterStatus::kWrongSequence);
-  EXPECT_EQ(c.check(31), CounterStatus::kOk) << "resynchronised on the wrong-sequence frame";
-}
-
-TEST(CounterCheck, WrapsAt256) {
-  CounterCheck c(3);
-  c.check(254);
-  EXPECT_EQ(c.check(255), CounterStatus::kOk);
-  EXPECT_EQ(c.check(0), CounterStatus::kOk);
-  EXPECT_EQ(c.check(2), CounterStatus::kSomeLost);
 }
 
 }  // namespace

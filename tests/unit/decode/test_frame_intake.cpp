@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <memory>
+#include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -134,6 +137,208 @@ TEST(FrameIntake, BadFramesAreCountedAndNeverCorruptNeighbours) {
   EXPECT_EQ(rec.samples.back().index - rec.samples.front().index, 9);
   EXPECT_FALSE(rec.problems.empty());
   EXPECT_NE(rec.problems.front().find("frame 100"), std::string::npos) << rec.problems.front();
+}
+
+// Issue 25 ("Trust"): frames of neighbouring periods out of order, as a USB-CAN
+// adapter's buffering delivers them, are reordered, not lost; what is lost is at
+// most what is missing; a late frame never makes the sample index jump.
+std::vector<CanFrame> periods(int first, int count) {
+  std::vector<CanFrame> f;
+  for (int k = first; k < first + count; ++k) push_sample(f, k);
+  return f;
+}
+
+std::int64_t lcg(std::uint64_t& state) {
+  state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+  return static_cast<std::int64_t>(state >> 33U);
+}
+
+TEST(FrameIntake, FramesShuffledWithinTheWindowAreReorderedNotLost) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames = periods(1, 600);  // counters wrap twice
+  // Arrival up to 3 ms (6 periods) late, log order = arrival order.
+  std::uint64_t seed = 25;
+  std::vector<std::pair<std::int64_t, CanFrame>> arrival;
+  for (const CanFrame& f : frames) arrival.emplace_back(f.timestamp_us + lcg(seed) % 3000, f);
+  std::stable_sort(arrival.begin(), arrival.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [t, f] : arrival) {
+    CanFrame g = f;
+    g.timestamp_us = t;
+    intake.feed(g);
+  }
+  intake.flush();
+  ASSERT_EQ(rec.samples.size(), 600U);
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) {
+    const BenchSample& s = rec.samples[i];
+    EXPECT_EQ(s.index, static_cast<std::int64_t>(i) + 1) << i;  // in order, no jump
+    EXPECT_TRUE(s.complete()) << i;
+    EXPECT_DOUBLE_EQ(s.get(Role::kSin), static_cast<std::int16_t>(100 * s.index)) << i;  // its own values
+  }
+  EXPECT_EQ(intake.stats().frames_lost, 0);
+  EXPECT_GT(intake.rejects().get("frames_reordered"), 100);
+  EXPECT_EQ(intake.rejects().total(), intake.rejects().get("frames_reordered")) << "only reordering is counted";
+}
+
+TEST(FrameIntake, LostFramesAreWhatIsMissingNeverMore) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames = periods(1, 600);
+  std::uint64_t seed = 7;
+  std::vector<std::pair<std::int64_t, CanFrame>> arrival;
+  std::int64_t deleted = 0;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (i > 30 && i + 30 < frames.size() && lcg(seed) % 50 == 0) {
+      ++deleted;  // lost on the bus
+      continue;
+    }
+    arrival.emplace_back(frames[i].timestamp_us + lcg(seed) % 3000, frames[i]);
+  }
+  std::stable_sort(arrival.begin(), arrival.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [t, f] : arrival) intake.feed(f);
+  intake.flush();
+  ASSERT_GT(deleted, 10);
+  EXPECT_EQ(intake.stats().frames_lost, deleted);
+  EXPECT_EQ(intake.rejects().get("frames_lost"), deleted);
+  EXPECT_EQ(intake.rejects().get("counter_wrong_sequence"), 0);
+  std::int64_t missing = 0;
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) {
+    EXPECT_EQ(rec.samples[i].index, static_cast<std::int64_t>(i) + 1);
+    missing += 3 - std::popcount(rec.samples[i].slots_present);
+  }
+  EXPECT_EQ(missing, deleted);
+}
+
+TEST(FrameIntake, ALateFrameDoesNotMoveTheSampleIndex) {
+  // Period 10's REFERENCE_ANGLE comes after period 11's frames: before, the index
+  // went 10, 266 (the counter read as wrapped), 268, with no gap counted.
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames = periods(1, 20);
+  const CanFrame late = frames[3 * 9 + 2];
+  frames.erase(frames.begin() + 3 * 9 + 2);
+  frames.insert(frames.begin() + 3 * 10 + 2, late);
+  for (const CanFrame& f : frames) intake.feed(f);
+  intake.flush();
+  ASSERT_EQ(rec.samples.size(), 20U);
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) {
+    EXPECT_EQ(rec.samples[i].index, static_cast<std::int64_t>(i) + 1);
+    EXPECT_TRUE(rec.samples[i].complete()) << i;
+  }
+  EXPECT_EQ(intake.rejects().get("frames_reordered"), 1);
+  EXPECT_EQ(intake.rejects().total(), 1);
+  ASSERT_EQ(rec.problems.size(), 1U);
+  EXPECT_NE(rec.problems[0].find("REFERENCE_ANGLE counter 10 came after a frame of counter 11: reordered"),
+            std::string::npos)
+      << rec.problems[0];
+}
+
+TEST(FrameIntake, AFrameLaterThanTheWindowIsLateNotLost) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames = periods(1, 30);
+  const CanFrame late = frames[3 * 4 + 1];  // period 5's PHASE_CURRENTS ...
+  frames.erase(frames.begin() + 3 * 4 + 1);
+  frames.insert(frames.begin() + 3 * 15 - 1, late);  // ... after period 15's frames
+  for (const CanFrame& f : frames) intake.feed(f);
+  intake.flush();
+  ASSERT_EQ(rec.samples.size(), 30U);
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) EXPECT_EQ(rec.samples[i].index, static_cast<std::int64_t>(i) + 1);
+  EXPECT_FALSE(rec.samples[4].complete());  // used without it: it came too late
+  EXPECT_EQ(intake.rejects().get("frames_late"), 1);
+  EXPECT_EQ(intake.rejects().get("sample_incomplete"), 1);
+  EXPECT_EQ(intake.stats().frames_lost, 0) << "it came: not lost";
+  EXPECT_EQ(intake.rejects().get("counter_wrong_sequence"), 0);
+  const auto it = std::find_if(rec.problems.begin(), rec.problems.end(),
+                               [](const std::string& p) { return p.rfind("frames_late", 0) == 0; });
+  ASSERT_NE(it, rec.problems.end());
+  EXPECT_NE(it->find("PHASE_CURRENTS counter 5 is 10 periods behind the newest (15), more than [layout] "
+                     "max_counter_delta = 8: it came after its sample was used, dropped (not lost"),
+            std::string::npos)
+      << *it;
+}
+
+TEST(FrameIntake, ANewSequenceIsCountedOnceWithTheIndexStep) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames = periods(1, 30);
+  std::vector<CanFrame> again = periods(1, 30);  // logs appended: the counter starts over
+  for (CanFrame& f : again) f.timestamp_us += 1'000'000;
+  frames.insert(frames.end(), again.begin(), again.end());
+  for (const CanFrame& f : frames) intake.feed(f);
+  intake.flush();
+  ASSERT_EQ(rec.samples.size(), 60U);
+  EXPECT_EQ(intake.rejects().get("counter_wrong_sequence"), 1);
+  EXPECT_EQ(intake.rejects().total(), 1);
+  EXPECT_EQ(intake.stats().frames_lost, 0);
+  EXPECT_EQ(rec.samples[30].index - rec.samples[29].index, 227);  // counter 30 -> 1, as the u8 counter counts
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) EXPECT_TRUE(rec.samples[i].complete()) << i;
+  ASSERT_EQ(rec.problems.size(), 1U);
+  EXPECT_NE(rec.problems[0].find("RESOLVER_SAMPLE counter jumped to 1 from 30: 226 periods missing as the 8-bit "
+                                 "counter counts, more than [layout] max_counter_delta = 8, or a new sequence (a "
+                                 "restart, logs appended): resynchronised, the sample index advances by 227"),
+            std::string::npos)
+      << rec.problems[0];
+}
+
+// Issue 25 ("Trust"): two benches (or two buses) in one candump log were joined
+// into one stream; their unrelated counters read as 500 s of a standing rotor.
+TEST(FrameIntake, OnlyTheFirstInterfaceWithABenchFrameIsRead) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  std::vector<CanFrame> frames;
+  CanFrame noise = bench::encode_phase_currents(999'000, 0, 0, 0, 0);
+  noise.id = 0x321;  // another ECU on can1 first: not a frame of the layout, reads no interface yet
+  noise.set_iface("can1");
+  frames.push_back(noise);
+  std::vector<CanFrame> a = periods(1, 40);
+  std::vector<CanFrame> b = periods(101, 40);  // a second bench, its counter elsewhere
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    a[i].set_iface("can0");
+    b[i].set_iface("can1");
+    b[i].timestamp_us = a[i].timestamp_us + 130;
+    frames.push_back(a[i]);
+    frames.push_back(b[i]);
+  }
+  for (const CanFrame& f : frames) intake.feed(f, 0);
+  intake.flush();
+  ASSERT_EQ(rec.samples.size(), 40U);
+  for (std::size_t i = 0; i < rec.samples.size(); ++i) {
+    EXPECT_EQ(rec.samples[i].index, static_cast<std::int64_t>(i) + 1);
+    EXPECT_TRUE(rec.samples[i].complete());
+  }
+  EXPECT_EQ(intake.rejects().get("other_interface"), 120);
+  EXPECT_EQ(intake.rejects().get("unknown_id"), 1);
+  EXPECT_EQ(intake.rejects().total(), 121);
+  ASSERT_EQ(intake.interfaces().size(), 2U);
+  EXPECT_EQ(intake.interfaces()[0].name, "can1");
+  EXPECT_EQ(intake.interfaces()[0].frames, 121);
+  EXPECT_EQ(intake.interfaces()[0].left_out, 120);
+  EXPECT_FALSE(intake.interfaces()[0].read);
+  EXPECT_EQ(intake.interfaces()[1].name, "can0");
+  EXPECT_TRUE(intake.interfaces()[1].read);
+  const auto it = std::find_if(rec.problems.begin(), rec.problems.end(),
+                               [](const std::string& p) { return p.rfind("other_interface", 0) == 0; });
+  ASSERT_NE(it, rec.problems.end());
+  EXPECT_NE(it->find("frame 100 at (1.000630) on can1: the log holds frames of more than one CAN interface; "
+                     "only can0's are read"),
+            std::string::npos)
+      << *it;
+  EXPECT_NE(it->find("grep ' can1 ' LOG > can1.log"), std::string::npos) << *it;
+  EXPECT_EQ(intake.interface_note(),
+            "the log holds frames of 2 CAN interfaces: can1 121 frames (120 left out: other_interface), can0 120 "
+            "frames (read); one interface's frames make one sample stream. To read can1 instead, replay a log of "
+            "its lines only (candump -l: grep ' can1 ' LOG > can1.log; a Vector ASC log: the lines of channel 2)");
+}
+
+TEST(FrameIntake, FramesWithoutAnInterfaceNameAreAlwaysRead) {
+  Recorder rec;
+  FrameIntake intake(bench_decoder(), 8, rec.callbacks());
+  for (const CanFrame& f : periods(1, 10)) intake.feed(f);  // live SocketCAN: no name
+  intake.flush();
+  EXPECT_EQ(rec.samples.size(), 10U);
+  EXPECT_TRUE(intake.interfaces().empty());
+  EXPECT_EQ(intake.interface_note(), "");
 }
 
 TEST(FrameDecoder, SignalMapErrorsNameTheProblem) {
