@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -250,6 +251,34 @@ void seed_from_state_dir(const std::string& state_dir, const resolver::DaemonCon
   }
 }
 
+/// Reads the input to its end (or a stop): the replayed log or the live interface.
+/// Opening or reading it fails with std::system_error (exit 3), a CSV column map that
+/// does not fit the export with ConfigError (exit 2): program_errors.h.
+void read_input(const Options& o, const resolver::CanOptions& can, resolver::Pipeline& pipeline,
+                const std::function<void()>& reload, resolver::StopFlags& flags, resolver::SdNotifier& notifier,
+                resolver::RunInfo& info) {
+  using namespace resolver;
+  if (!o.replay_path.empty()) {
+    ReplayOptions ro;
+    ro.path = o.replay_path;
+    ro.format = log_format_from_name(o.format_name);
+    ro.fast = o.fast;
+    ro.once = o.once;
+    ro.rate = o.rate;
+    ro.progress = !o.quiet;
+    const ReplayResult rr = run_replay(ro, [&]() -> Pipeline& { return pipeline; }, reload, flags, std::cerr);
+    info.source = o.replay_path;
+    info.wall_seconds = rr.wall_seconds;
+    return;
+  }
+  const auto live_start = std::chrono::steady_clock::now();
+  run_live(LiveOptions{o.can_iface, notifier.enabled() ? &notifier : nullptr, can.receive_buffer_bytes, can.wake_auto,
+                       can.wake_ids},
+           [&]() -> Pipeline& { return pipeline; }, reload, flags, std::cerr);
+  info.source = o.can_iface;
+  info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
+}
+
 /// What the run's calibration needs beyond the pipeline: where it is saved and the provenance.
 struct SaveContext {
   std::string state_dir, config_path, config_crc;
@@ -418,28 +447,7 @@ static int run(int argc, char** argv) {
     }
     notifier.ready();
   };
-  // Opening or reading the input fails with std::system_error (exit 3), a CSV column
-  // map that does not fit the export with ConfigError (exit 2): program_errors.h.
-  {
-    if (!o.replay_path.empty()) {
-      ReplayOptions ro;
-      ro.path = o.replay_path;
-      ro.format = log_format_from_name(o.format_name);
-      ro.fast = o.fast;
-      ro.once = o.once;
-      ro.rate = o.rate;
-      ro.progress = !o.quiet;
-      const ReplayResult rr = run_replay(ro, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
-      info.source = o.replay_path;
-      info.wall_seconds = rr.wall_seconds;
-    } else {
-      const auto live_start = std::chrono::steady_clock::now();
-      run_live(LiveOptions{o.can_iface, notifier.enabled() ? &notifier : nullptr, config.can.receive_buffer_bytes, config.can.wake_auto, config.can.wake_ids}, [&]() -> Pipeline& { return *pipeline; }, reload, flags, std::cerr);
-      info.source = o.can_iface;
-      info.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - live_start).count();
-    }
-  }
-
+  read_input(o, config.can, *pipeline, reload, flags, notifier, info);
   const bool saved_or_not_asked = save_run_calibration({o.state_dir, config_path, config_crc, &config}, *pipeline, info);
   return finish_outputs(o, *output, *pipeline, info, saved_or_not_asked);
 }

@@ -119,10 +119,11 @@ std::string not_compensated_reason(const Pipeline& p) {
 
 }  // namespace
 
-void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info) {
+namespace {
+
+/// Frames, samples, the slice, rejects and interfaces.
+void print_intake(std::ostream& out, const Pipeline& p, const RunInfo& info) {
   const IntakeStats& st = p.intake().stats();
-  const HwangIntegralEstimator& est = p.processor().estimator();
-  const RunSummary& s = p.summary();
   out << fmt::format("resolverd report: {}\n", info.source);
   out << fmt::format("  frames     {} seen, {} decoded, {} CAN error frames; {:.0f} frames/s processed\n",
                      st.frames_seen, st.frames_decoded, st.bus_errors,
@@ -141,9 +142,12 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     out << "\n";
   }
   if (const std::string note = p.intake().interface_note(); !note.empty()) out << "  interfaces " << note << "\n";
+}
+
+/// The active method's final estimate with what its errors are from.
+void print_estimate(std::ostream& out, const Pipeline& p) {
+  const HwangIntegralEstimator& est = p.processor().estimator();
   const ProcessorConfig& pc = p.processor().config();
-  out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
-  print_signal_health(out, p.signal_health().summary(), p.signal_health().monitor().config());
   const ModelEstimate model = p.processor().estimate();
   if (pc.method == EstimatorMethod::kHwangIntegral) {
     out << fmt::format("  estimate   hwang_integral: alpha = {:.6f} +- {:.2e} (std. error; spread {:.2e} over {} revolutions) {}\n",
@@ -161,6 +165,12 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
     }
     if (!model.params.empty()) out << "             +- standard error: " << estimate_std_error_basis(p) << "\n";
   }
+}
+
+/// The samples, and the position error against the reference, raw and compensated.
+void print_position(std::ostream& out, const Pipeline& p) {
+  const RunSummary& s = p.summary();
+  const ProcessorConfig& pc = p.processor().config();
   out << fmt::format("  samples    {} with an angle over {:.3f} s, {} moving, {} at standstill, {} with a reference\n",
                      s.samples, s.t_last - s.t_first, s.moving, s.samples - s.moving, s.with_reference);
   if (s.raw_all.stats.n > 1) {
@@ -192,6 +202,10 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
       out << "             not compensated: " << not_compensated_reason(p) << "\n";
     }
   }
+}
+
+/// The dq ripple at 1x, 2x, 6x theta_e.
+void print_ripple(std::ostream& out, const RunSummary& s) {
   if (s.have_ripple) {
     const RippleSet& r = s.ripple;
     for (std::size_t k = 0; k < 3; ++k) {
@@ -204,6 +218,10 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   } else {
     out << "  dq ripple  not measured (no phase currents, or no converged estimate)\n";
   }
+}
+
+/// The live model fit, reloads, the calibration and the latency.
+void print_run_record(std::ostream& out, const Pipeline& p, const RunInfo& info) {
   if (const LiveModelFit* mf = p.model_fit()) {
     const auto& c = mf->counters();
     const model_fit_t& last = mf->last();
@@ -234,6 +252,19 @@ void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info)
   const LatencyHistogram& lat = p.latency_total();
   out << fmt::format("  latency    frame read -> publish return: p50 {:.0f} us, p99 {:.0f} us, max {:.0f} us ({} frames timed)\n",
                      lat.percentile(0.5), lat.percentile(0.99), lat.max(), lat.count());
+}
+
+}  // namespace
+
+void print_run_report(std::ostream& out, const Pipeline& p, const RunInfo& info) {
+  print_intake(out, p, info);
+  const ProcessorConfig& pc = p.processor().config();
+  out << fmt::format("  bench      p_r={} p={}\n", pc.p_r, pc.p);
+  print_signal_health(out, p.signal_health().summary(), p.signal_health().monitor().config());
+  print_estimate(out, p);
+  print_position(out, p);
+  print_ripple(out, p.summary());
+  print_run_record(out, p, info);
 }
 
 std::string run_report_json(const Pipeline& p, const RunInfo& info) {
