@@ -189,20 +189,23 @@ std::string format_calibration(const Calibration& c) {
   return body + std::string(kChecksumKey) + crc + "\n";
 }
 
-Calibration parse_calibration(const std::string& text, const std::string& where) {
-  auto fail = [&](const std::string& why) -> Calibration { throw InputError(Fault::kData, why, Where::at_file(where)); };
-  if (text.empty()) return fail("empty file (an interrupted write by an old version?); it is ignored");
+namespace {
 
-  // Identity and version first, so a foreign or future file is named as such
-  // rather than as "corrupt".
-  const std::string_view all(text);
+[[noreturn]] void refuse(const std::string& where, const std::string& why) {
+  throw InputError(Fault::kData, why, Where::at_file(where));
+}
+
+/// The identity line and the format version, first, so a foreign or future file is
+/// named as such rather than as "corrupt". Returns where the identity line ends.
+std::size_t check_identity(std::string_view all, const std::string& where) {
+  if (all.empty()) refuse(where, "empty file (an interrupted write by an old version?); it is ignored");
   const std::string_view first = all.substr(0, all.find('\n'));
   if (first.size() == all.size() && kMagic.substr(0, first.size()) == first) {
-    return fail("truncated inside the identity line; the file is ignored");
+    refuse(where, "truncated inside the identity line; the file is ignored");
   }
   if (first != kMagic) {
-    return fail("not a resolverd calibration file: the first line is '" + printable(first) + "', expected '" +
-                std::string(kMagic) + "'; check --state-dir, the file is ignored");
+    refuse(where, "not a resolverd calibration file: the first line is '" + printable(first) + "', expected '" +
+                      std::string(kMagic) + "'; check --state-dir, the file is ignored");
   }
   std::size_t pos = first.size() + 1;
   std::string_view version_line;
@@ -214,50 +217,61 @@ Calibration parse_calibration(const std::string& text, const std::string& where)
     version_line = line;
     break;
   }
-  {
-    const auto [key, rest] = split_key(version_line);
-    int version = 0;
-    if (key != "format" || !parse_number(rest, version)) {
-      return fail("no 'format N' line after the identity line (found '" + printable(version_line) +
-                  "'); the file is truncated or damaged and is ignored");
-    }
-    if (version < 1 || version > kCalibrationFormatVersion) {
-      return fail("calibration format version " + std::to_string(version) + ", but this resolverd reads only versions " +
-                  std::to_string(kCalibrationFormatVersion) +
-                  ", 2 and 1; it was written by another resolverd release and is ignored (it is replaced at the next save)");
-    }
+  const auto [key, rest] = split_key(version_line);
+  int version = 0;
+  if (key != "format" || !parse_number(rest, version)) {
+    refuse(where, "no 'format N' line after the identity line (found '" + printable(version_line) +
+                      "'); the file is truncated or damaged and is ignored");
   }
+  if (version < 1 || version > kCalibrationFormatVersion) {
+    refuse(where, "calibration format version " + std::to_string(version) + ", but this resolverd reads only versions " +
+                      std::to_string(kCalibrationFormatVersion) +
+                      ", 2 and 1; it was written by another resolverd release and is ignored (it is replaced at the "
+                      "next save)");
+  }
+  return first.size();
+}
 
-  // Checksum: the last line, covering every byte before it.
-  if (text.back() != '\n') {
-    return fail("truncated: the file does not end with a complete line; it is ignored");
-  }
+/// The checksum: the last line, covering every byte before it. Returns where that line starts.
+std::size_t check_checksum(const std::string& text, const std::string& where) {
+  const std::string_view all(text);
+  if (text.back() != '\n') refuse(where, "truncated: the file does not end with a complete line; it is ignored");
   const std::size_t last_start = all.rfind('\n', all.size() - 2);
   const std::size_t crc_line_start = last_start == std::string_view::npos ? 0 : last_start + 1;
   const std::string_view crc_line = all.substr(crc_line_start, all.size() - 1 - crc_line_start);
   if (crc_line.substr(0, kChecksumKey.size()) != kChecksumKey) {
-    return fail("truncated: the last line is '" + printable(crc_line) + "', not the 'crc32 XXXXXXXX' checksum; ignored");
+    refuse(where, "truncated: the last line is '" + printable(crc_line) + "', not the 'crc32 XXXXXXXX' checksum; ignored");
   }
   std::uint32_t stated = 0;
   const std::string_view hex = crc_line.substr(kChecksumKey.size());
   const auto [ptr, ec] = std::from_chars(hex.data(), hex.data() + hex.size(), stated, 16);
   if (hex.size() != 8 || ec != std::errc{} || ptr != hex.data() + hex.size()) {
-    return fail("malformed checksum line '" + printable(crc_line) + "'; ignored");
+    refuse(where, "malformed checksum line '" + printable(crc_line) + "'; ignored");
   }
   const std::uint32_t actual = crc32_ieee(text.substr(0, crc_line_start));
   if (actual != stated) {
     char msg[160];
     std::snprintf(msg, sizeof msg, "checksum mismatch (file says %08x, contents give %08x): the file is corrupt; ignored",
                   static_cast<unsigned>(stated), static_cast<unsigned>(actual));
-    return fail(msg);
+    refuse(where, msg);
   }
+  return crc_line_start;
+}
+
+}  // namespace
+
+Calibration parse_calibration(const std::string& text, const std::string& where) {
+  auto fail = [&](const std::string& why) -> Calibration { refuse(where, why); };
+  const std::size_t identity_end = check_identity(text, where);
+  const std::size_t crc_line_start = check_checksum(text, where);
+  const std::string_view all(text);
 
   // Fields. The checksum matched, so anything odd here was written that way.
   Calibration c;
   bool have_p_r = false, have_p = false, have_method = false, have_samples = false;
   std::set<std::string> names;
   std::size_t line_no = 1;
-  pos = first.size() + 1;
+  std::size_t pos = identity_end + 1;
   while (pos < crc_line_start) {
     ++line_no;
     const std::size_t end = all.find('\n', pos);
