@@ -149,7 +149,8 @@ std::string header(const FleetPageInput& in, const std::vector<UnitRow>& units) 
   o += fmt::format(
       "<p class=\"meta\">{} units, {} logs · bench p<sub>r</sub> = {}, p = {} · model fitted: {} · written by "
       "<code>{}</code></p>\n",
-      f["units_total"].integer(), f["logs_total"].integer(), f["p_r"].integer(),
+      f["units_total"].integer(), f["logs_total"].integer(),
+      f["p_r"].integer() > 0 ? std::to_string(f["p_r"].integer()) : std::string("–"),
       p.empty() ? std::string("–") : fmt::format("{}", fmt::join(p, " / ")),
       models.empty() ? std::string("–") : escape(fmt::format("{}", fmt::join(models, "; "))), escape(in.version));
   const char* tone = failed + unexplained > 0 ? "v-unexplained" : missing > 0 ? "v-missing_effect" : "v-explained";
