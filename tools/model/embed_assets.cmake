@@ -1,7 +1,8 @@
-# cmake -DOUT=report_assets.cpp -DUPLOT_DIR=<node_modules/uplot> -DPAGE_JS=<js> -DPAGE_CSS=<css> -P embed_assets.cmake
+# cmake -DOUT=report_assets.cpp -DUPLOT_DIR=<node_modules/uplot> -DPAGE_JS=<js> -DPAGE_CSS=<css>
+#       -DFLEET_JS=<js> -DFLEET_CSS=<css> -P embed_assets.cmake
 # Writes report_assets.cpp (report_assets.h): each file as an array of bytes, so no
 # byte of a minified library can break the C++ source.
-foreach(var OUT UPLOT_DIR PAGE_JS PAGE_CSS)
+foreach(var OUT UPLOT_DIR PAGE_JS PAGE_CSS FLEET_JS FLEET_CSS)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "embed_assets.cmake: -D${var}=... is required")
   endif()
@@ -31,6 +32,8 @@ embed(uplot_css "${UPLOT_DIR}/dist/uPlot.min.css")
 embed(uplot_license "${UPLOT_DIR}/LICENSE")
 embed(page_js "${PAGE_JS}")
 embed(page_css "${PAGE_CSS}")
+embed(fleet_page_js "${FLEET_JS}")
+embed(fleet_page_css "${FLEET_CSS}")
 file(READ "${UPLOT_DIR}/package.json" manifest)
 string(JSON version GET "${manifest}" version)
 

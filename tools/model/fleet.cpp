@@ -17,6 +17,7 @@
 
 #include "daemon/service/program_errors.h"
 #include "daemon/service/table_file.h"
+#include "tools/model/fleet_page.h"
 #include "tools/model/html_report.h"
 #include "tools/model/json_text.h"
 #include "tools/model/json_value.h"
@@ -509,7 +510,8 @@ std::string summarize_fleet(const std::string& out_dir, int& failed) {
   text += params.table + outliers.lines;
   for (const auto& [e, n] : t.needed) text += fmt::format("needed: {} by {} of {} units\n", e, n, t.done);
   text += lists.failed_lines;
-  text += "wrote " + out_dir + "/fleet.json\n";
+  write_fleet_page(out_dir);
+  text += "wrote " + out_dir + "/fleet.json\nwrote " + out_dir + "/fleet.html\n";
   return text;
 }
 

@@ -3,7 +3,7 @@
 //
 //   MANIFEST (CSV "unit,log") ─► per unit: each log read and explained (the code explain
 //   runs) ─► DIR/UNIT/unit.json + the calibration of its best log (export's formats)
-//   DIR/*/unit.json ─► summarize_fleet ─► DIR/fleet.json + a text table
+//   DIR/*/unit.json ─► summarize_fleet ─► DIR/fleet.json + a text table ─► DIR/fleet.html (fleet_page.h)
 //
 // The summary is computed from the unit.json files only, so a fleet run on one machine
 // and one whose units ran elsewhere (tools/python/resolver_bench, Dask) give the same
@@ -45,7 +45,8 @@ struct FleetOptions {
 int run_fleet_units(const std::vector<ManifestRow>& rows, const std::string& manifest, const std::string& out_dir,
                     const FleetOptions& options);
 
-/// Recomputes out_dir/fleet.json from out_dir/*/unit.json and returns the text table.
+/// Recomputes out_dir/fleet.json from out_dir/*/unit.json, writes the fleet's page
+/// out_dir/fleet.html from them (fleet_page.h) and returns the text table.
 /// `failed` is set to the number of units that are not done (including those whose p_r
 /// differs from the fleet's).
 [[nodiscard]] std::string summarize_fleet(const std::string& out_dir, int& failed);

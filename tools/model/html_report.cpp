@@ -7,10 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <stdexcept>
 #include <system_error>
 
 #include "daemon/core/angles.h"
+#include "tools/model/html_page.h"
 #include "tools/model/report_assets.h"
 #include "tools/model/report_data.h"
 
@@ -18,22 +18,9 @@ namespace resolver {
 
 namespace {
 
-/// Escapes & < > " ' so any text is safe in HTML text and attribute values.
-std::string escape(std::string_view text) {
-  std::string o;
-  o.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      case '\'': o += "&#39;"; break;
-      default: o += c;
-    }
-  }
-  return o;
-}
+using html::escape;
+using html::num_cell;
+using html::table;
 
 std::string g3(double v) { return std::isfinite(v) ? fmt::format("{:.3g}", v) : std::string("–"); }
 std::string ratio(double v) { return std::isfinite(v) ? fmt::format("{:.2f}x", v) : std::string("–"); }
@@ -43,22 +30,6 @@ std::string list(const std::vector<std::string>& items) {
   for (const auto& s : items) o += "<li>" + escape(s) + "</li>";
   return o + "</ul>\n";
 }
-
-/// A table: header cells (HTML allowed: units with <sub>) and rows of cells (already HTML).
-std::string table(std::string_view cls, const std::vector<std::string>& header,
-                  const std::vector<std::vector<std::string>>& rows) {
-  std::string o = fmt::format("<table class=\"{}\"><tr>", cls);
-  for (const auto& h : header) o += "<th>" + h + "</th>";
-  o += "</tr>\n";
-  for (const auto& r : rows) {
-    o += "<tr>";
-    for (const auto& c : r) o += c.starts_with("<td") ? c : "<td>" + c + "</td>";
-    o += "</tr>\n";
-  }
-  return o + "</table>\n";
-}
-
-std::string num_cell(const std::string& text) { return "<td class=\"num\">" + text + "</td>"; }
 
 /// Unit of each fitted signal as the tables show it.
 std::string signal_unit(std::string_view signal) {
@@ -307,39 +278,6 @@ std::string candidates_table(const Explanation& ex, bool currents) {
   return o + "</details>\n";
 }
 
-// ---- plots -------------------------------------------------------------------------------
-
-std::string figure(const report::Plot& p) {
-  return fmt::format(
-      "<figure class=\"plot{}\" id=\"fig-{}\"><div class=\"plot-title\">{}</div>"
-      "<div class=\"chart\" data-plot=\"{}\"></div><div class=\"legend\" data-legend=\"{}\"></div>"
-      "<div class=\"tools\"><button type=\"button\" data-csv=\"{}\">download CSV</button> "
-      "<button type=\"button\" data-reset=\"{}\">reset zoom</button> <span class=\"readout\" data-readout=\"{}\"></span>"
-      "</div><figcaption>{}</figcaption></figure>\n",
-      p.half ? " half" : "", p.id, escape(p.title), p.id, p.id, p.id, p.id, p.id, escape(p.caption));
-}
-
-std::string figures(const std::vector<report::Plot>& plots) {
-  std::string o;
-  for (std::size_t i = 0; i < plots.size(); ++i) {
-    if (plots[i].half && i + 1 < plots.size() && plots[i + 1].half) {
-      o += "<div class=\"row\">" + figure(plots[i]) + figure(plots[i + 1]) + "</div>\n";
-      ++i;
-    } else {
-      o += figure(plots[i]);
-    }
-  }
-  return o;
-}
-
-/// Text for an inline <script>: nothing in it may close the element early.
-std::string_view script_safe(std::string_view js, std::string_view what) {
-  if (js.find("</script") != std::string_view::npos || js.find("<!--") != std::string_view::npos) {
-    throw std::runtime_error(fmt::format("{} contains </script or <!--: it cannot be inlined", what));
-  }
-  return js;
-}
-
 }  // namespace
 
 std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, std::string_view log_path,
@@ -351,11 +289,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
   std::vector<std::string> signals;
   for (const auto& s : f.signals) signals.push_back(s.signal);
 
-  std::string o =
-      "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<meta name=\"viewport\" "
-      "content=\"width=device-width\">\n";
-  o += fmt::format("<title>resolver-model report: {}</title>\n<style>{}</style>\n<style>{}</style></head><body>\n",
-                   escape(name), report_assets::uplot_css(), report_assets::page_css());
+  std::string o = html::page_head("resolver-model report: " + name);
   o += fmt::format("<h1>Resolver model discovery report: {}</h1>\n", escape(name));
   o += fmt::format(
       "<p class=\"meta\">log <code>{}</code> · {} samples from {} frames · p<sub>r</sub> = {}, p = {}{} · "
@@ -405,7 +339,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
        "<noscript><p class=\"bad\">The plots are drawn by the page's script: enable JavaScript to see them. The "
        "tables do not need it.</p></noscript>\n";
   if (const std::string n = report::one_speed_note(f); !n.empty()) o += "<p class=\"single\">" + escape(n) + "</p>\n";
-  o += figures(plots);
+  o += html::figures(plots);
 
   o += "<h2 id=\"floors\">Noise floors, outliers, whiteness, directions</h2>\n" + floors_table(f.floors) +
        outliers_section(f) + whiteness_and_directions(f);
@@ -432,12 +366,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
       "weighted residual a candidate removes. Written by <code>resolver-model report</code>. Plots drawn with uPlot "
       "{} (MIT licence, embedded in this page with its notice).</p>\n",
       escape(report_assets::uplot_version()));
-  o += "<script type=\"application/json\" id=\"report-data\">{\"plots\":" + report::plots_json(plots) + "}</script>\n";
-  o += fmt::format("<script>/*! uPlot {}\n{}\n*/\n{}</script>\n", report_assets::uplot_version(),
-                   script_safe(report_assets::uplot_license(), "uPlot's LICENSE"),
-                   script_safe(report_assets::uplot_js(), "uPlot.iife.min.js"));
-  o += fmt::format("<script>{}</script>\n", script_safe(report_assets::page_js(), "report_page.js"));
-  return o + "</body></html>\n";
+  return o + html::page_tail(plots);
 }
 
 void write_text_file(const std::string& path, std::string_view text) {

@@ -596,6 +596,13 @@ std::string plots_json(const std::vector<Plot>& plots) {
       if (s.mark == Mark::kBand) {
         o += ",\"spread\":" + json::array(s.spread, s.digits) + ",\"count\":" + json::array(s.count, 9);
       }
+      if (!s.error.empty()) o += ",\"err\":" + json::array(s.error, 3);
+      if (!s.names.empty()) {
+        o += ",\"names\":[";
+        for (std::size_t n = 0; n < s.names.size(); ++n) o += (n > 0 ? "," : "") + json::str(s.names[n]);
+        o += "]";
+      }
+      if (s.label_points) o += ",\"label_points\":true";
       o += "}";
     }
     o += "]}";

@@ -47,6 +47,10 @@ struct Series {
   bool legend = true;   ///< false: no legend entry of its own (shown and hidden with the entry before it)
   double width = 1.5;   ///< [px] line width or dot diameter
   int digits = 6;       ///< significant digits in the page's data
+  // Drawn by the fleet page's own script (web/fleet_page.js); empty on the report page.
+  std::vector<double> error;       ///< per point, an error bar of +- this (a standard error); NaN: none
+  std::vector<std::string> names;  ///< per point, what it is (a unit id): the readout shows it
+  bool label_points = false;       ///< names written beside the points
 };
 
 struct Axis {

@@ -5,7 +5,10 @@
                   alpha varied per unit; one unit with a large quadrature, one with a far-off
                   alpha, one with two logs): the two outliers are named with their parameter
                   and nothing else is; a corrupt log, a missing log, a log listed twice and a
-                  p_r = 1 log fail their unit only, with the reason, and exit 1.
+                  p_r = 1 log fail their unit only, with the reason, and exit 1. The fleet's
+                  page (fleet.html) parses with html.parser, refers to nothing outside itself
+                  (scripts inline; its links are the units' own files), and names every unit,
+                  the outliers in its outlier table and the failed units with their reason.
   --part dask     the same fleet through python3 -m resolver_bench.fleet --local 2: fleet.json
                   equals the single-process one (the failed units' reasons name the manifest
                   each run saw, so only their names are compared); then again with a worker
@@ -24,6 +27,7 @@ import subprocess
 import sys
 import time
 import unittest
+from html.parser import HTMLParser
 
 ARGS = None
 GOOD_UNITS = 20
@@ -107,6 +111,93 @@ def comparable(fleet):
     return fleet
 
 
+VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
+# uPlot's minified file starts with this banner comment: text inside the inline script, not a reference.
+UPLOT_BANNER = "/*! https://github.com/leeoniya/uPlot"
+
+
+class Page(HTMLParser):
+    """fleet.html as the tests see it: nesting errors, references, scripts, tables by class."""
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.stack, self.errors, self.refs, self.scripts = [], [], [], []
+        self.tables = {}       # class -> rows of cell texts (the first table of that class)
+        self.failed_list = []  # texts of the header's failed units
+        self.title = ""
+        self._table = None
+        self._cell = None
+        self._script = None
+        self._li = None
+        self._in_title = False
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        for k, v in attrs:
+            if k in ("src", "href", "xlink:href", "srcset", "action", "data", "poster"):
+                self.refs.append((tag, k, v))
+        cls = (a.get("class") or "").split()
+        if tag == "table":
+            self._table = self.tables.setdefault(" ".join(cls), [])
+        elif tag == "tr" and self._table is not None:
+            self._table.append([])
+        elif tag in ("td", "th") and self._table is not None:
+            self._table[-1].append("")
+            self._cell = True
+        elif tag == "script":
+            self._script = {"attrs": a, "text": ""}
+        elif tag == "li" and self.stack and "failed-list" in self.stack[-1][1]:
+            self._li = ""
+        elif tag == "title":
+            self._in_title = True
+        if tag not in VOID:
+            self.stack.append((tag, cls))
+
+    def handle_startendtag(self, tag, attrs):
+        self.handle_starttag(tag, attrs)
+        if tag not in VOID:
+            self.stack.pop()
+
+    def handle_endtag(self, tag):
+        if tag in VOID:
+            return
+        if not self.stack or self.stack[-1][0] != tag:
+            self.errors.append(f"</{tag}> closes {self.stack[-1][0] if self.stack else 'nothing'}")
+            return
+        self.stack.pop()
+        if tag == "table":
+            self._table = None
+        elif tag in ("td", "th"):
+            self._cell = None
+        elif tag == "script":
+            self.scripts.append(self._script)
+            self._script = None
+        elif tag == "li" and self._li is not None:
+            self.failed_list.append(self._li)
+            self._li = None
+        elif tag == "title":
+            self._in_title = False
+
+    def handle_data(self, data):
+        if self._cell and self._table:
+            self._table[-1][-1] += data
+        if self._script is not None:
+            self._script["text"] += data
+        if self._li is not None:
+            self._li += data
+        if self._in_title:
+            self.title += data
+
+
+def parse_page(path):
+    with open(path, encoding="utf-8") as f:
+        html = f.read()
+    page = Page()
+    page.feed(html)
+    page.close()
+    return html, page
+
+
 class SingleProcess(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -174,8 +265,98 @@ class SingleProcess(unittest.TestCase):
 
     def test_summarize_alone_gives_the_same(self):
         before = open(work("single", "fleet.json")).read()
-        run([binary("resolver-model"), "fleet", "--summarize", work("single")], expect_rc=1)
+        page = open(work("single", "fleet.html"), encoding="utf-8").read()
+        os.remove(work("single", "fleet.html"))
+        proc = run([binary("resolver-model"), "fleet", "--summarize", work("single")], expect_rc=1)
         self.assertEqual(open(work("single", "fleet.json")).read(), before)
+        self.assertEqual(open(work("single", "fleet.html"), encoding="utf-8").read(), page)
+        self.assertIn("fleet.html", proc.stdout)
+
+
+class FleetPage(unittest.TestCase):
+    """fleet.html of the single-process run."""
+
+    @classmethod
+    def setUpClass(cls):
+        out = work("single")
+        if not os.path.exists(os.path.join(out, "fleet.json")):
+            single_run(out)
+        cls.out = out
+        cls.fleet = load(os.path.join(out, "fleet.json"))
+        cls.html, cls.page = parse_page(os.path.join(out, "fleet.html"))
+
+    def test_parses(self):
+        self.assertEqual(self.page.errors, [])
+        self.assertEqual(self.page.stack, [], "elements left open")
+        self.assertTrue(self.html.startswith("<!DOCTYPE html>"))
+        self.assertIn("single", self.page.title)
+
+    def test_self_contained(self):
+        # Scripts inline (uPlot, its licence, the report's and the fleet's script); no src anywhere.
+        self.assertGreaterEqual(len(self.page.scripts), 4)
+        self.assertTrue(all("src" not in s["attrs"] for s in self.page.scripts))
+        self.assertIn("var uPlot=", self.html)
+        self.assertIn("Permission is hereby granted, free of charge", self.html)
+        self.assertIn("window.resolverFleet", self.html)
+        # No http(s) reference: the one such text is uPlot's banner comment, inside its inline script.
+        self.assertEqual(self.html.count(UPLOT_BANNER), 1)
+        rest = self.html.replace(UPLOT_BANNER, "")
+        self.assertNotIn("http://", rest)
+        self.assertNotIn("https://", rest)
+        self.assertNotIn("@import", self.html)
+        self.assertNotRegex(self.html, r"url\(\s*['\"]?(?!#)", "url() to something other than an #id")
+        # Links: anchors in the page, or the units' own files beside it (which exist).
+        for tag, attr, value in self.page.refs:
+            self.assertEqual((tag, attr), ("a", "href"), value)
+            if not value.startswith("#"):
+                self.assertFalse(os.path.isabs(value) or ":" in value, value)
+                self.assertTrue(os.path.isfile(os.path.join(self.out, value)), value)
+        self.assertIn(("a", "href", "unit05/calibration.csv"), self.page.refs)
+
+    def test_every_unit_in_the_units_table(self):
+        rows = self.page.tables["params units"]
+        header = rows[0]
+        units = {r[header.index("unit")]: r for r in rows[1:]}
+        expected = {u["unit"] for u in self.fleet["units"]} | {f["unit"] for f in self.fleet["failed"]}
+        self.assertEqual(set(units), expected)
+        self.assertEqual(len(units), self.fleet["units_total"])
+        for u in self.fleet["units"]:
+            self.assertEqual(units[u["unit"]][header.index("verdict")], u["verdict"])
+        for unit in FAILED:
+            self.assertEqual(units[unit][header.index("verdict")], "failed")
+        self.assertEqual(units["quad"][header.index("outside the spread on")], "quadrature.beta")
+
+    def test_outlier_table(self):
+        rows = self.page.tables["params outliers"]
+        header = rows[0]
+        shown = {(r[header.index("unit")], r[header.index("parameter")]) for r in rows[1:]}
+        self.assertEqual(shown, {(o["unit"], o["param"]) for o in self.fleet["outliers"]})
+        self.assertIn(("quad", "quadrature.beta"), shown)
+        self.assertIn(("faralpha", "amplitude_imbalance.alpha"), shown)
+
+    def test_failed_units_named_with_the_reason(self):
+        named = {item.split(":")[0].strip(): item for item in self.page.failed_list}
+        self.assertEqual(set(named), FAILED)
+        self.assertIn("corrupt.log", named["corrupt"])
+        self.assertIn("No such file", named["missing"])
+        self.assertIn("listed twice", named["twice"])
+        self.assertIn("p_r = 1", named["pr1"])
+        self.assertRegex(self.html, rf"{GOOD_UNITS + 2} explained.*0 missing_effect.*0 unexplained.*{len(FAILED)} failed")
+
+    def test_strip_plots(self):
+        data = [s for s in self.page.scripts if s["attrs"].get("id") == "report-data"]
+        self.assertEqual(len(data), 1)
+        plots = {p["y"]["label"]: p for p in json.loads(data[0]["text"])["plots"]}
+        self.assertEqual(set(plots), set(self.fleet["params"]))
+        done = {u["unit"] for u in self.fleet["units"]}
+        for name, plot in plots.items():
+            units = [s for s in plot["series"] if s.get("err")]
+            self.assertEqual(len(units), 1, name)
+            self.assertEqual(set(units[0]["names"]), done, name)
+            self.assertEqual(len(units[0]["err"]), len(units[0]["y"]))
+            self.assertTrue(plot["y"]["unit"] and plot["y"]["column"], name)
+            labelled = {n for s in plot["series"] if s.get("label_points") for n in s["names"]}
+            self.assertEqual(labelled, {o["unit"] for o in self.fleet["outliers"] if o["param"] == name}, name)
 
 
 def dask_cmd(out, resolver_model=None):
@@ -199,6 +380,9 @@ class OnDask(unittest.TestCase):
               f"Dask --local 2 {seconds:.2f} s (cluster start included)", file=sys.stderr)
         self.assertEqual(comparable(load(os.path.join(out, "fleet.json"))), comparable(self.single))
         self.assertIn("unit corrupt", proc.stderr)
+        _, page = parse_page(os.path.join(out, "fleet.html"))  # the page too, through --summarize
+        self.assertEqual(page.errors, [])
+        self.assertIn(("quad", "quadrature.beta"), {(r[0], r[1]) for r in page.tables["params outliers"][1:]})
         self.assertFalse(os.path.exists(os.path.join(out, ".tasks")))
 
     def test_a_worker_killed_mid_run(self):
@@ -252,8 +436,11 @@ def main():
             print("SKIP: Dask is not installed (apt-get install python3-distributed)")
             sys.exit(77)
     os.makedirs(ARGS.work, exist_ok=True)
-    test = SingleProcess if ARGS.part == "single" else OnDask
-    suite = unittest.defaultTestLoader.loadTestsFromTestCase(test)
+    loader = unittest.defaultTestLoader
+    if ARGS.part == "single":
+        suite = unittest.TestSuite([loader.loadTestsFromTestCase(SingleProcess), loader.loadTestsFromTestCase(FleetPage)])
+    else:
+        suite = loader.loadTestsFromTestCase(OnDask)
     result = unittest.TextTestRunner(verbosity=2).run(suite)
     sys.exit(0 if result.wasSuccessful() else 1)
 
