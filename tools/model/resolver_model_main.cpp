@@ -189,7 +189,9 @@ Writes OUT/UNIT/unit.json (verdict, residual vs floor, parameters with standard 
 log's fit, parameters the unit's logs disagree on), OUT/UNIT/calibration.{csv,json,h} (export's
 formats, from the unit's log with the smallest residual/floor) and OUT/fleet.json (per parameter
 median, robust spread = 1.4826 MAD and quantiles; proposed effects; outlier units, robust z > 4;
-failed units with the reason). A unit fails, and the others go on, when a log is missing,
+failed units with the reason) with OUT/fleet.html, the same on one self-contained page (every
+parameter's strip plot with the outliers named, the effects the units need, every unit's row).
+A unit fails, and the others go on, when a log is missing,
 unreadable or has no usable data, is listed twice, or has another p_r than the fleet.
 Exit 0 when every unit is done, 1 when some unit failed (fleet.json says which and why).)";
 
