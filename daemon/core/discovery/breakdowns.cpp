@@ -321,8 +321,10 @@ void append_series_point(const FitRow& r, const SignalValues& pred, const Prepar
 
 ResidualPass residual_pass(const Design& design, const PreparedLog& log, const GroupFloors& floors,
                            std::span<const int> score_columns, const DiscoveryOptions& options,
-                           const NuisanceValues& nuisance) {
+                           std::span<const NuisanceValues> nuisance) {
   ResidualPass out;
+  out.part_rss.assign(nuisance.size(), {0.0, 0.0, 0.0});
+  out.part_n.assign(nuisance.size(), {0, 0, 0});
   const int order = std::max(1, options.max_report_order);
   const int hk = 2 * order + 1;
   NormalEquations h_theta(hk), h_mech(hk), h_d(hk), h_q(hk);
@@ -343,7 +345,7 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
     }
     // The prediction evaluated: what the fit reports, not its linearised estimate.
     design.evaluate(log.rows, i, basis, pred, jac);
-    const RowResiduals e = row_residuals(r, pred, nuisance, log);
+    const RowResiduals e = row_residuals(r, pred, nuisance[r.part], log);
     if (e.has_position) {
       out.rss_position_with_outliers += e.position * e.position;
       ++out.n_position_with_outliers;
@@ -359,6 +361,8 @@ ResidualPass residual_pass(const Design& design, const PreparedLog& log, const G
     for (int grp = 0; grp < 3; ++grp) {
       out.rss[grp] += e.rss[grp];
       out.n[grp] += e.n[grp];
+      out.part_rss[r.part][static_cast<std::size_t>(grp)] += e.rss[grp];
+      out.part_n[r.part][static_cast<std::size_t>(grp)] += e.n[grp];
     }
     if (e.has_position) {
       out.rss_position += e.position * e.position;

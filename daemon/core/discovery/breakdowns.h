@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <span>
 #include <vector>
 
@@ -37,6 +38,9 @@ struct ResidualPass {
   /// Sum over revolution blocks of g g', g = the block's weighted score J'W r on `score_columns`.
   Eigen::MatrixXd score_outer;
   int blocks = 0;
+  /// Per pooled part (FitRow::part) and signal group, the fitted rows' residual.
+  std::vector<std::array<double, 3>> part_rss;
+  std::vector<std::array<std::int64_t, 3>> part_n;
 };
 
 /// The fitted nuisance constants (design.h): what the residual is measured about.
@@ -45,9 +49,10 @@ struct NuisanceValues {
 };
 
 /// Runs the pass. `design` holds the fitted model (no candidates); `score_columns`
-/// are the columns whose robust covariance is wanted (nuisance + model).
+/// are the columns whose robust covariance is wanted (nuisance + model); `nuisance`
+/// has one entry per pooled part (design.h "Parts").
 [[nodiscard]] ResidualPass residual_pass(const Design& design, const PreparedLog& log, const GroupFloors& floors,
                                          std::span<const int> score_columns, const DiscoveryOptions& options,
-                                         const NuisanceValues& nuisance);
+                                         std::span<const NuisanceValues> nuisance);
 
 }  // namespace resolver

@@ -22,10 +22,16 @@ std::vector<Nuisance> nuisances_for(const PreparedLog& log) {
   return out;
 }
 
+Design design_for(const Model& model, const PreparedLog& log) {
+  Design d = model.design(nuisances_for(log));
+  d.set_parts(log.part_count());
+  return d;
+}
+
 std::vector<int> model_columns(const Design& design) {
   std::vector<int> out;
   out.reserve(static_cast<std::size_t>(design.columns()));
-  for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) out.push_back(j);
+  for (int j = 0; j < design.nuisance_columns(); ++j) out.push_back(j);
   for (std::size_t i = 0; i < design.terms().size(); ++i) {
     if (design.terms()[i].candidate) continue;
     for (int c : term_columns(design, i)) out.push_back(c);

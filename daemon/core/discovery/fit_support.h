@@ -19,6 +19,10 @@ inline constexpr std::string_view kNeedsAlignedReference =
 /// reference), the envelopes' amplitude, the dq operating point.
 [[nodiscard]] std::vector<Nuisance> nuisances_for(const PreparedLog& log);
 
+/// The design of `model` at its values for `log`: its nuisances, one set per pooled
+/// part (a model fitted to the same parts keeps each part's frame shift).
+[[nodiscard]] Design design_for(const Model& model, const PreparedLog& log);
+
 /// Nuisance and model (non-candidate) columns of a design.
 [[nodiscard]] std::vector<int> model_columns(const Design& design);
 

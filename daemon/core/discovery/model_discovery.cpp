@@ -161,24 +161,31 @@ std::vector<std::string_view> fittable_effects() {
 namespace {
 
 /// The nuisance constants at the solution (the last step solved them from zero),
-/// into f.nuisance; returned as the residual pass measures about them.
-NuisanceValues nuisance_at_solution(const Design& d, const FitResult& fr, ModelFit& f) {
-  NuisanceValues nv;
-  for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
-    const double v = fr.last.dz[static_cast<Eigen::Index>(j)];
-    // The position errors' constants: the prediction carries -frame_shift (design.h),
-    // the solution what is left.
-    double total = v;
-    switch (d.nuisances()[j]) {
-      case Nuisance::kRdConstant: nv.rd = v; total -= d.frame_shift(); break;
-      case Nuisance::kSaConstant: nv.sa = v; total -= d.frame_shift(); break;
-      case Nuisance::kScGain: nv.sr = v; break;
-      case Nuisance::kIdConstant: nv.d = v; break;
-      case Nuisance::kIqConstant: nv.q = v; break;
+/// into f.nuisance (a pooled fit's per log, named "[log]"); returned per part as the
+/// residual pass measures about them.
+std::vector<NuisanceValues> nuisance_at_solution(const Design& d, const FitResult& fr, const PreparedLog& log,
+                                                 ModelFit& f) {
+  std::vector<NuisanceValues> out(static_cast<std::size_t>(d.parts()));
+  for (int part = 0; part < d.parts(); ++part) {
+    NuisanceValues& nv = out[static_cast<std::size_t>(part)];
+    const std::string suffix =
+        log.part_names.empty() ? std::string() : "[" + log.part_names[static_cast<std::size_t>(part)] + "]";
+    for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
+      const double v = fr.last.dz[d.nuisance_column(part, j)];
+      // The position errors' constants: the prediction carries -frame_shift (design.h),
+      // the solution what is left.
+      double total = v;
+      switch (d.nuisances()[j]) {
+        case Nuisance::kRdConstant: nv.rd = v; total -= d.frame_shift(part); break;
+        case Nuisance::kSaConstant: nv.sa = v; total -= d.frame_shift(part); break;
+        case Nuisance::kScGain: nv.sr = v; break;
+        case Nuisance::kIdConstant: nv.d = v; break;
+        case Nuisance::kIqConstant: nv.q = v; break;
+      }
+      f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])) + suffix, total, kNaN, ""});
     }
-    f.nuisance.push_back({std::string(nuisance_name(d.nuisances()[j])), total, kNaN, ""});
   }
-  return nv;
+  return out;
 }
 
 /// The parameters' covariance: from the revolution-to-revolution spread of the
@@ -267,6 +274,18 @@ void take_breakdowns(const ResidualPass& pass, ModelFit& f) {
   f.series = pass.series;
 }
 
+/// A pooled fit's residual per log (PartResidual).
+std::vector<PartResidual> part_residuals(const PreparedLog& log, const ResidualPass& pass) {
+  std::vector<PartResidual> out;
+  for (std::size_t part = 0; part < log.part_names.size() && part < pass.part_rss.size(); ++part) {
+    const auto& rss = pass.part_rss[part];
+    const auto& n = pass.part_n[part];
+    auto of = [&](int g) { return n[static_cast<std::size_t>(g)] > 0 ? rms(rss[static_cast<std::size_t>(g)], n[static_cast<std::size_t>(g)]) : kNaN; };
+    out.push_back({log.part_names[part], std::max({n[0], n[1] / 2, n[2] / 2}), of(0), of(1), of(2)});
+  }
+  return out;
+}
+
 /// Explained: every signal at its floor, in-sample and held back, and no outliers
 /// that matter (the residual with them included also at the floor).
 bool at_floor(const ModelFit& f, double explained_ratio) {
@@ -288,7 +307,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   ModelFit f;
   f.model = Model(spec, log.p_r, log.p);
   f.effects = spec.references();
-  Design d = f.model.design(nuisances_for(log));
+  Design d = design_for(f.model, log);
   const FitResult fr = fit_design(d, log.rows, floors, 12, [&] {
     if (options.progress) options.progress(0.1);
   });
@@ -304,11 +323,12 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   const std::vector<int> cols = model_columns(d);
   // The nuisance-only fit of the same rows: the "raw" residual.
   Design raw(ModelSpec{}, {}, nuisances_for(log));
+  raw.set_parts(log.part_count());
   PassStatistics raw_stats(raw.columns());
   accumulate(raw, log.rows, floors, raw_stats);
   ++f.passes;
   const StepSolution raw_sol = solve_step(raw_stats.all, floors);
-  const NuisanceValues nv = nuisance_at_solution(d, fr, f);
+  const std::vector<NuisanceValues> nv = nuisance_at_solution(d, fr, log, f);
   // One pass at the solution: breakdowns, whiteness, robust scores, series.
   const ResidualPass pass = residual_pass(d, log, floors, cols, options, nv);
   ++f.passes;
@@ -318,6 +338,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   f.residual_rms_rad = f.signals.empty() ? 0.0 : f.signals.front().rms;
   f.noise_floor_rad = f.signals.empty() ? 0.0 : f.signals.front().floor;
   take_breakdowns(pass, f);
+  f.parts = part_residuals(log, pass);
   f.floors = log.floors;
   f.account = account_of(log);
   f.outliers = log.outliers;

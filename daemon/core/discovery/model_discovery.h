@@ -139,6 +139,16 @@ struct ResidualSeries {
   std::vector<double> i_d_model, i_q_model;  ///< [A] the model's prediction of the reference-frame dq
 };
 
+/// One log of a pooled fit: its residual with the shared parameters and its own
+/// nuisance constants (pool.h).
+struct PartResidual {
+  std::string name;               ///< the log
+  std::int64_t rows = 0;          ///< its fitted rows
+  double position_rms = 0.0;      ///< [rad] R/D angle's (NaN without one)
+  double sincos_rms = 0.0;        ///< [1] sin/cos angle and radius (NaN without them)
+  double dq_rms = 0.0;            ///< [A] (NaN without currents)
+};
+
 /// What the statistics cover.
 struct SampleAccount {
   std::int64_t samples_in = 0;          ///< samples the log gave
@@ -193,6 +203,8 @@ struct ModelFit {
   int passes = 0;                            ///< passes over the rows
   std::vector<std::string> notes;
   ResidualSeries series;
+  /// A pooled fit's logs (empty for one log).
+  std::vector<PartResidual> parts;
 };
 
 struct Candidate {

@@ -69,7 +69,10 @@ struct PreparedLog {
   std::int64_t unusable_self_calibration = 0;
   std::string fold_rule;                  ///< how the validation folds were drawn
   std::vector<std::string> notes;         ///< what the log lacks, assumptions
+  /// A pooled fit's logs, in FitRow::part order (pool.h); empty for one log.
+  std::vector<std::string> part_names;
 
+  [[nodiscard]] int part_count() const { return part_names.empty() ? 1 : static_cast<int>(part_names.size()); }
   [[nodiscard]] std::int64_t fitted_rows() const;
   [[nodiscard]] std::int64_t outlier_rows() const;
   /// [rev] electrical revolutions travelled while moving.

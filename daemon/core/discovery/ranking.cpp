@@ -285,6 +285,7 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     ModelSpec with = fit.model.spec();
     with.add(term);
     Design dm(with, fit.model.values(), nuisances_for(log));
+    dm.set_parts(log.part_count());
     const FitResult fr = fit_design(dm, log.rows, floors);
     out.passes += fr.passes;
     if (!fr.ok) continue;
@@ -361,7 +362,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   }
   if (terms.empty()) return out;
   const GroupFloors floors = fit.floors.floors();
-  Design d = fit.model.design(nuisances_for(log));
+  Design d = design_for(fit.model, log);
   const std::size_t first_candidate = d.terms().size();
   for (const ModelTerm& t : terms) d.add_candidate(t);
   PassStatistics stats(d.columns());

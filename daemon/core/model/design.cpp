@@ -82,9 +82,15 @@ void Design::add_candidate(const ModelTerm& term) {
   rebuild();
 }
 
+void Design::set_parts(int parts) {
+  if (parts < 1) throw std::invalid_argument("design: a pooled fit needs at least one part");
+  frame_shifts_.resize(static_cast<std::size_t>(parts), frame_shifts_.front());
+  rebuild();
+}
+
 void Design::rebuild() {
   term_first_.clear();
-  int k = static_cast<int>(nuisances_.size());
+  int k = nuisance_columns();
   std::size_t widest = 0;
   for (const DesignTerm& t : terms_) {
     term_first_.push_back(k);
@@ -98,7 +104,12 @@ void Design::rebuild() {
 
 std::vector<std::string> Design::column_names() const {
   std::vector<std::string> out;
-  for (Nuisance n : nuisances_) out.emplace_back(nuisance_name(n));
+  for (int part = 0; part < parts(); ++part) {
+    for (Nuisance n : nuisances_) {
+      out.push_back(parts() == 1 ? std::string(nuisance_name(n))
+                                 : std::string(nuisance_name(n)) + "[" + std::to_string(part + 1) + "]");
+    }
+  }
   for (const DesignTerm& t : terms_) {
     for (int p : t.params) {
       out.push_back(std::string(t.effect->name()) + "." +
@@ -241,10 +252,10 @@ const Design::EnvelopeCache& Design::envelope() const {
   return envelope_;
 }
 
-BasisTransform Design::transform(const SignatureRow& row, std::size_t extra_term,
+BasisTransform Design::transform(const SignatureRow& row, int part, std::size_t extra_term,
                                  const std::vector<double>* extra_values) const {
   BasisTransform tr;
-  tr.shift = frame_shift_;
+  tr.shift = frame_shift(part);
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = extra_values != nullptr && i == extra_term;
@@ -254,9 +265,9 @@ BasisTransform Design::transform(const SignatureRow& row, std::size_t extra_term
   return tr;
 }
 
-SignalValues Design::predict_with(const SignatureRow& row, AngleBasis& basis, std::size_t override_term,
+SignalValues Design::predict_with(const SignatureRow& row, int part, AngleBasis& basis, std::size_t override_term,
                                   const std::vector<double>* override_values) const {
-  basis.set(row, transform(row, override_term, override_values));
+  basis.set(row, transform(row, part, override_term, override_values));
   SignalValues pred;
   const bool envelope_override = override_values != nullptr && override_term < terms_.size() &&
                                  terms_[override_term].effect->envelope_only();
@@ -288,13 +299,13 @@ SignalValues Design::predict_with(const SignatureRow& row, AngleBasis& basis, st
     }
   }
   // The position error's constant in the log's frame: the sensor's zero (header).
-  pred.rd -= frame_shift_;
-  pred.sa -= frame_shift_;
+  pred.rd -= frame_shift(part);
+  pred.sa -= frame_shift(part);
   return pred;
 }
 
 SignalValues Design::predict(const FitRow& row, AngleBasis& basis) const {
-  return predict_with(row.sig, basis, terms_.size(), nullptr);
+  return predict_with(row.sig, row.part, basis, terms_.size(), nullptr);
 }
 
 namespace {
@@ -328,7 +339,7 @@ SignalValues Design::predict(std::span<const FitRow> rows, std::size_t i, AngleB
   const RowsHistory h{rows};
   SignatureRow row = rows[i].sig;
   row.history = AngleHistory{&h, &history_angle, i};
-  return predict_with(row, basis, terms_.size(), nullptr);
+  return predict_with(row, rows[i].part, basis, terms_.size(), nullptr);
 }
 
 void Design::evaluate(std::span<const FitRow> rows, std::size_t i, AngleBasis& basis, SignalValues& prediction,
@@ -336,15 +347,15 @@ void Design::evaluate(std::span<const FitRow> rows, std::size_t i, AngleBasis& b
   const RowsHistory h{rows};
   SignatureRow row = rows[i].sig;
   row.history = AngleHistory{&h, &history_angle, i};
-  evaluate_row(row, basis, prediction, jac);
+  evaluate_row(row, rows[i].part, basis, prediction, jac);
 }
 
-void Design::evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValues& prediction,
+void Design::evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, SignalValues& prediction,
                           RowJacobian& jac) const {
   if (jac.rd.size() != columns_) jac.resize(columns_);
   jac.set_zero();
-  prediction = predict_with(row, basis, terms_.size(), nullptr);
-  int col = 0;
+  prediction = predict_with(row, part, basis, terms_.size(), nullptr);
+  int col = nuisance_column(part, 0);  // this row's part's own constants (header)
   for (Nuisance n : nuisances_) {
     switch (n) {
       case Nuisance::kRdConstant: jac.rd[col] = 1.0; break;
@@ -358,6 +369,7 @@ void Design::evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValu
     }
     ++col;
   }
+  col = nuisance_columns();
   AngleBasis shifted;  // numeric derivatives move the basis; `basis` stays at the model's
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
@@ -386,7 +398,7 @@ void Design::evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValu
         const double z = ps[p].polar != Polar::kNone ? 0.0 : to_internal(ps[p], t.values[p]);
         const double h = fd_step(ps[p], z);
         const std::vector<double> moved = values_with(i, static_cast<int>(k), h);
-        const SignalValues shifted_pred = predict_with(row, shifted, i, &moved);
+        const SignalValues shifted_pred = predict_with(row, part, shifted, i, &moved);
         c = SignalValues{.rd = (shifted_pred.rd - prediction.rd) / h, .sa = (shifted_pred.sa - prediction.sa) / h,
                          .sr = (shifted_pred.sr - prediction.sr) / h, .d = (shifted_pred.d - prediction.d) / h,
                          .q = (shifted_pred.q - prediction.q) / h};

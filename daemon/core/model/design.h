@@ -20,6 +20,11 @@
 // nuisance constant: the fit moves it by that column's step (fit_design), so the
 // parameters do not depend on the reference's zero.
 //
+// Parts (a pooled fit of several logs of one bench, FitRow::part): the sensor's
+// parameters are shared, each part has its own nuisance columns and frame shift
+// (each log's reference zero, envelope amplitude and operating point). Columns:
+// part 0's nuisances, part 1's, ..., then the terms.
+//
 // Internal coordinates z (what Gauss-Newton moves): a linear parameter is its
 // value; a nonlinear one with FitScale::kInverseSquare is 1/value^2 (0 = neutral);
 // a polar pair is its Cartesian pair (effect.h). Linear parameters' Jacobian
@@ -28,6 +33,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <span>
 #include <string>
 #include <vector>
@@ -72,7 +78,17 @@ class Design {
   void add_candidate(const ModelTerm& term);
 
   [[nodiscard]] int columns() const { return columns_; }
+  /// The nuisance kinds of one part (each part has its own columns of them).
   [[nodiscard]] const std::vector<Nuisance>& nuisances() const { return nuisances_; }
+  /// Pooled parts (>= 1); setting it keeps part 0's frame shift for every new part.
+  [[nodiscard]] int parts() const { return static_cast<int>(frame_shifts_.size()); }
+  void set_parts(int parts);
+  /// Nuisance columns of every part: the first nuisance_columns() columns.
+  [[nodiscard]] int nuisance_columns() const { return static_cast<int>(nuisances_.size()) * parts(); }
+  /// Column of nuisance kind index `j` of part `part`.
+  [[nodiscard]] int nuisance_column(int part, std::size_t j) const {
+    return part * static_cast<int>(nuisances_.size()) + static_cast<int>(j);
+  }
   [[nodiscard]] const std::vector<DesignTerm>& terms() const { return terms_; }
   /// Mutable terms (the cached envelope series is recomputed on next use).
   [[nodiscard]] std::vector<DesignTerm>& terms() {
@@ -80,8 +96,12 @@ class Design {
     return terms_;
   }
   /// [rad, resolver electrical] the sensor's zero in the fit's frame (header comment).
-  [[nodiscard]] double frame_shift() const { return frame_shift_; }
-  void set_frame_shift(double shift) { frame_shift_ = shift; }
+  [[nodiscard]] double frame_shift(int part = 0) const { return frame_shifts_[static_cast<std::size_t>(part)]; }
+  /// Sets one part's shift.
+  void set_frame_shift(int part, double shift) { frame_shifts_[static_cast<std::size_t>(part)] = shift; }
+  /// Sets every part's shift.
+  void set_frame_shift(double shift) { std::fill(frame_shifts_.begin(), frame_shifts_.end(), shift); }
+  [[nodiscard]] const std::vector<double>& frame_shifts() const { return frame_shifts_; }
   /// "nuisance.sr_gain", "amplitude_imbalance.alpha", "eccentricity.e_x" ... per column.
   [[nodiscard]] std::vector<std::string> column_names() const;
   /// First column of term i.
@@ -105,7 +125,7 @@ class Design {
   /// Evaluates one row: the prediction of every signal (model terms) and the
   /// Jacobian rows of every column. `basis` is scratch.
   void evaluate(const FitRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const {
-    evaluate_row(row.sig, basis, prediction, jac);
+    evaluate_row(row.sig, row.part, basis, prediction, jac);
   }
   /// The same for rows[i], with the earlier rows as the angle's history (a delay
   /// reads theta(t - d) from them: exact across speed steps).
@@ -116,9 +136,9 @@ class Design {
   [[nodiscard]] SignalValues predict(std::span<const FitRow> rows, std::size_t i, AngleBasis& basis) const;
 
  private:
-  [[nodiscard]] BasisTransform transform(const SignatureRow& row, std::size_t extra_term,
+  [[nodiscard]] BasisTransform transform(const SignatureRow& row, int part, std::size_t extra_term,
                                          const std::vector<double>* extra_values) const;
-  [[nodiscard]] SignalValues predict_with(const SignatureRow& row, AngleBasis& basis, std::size_t override_term,
+  [[nodiscard]] SignalValues predict_with(const SignatureRow& row, int part, AngleBasis& basis, std::size_t override_term,
                                           const std::vector<double>* override_values) const;
   void rebuild();
   /// The envelope terms' joint series and every envelope column's derivative series
@@ -133,13 +153,14 @@ class Design {
   [[nodiscard]] std::vector<EnvelopeMember> envelope_members(std::size_t override_term,
                                                              const std::vector<double>* override_values,
                                                              std::size_t with_candidate) const;
-  void evaluate_row(const SignatureRow& row, AngleBasis& basis, SignalValues& prediction, RowJacobian& jac) const;
+  void evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, SignalValues& prediction,
+                    RowJacobian& jac) const;
 
   std::vector<Nuisance> nuisances_;
   std::vector<DesignTerm> terms_;
   std::vector<int> term_first_;
   int columns_ = 0;
-  double frame_shift_ = 0.0;
+  std::vector<double> frame_shifts_ = std::vector<double>(1, 0.0);  ///< per part
   mutable std::vector<SignalValues> scratch_;
   mutable EnvelopeCache envelope_;
 };

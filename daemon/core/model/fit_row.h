@@ -27,6 +27,7 @@ struct FitRow {
   double y_d = 0.0;   ///< [A] i_d in the frame of the true theta_e
   double y_q = 0.0;   ///< [A]
   std::uint16_t flags = 0;
+  std::uint16_t part = 0;  ///< which log of a pooled fit (design.h "Parts"); 0 for one log
   std::int32_t block = 0;  ///< electrical revolution the row belongs to (robust standard errors)
 
   [[nodiscard]] bool has(Flag f) const { return (flags & f) != 0; }

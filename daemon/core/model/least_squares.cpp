@@ -155,16 +155,31 @@ double cost_at(const PassStatistics& s, const GroupFloors& floors, std::span<con
 /// of 0.1 rad by 1e-8 rad, far below any floor (a 24-bit converter's LSB is 3.7e-7).
 constexpr double kShiftSettled = 1e-7;
 
-/// The column of the position-error constant the frame shift follows: the sin/cos
-/// angle's where the log has it (the windings' own frame), else the R/D angle's; -1
-/// when the reference is aligned (no constant: mounting_offset is a parameter).
-int frame_constant_column(const Design& d) {
-  int rd = -1;
+/// The columns of the position-error constant the frame shift follows, one per
+/// pooled part (design.h): the sin/cos angle's where the log has it (the windings'
+/// own frame), else the R/D angle's; empty when the reference is aligned (no
+/// constant: mounting_offset is a parameter).
+std::vector<int> frame_constant_columns(const Design& d) {
+  int kind = -1;
   for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
-    if (d.nuisances()[j] == Nuisance::kSaConstant) return static_cast<int>(j);
-    if (d.nuisances()[j] == Nuisance::kRdConstant) rd = static_cast<int>(j);
+    if (d.nuisances()[j] == Nuisance::kSaConstant) {
+      kind = static_cast<int>(j);
+      break;
+    }
+    if (d.nuisances()[j] == Nuisance::kRdConstant) kind = static_cast<int>(j);
   }
-  return rd;
+  std::vector<int> out;
+  if (kind < 0) return out;
+  for (int part = 0; part < d.parts(); ++part) out.push_back(d.nuisance_column(part, static_cast<std::size_t>(kind)));
+  return out;
+}
+
+/// Every part's frame shift moved by its constant's step (the prediction carries
+/// -shift: design.h).
+void shift_frames(Design& d, const std::vector<int>& zero_cols, const Eigen::VectorXd& dz) {
+  for (std::size_t part = 0; part < zero_cols.size(); ++part) {
+    d.set_frame_shift(static_cast<int>(part), d.frame_shift(static_cast<int>(part)) - dz[zero_cols[part]]);
+  }
 }
 
 /// True when design column `col` is a model term's nonlinear parameter.
@@ -197,7 +212,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   // Model columns only: candidates are evaluated at the model's solution later.
   std::vector<int> model_cols;
   model_cols.reserve(static_cast<std::size_t>(design.columns()));
-  for (int j = 0; j < static_cast<int>(design.nuisances().size()); ++j) model_cols.push_back(j);
+  for (int j = 0; j < design.nuisance_columns(); ++j) model_cols.push_back(j);
   const std::vector<int> nuisance_cols = model_cols;
   for (std::size_t i = 0; i < design.terms().size(); ++i) {
     if (design.terms()[i].candidate) continue;
@@ -215,16 +230,16 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   for (int c : model_cols) {
     if (!column_is_nonlinear(design, c)) warm_cols.push_back(c);
   }
-  const int zero_col = linear ? -1 : frame_constant_column(design);
-  if (zero_col >= 0) {
+  const std::vector<int> zero_cols = linear ? std::vector<int>{} : frame_constant_columns(design);
+  if (!zero_cols.empty()) {
     // Start in the sensor's frame: the constant alone at the starting values (its
     // error is the windings' mean angle error, ~beta/2). From a frame half a turn
     // away the first step would fit every harmonic turned and could only go uphill.
     PassStatistics start(design.columns());
     accumulate(design, rows, floors, start);
     ++out.passes;
-    const StepSolution c = solve_step(start.all, floors, std::vector<int>{zero_col});
-    if (c.ok) design.set_frame_shift(design.frame_shift() - c.dz[zero_col]);
+    const StepSolution c = solve_step(start.all, floors, zero_cols);
+    if (c.ok) shift_frames(design, zero_cols, c.dz);
   }
   double lambda = 0.0;
   double cost = std::numeric_limits<double>::infinity();
@@ -279,8 +294,8 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     // point is the solution.
     // The frame shift is the position-error constant's coordinate (the prediction
     // carries -shift: design.h); the constant's step moves it like any parameter.
-    const double shift = zero_col >= 0 ? design.frame_shift() - sol.dz[zero_col] : design.frame_shift();
-    const bool shift_settled = std::abs(shift - design.frame_shift()) <= kShiftSettled;
+    bool shift_settled = true;
+    for (int c : zero_cols) shift_settled = shift_settled && std::abs(sol.dz[c]) <= kShiftSettled;
     if (pass > 0 && shift_settled && here - sol.rss_w <= tolerance) {
       const StepSolution free = lambda > 0.0 ? solve_step(stats.all, floors, cols, 0.0) : sol;
       if (free.ok && here - free.rss_w <= tolerance) {
@@ -294,7 +309,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     out.last = sol;
     out.stats = std::move(stats);
     design.step(sol.dz);
-    design.set_frame_shift(shift);
+    shift_frames(design, zero_cols, sol.dz);
     if (linear) {
       // One linearised step is exact; the statistics move with it (RSS(dz) above).
       out.cost = sol.rss_w;

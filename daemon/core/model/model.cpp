@@ -47,7 +47,8 @@ std::vector<ModelParameter> Model::parameters() const {
 
 Design Model::design(std::vector<Nuisance> nuisances) const {
   Design d(spec_, values_, std::move(nuisances));
-  d.set_frame_shift(frame_shift_);
+  d.set_parts(static_cast<int>(frame_shifts_.size()));
+  for (std::size_t part = 0; part < frame_shifts_.size(); ++part) d.set_frame_shift(static_cast<int>(part), frame_shifts_[part]);
   return d;
 }
 
@@ -58,19 +59,19 @@ void Model::take_values(const Design& design) {
     if (i < values_.size()) values_[i] = t.values;
     ++i;
   }
-  frame_shift_ = design.frame_shift();
+  frame_shifts_ = design.frame_shifts();
   scratch_valid_ = false;
 }
 
 SignalValues Model::predict(const SignatureRow& row) const { return predict_with_shift(row, 0.0); }
 
 SignalValues Model::predict_in_log_frame(const SignatureRow& row) const {
-  return predict_with_shift(row, frame_shift_);
+  return predict_with_shift(row, frame_shift());
 }
 
 SignalValues Model::predict_with_shift(const SignatureRow& row, double shift) const {
   if (!scratch_valid_) {
-    scratch_ = design({});
+    scratch_ = Design(spec_, values_, {});
     scratch_valid_ = true;
   }
   AngleBasis basis;

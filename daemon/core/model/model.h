@@ -50,8 +50,10 @@ class Model {
   /// The same at a row of the fitted log's true angles (its reference's frame:
   /// the sensor's zero sits at frame_shift() there; design.h).
   [[nodiscard]] SignalValues predict_in_log_frame(const SignatureRow& row) const;
-  /// [rad, resolver electrical] the sensor's zero in the fitted log's frame.
-  [[nodiscard]] double frame_shift() const { return frame_shift_; }
+  /// [rad, resolver electrical] the sensor's zero in the fitted log's frame (of the
+  /// first log of a pooled fit: each log has its own, frame_shifts()).
+  [[nodiscard]] double frame_shift() const { return frame_shifts_.front(); }
+  [[nodiscard]] const std::vector<double>& frame_shifts() const { return frame_shifts_; }
   /// True when some term changes the R/D or sin/cos angle (compensation has work to do).
   [[nodiscard]] bool has_angle_terms() const;
   [[nodiscard]] bool empty() const { return spec_.terms.empty(); }
@@ -65,7 +67,7 @@ class Model {
   int p_r_ = 1, p_ = 1;
   std::vector<std::vector<double>> values_;
   std::vector<double> std_errors_;
-  double frame_shift_ = 0.0;
+  std::vector<double> frame_shifts_ = std::vector<double>(1, 0.0);  ///< per pooled log (design.h "Parts")
   std::shared_ptr<const CustomEffects> customs_;
   mutable Design scratch_;
   mutable bool scratch_valid_ = false;
