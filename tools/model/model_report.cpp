@@ -270,7 +270,8 @@ std::string format_model_text(const Explanation& ex, bool explain, const std::ve
   return o + text_explanation(ex);
 }
 
-std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes) {
+std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes,
+                              const std::string& extra_members) {
   const ModelFit& f = ex.fit;
   std::string o = json_fit_head(f) + json_diagnostics(f) + json_breakdowns(f);
   std::vector<std::string> all = notes;
@@ -281,7 +282,7 @@ std::string format_model_json(const Explanation& ex, bool explain, const std::ve
   } else {
     o += std::string(",\"verdict\":") + (f.explained ? "\"explained\"" : "\"not_explained\"");
   }
-  return o + "}\n";
+  return o + extra_members + "}\n";
 }
 
 }  // namespace resolver

@@ -13,6 +13,8 @@ namespace resolver {
 
 /// `explained` = false: the fit only (candidates and verdict omitted).
 [[nodiscard]] std::string format_model_text(const Explanation& ex, bool explain, const std::vector<std::string>& notes);
-[[nodiscard]] std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes);
+/// `extra_members` (",\"key\":value...") ends the object (a pooled fit's "pool").
+[[nodiscard]] std::string format_model_json(const Explanation& ex, bool explain, const std::vector<std::string>& notes,
+                                            const std::string& extra_members = "");
 
 }  // namespace resolver

@@ -45,6 +45,7 @@
 #include "tools/model/html_report.h"
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
+#include "tools/model/pooled_run.h"
 #include "daemon/service/program_version.h"
 
 namespace {
@@ -146,7 +147,9 @@ constexpr const char* kFitExamples = R"(Examples:
   resolver-model fit demo.log --effects amplitude_imbalance,dead_time --json
   resolver-model fit bench.asc --from 1 --to 4
   # a scope export mapped by [input.csv] in a resolverd config; forward motion only
-  resolver-model fit scope.csv --config scope.toml --direction forward)";
+  resolver-model fit scope.csv --config scope.toml --direction forward
+  # one motor's runs of a week fitted together; each run's own fit against the pool
+  resolver-model fit mon.log tue.log wed.log --effects amplitude_imbalance,quadrature --jobs 2)";
 
 constexpr const char* kExplainExamples = R"(Examples:
   # where the seed model fails and the ranked missing effects
@@ -154,7 +157,10 @@ constexpr const char* kExplainExamples = R"(Examples:
   # the same from a richer model, as JSON (suggested_custom: a [[model.custom]] block)
   resolver-model explain demo.log --effects amplitude_imbalance,quadrature --json
   # with the effects of a resolverd config (its [model] effects and [[model.custom]] blocks)
-  resolver-model explain demo.log --config tools/demo/model_with_dead_time.toml)";
+  resolver-model explain demo.log --config tools/demo/model_with_dead_time.toml
+  # several runs of one bench together: what they share is fitted once, and they are
+  # told apart only by their reference zero, amplitude and operating point
+  resolver-model explain run1.log run2.log --json)";
 
 constexpr const char* kReportExamples = R"(Examples:
   # the discovery loop to its verdict, as one self-contained page
@@ -254,7 +260,9 @@ enum class Command { kFit, kExplain, kReport, kExportData, kExport, kFleet };
 /// Every value the command line sets, one field per option whatever subcommand gives it.
 struct Arguments {
   Command command = Command::kFit;
-  std::string log;
+  std::string log;                // the first of `logs` for fit and explain
+  std::vector<std::string> logs;  // fit, explain: two or more make a pooled fit
+  int jobs = 1;                   // pooled: logs read at once
   std::vector<std::string> effects_args;
   std::string config_path;
   std::string format_name;
@@ -274,7 +282,12 @@ struct Arguments {
 
 /// fit and explain: the log, the model (with the fittable effects listed) and --json.
 void add_model_options(CLI::App* sub, Arguments& a, const std::string& fittable) {
-  sub->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
+  sub->add_option("LOG", a.logs,
+                  "log: candump -l, Vector ASC or CSV (default bench layout unless --config); two or more logs of one "
+                  "bench are fitted together (shared sensor parameters, each log its own reference zero, amplitude "
+                  "and operating point), and each log's own fit is compared with the pool")
+      ->required();
+  sub->add_option("--jobs", a.jobs, "pooled fit: read this many logs at once (default 1)")->check(CLI::Range(1, 256));
   sub->add_option("--effects", a.effects_args,
                   "the model: comma-separated effect references, an effect by name (its default parameters) or "
                   "with a parameter list, e.g. amplitude_imbalance,harmonics(k5,k3_opp),delay; catalog effects or "
@@ -522,10 +535,30 @@ std::vector<std::string> report_notes(const resolver::LogSamples& samples) {
   return notes;
 }
 
+/// fit or explain of two or more logs together.
+int run_on_logs(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
+  resolver::PooledRun run;
+  run.logs = a.logs;
+  run.effects = model.effects;
+  run.options = discovery_options(a, model.config);
+  run.explain = a.command == Command::kExplain;
+  run.json = a.json;
+  run.jobs = a.jobs;
+  run.read = [&](const std::string& log, bool quiet) {
+    Arguments one = a;
+    one.log = log;
+    return read_samples(one, model.config, quiet ? resolver::ProgressMeter::Options{} : shown);
+  };
+  run.weigh_faults = weigh_signal_faults;
+  run.notes = report_notes;
+  return resolver::run_pooled(run);
+}
+
 /// Every subcommand but fleet: read the log, then fit, explain or write.
 int run_on_log(const Arguments& a) {
   const Model model = load_model(a);
   const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(a.progress);
+  if (a.logs.size() > 1) return run_on_logs(a, model, shown);
   resolver::LogSamples samples = read_samples(a, model.config, shown);
   resolver::DiscoveryOptions options = discovery_options(a, model.config);
   weigh_signal_faults(samples, options);
@@ -553,6 +586,7 @@ int run(int argc, char** argv) {
   add_calibration_subcommands(app, a, subs);
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
   a.command = subs.parsed();
+  if (!a.logs.empty()) a.log = a.logs.front();
   if (a.command == Command::kFleet) {
     return run_fleet(a.manifest, a.fleet_out, a.summarize_dir, split_effects(a.effects_args), a.config_path,
                      a.export_points);
