@@ -1,5 +1,7 @@
 #include "tools/model/fleet.h"
 
+#include "daemon/core/discovery/pool.h"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -102,26 +104,24 @@ std::string fit_fields(const Explanation& ex) {
       json::num(ratio(f)), strings_json(f.effects), params_json(f.params), strings_json(proposed));
 }
 
-/// Pairs of the unit's logs whose values of a parameter differ by more than 4 combined
-/// standard errors.
+/// The unit's logs whose own fit disagrees with its other logs (pool.h's rule: the
+/// consensus of the logs that agree, beyond kPoolDisagreementZ standard errors).
 std::string disagreements_json(const std::vector<LogResult>& logs, std::vector<std::string>& names) {
+  std::vector<ModelFit> fits;
+  std::vector<std::string> log_names;
+  for (const LogResult& l : logs) {
+    fits.push_back(l.ex.fit);
+    log_names.push_back(l.log);
+  }
   std::string o = "[";
-  for (std::size_t a = 0; a < logs.size(); ++a) {
-    for (std::size_t b = a + 1; b < logs.size(); ++b) {
-      for (const auto& pa : logs[a].ex.fit.params) {
-        for (const auto& pb : logs[b].ex.fit.params) {
-          if (pa.name != pb.name) continue;
-          const double se = std::hypot(pa.std_error, pb.std_error);
-          const double z = std::abs(pa.value - pb.value) / se;
-          if (!(se > 0.0) || !(z > 4.0)) continue;
-          if (std::find(names.begin(), names.end(), pa.name) == names.end()) names.push_back(pa.name);
-          o += (o.size() > 1 ? "," : "") +
-               fmt::format("{{\"param\":{},\"logs\":[{},{}],\"values\":[{},{}],\"z\":{}}}", json::str(pa.name),
-                           json::str(logs[a].log), json::str(logs[b].log), json::num(pa.value),
-                           json::num(pb.value), json::num(z, 4));
-        }
-      }
-    }
+  if (fits.empty()) return o + "]";
+  for (const PoolDisagreement& d : compare_with_pool(fits.front(), fits, log_names)) {
+    if (!(std::abs(d.z) > kPoolDisagreementZ)) continue;
+    if (std::find(names.begin(), names.end(), d.parameter) == names.end()) names.push_back(d.parameter);
+    o += (o.size() > 1 ? "," : "") +
+         fmt::format("{{\"param\":{},\"log\":{},\"value\":{},\"others\":{},\"others_stderr\":{},\"z\":{}}}",
+                     json::str(d.parameter), json::str(d.log), json::num(d.value), json::num(d.others),
+                     json::num(d.others_std_error), json::num(d.z, 4));
   }
   return o + "]";
 }
@@ -201,7 +201,7 @@ bool run_unit(const std::string& unit, const std::vector<ManifestRow>& rows, con
                               strings_json(disagreeing), disagreements, rows.size(), logs_json));
   if (!disagreeing.empty()) {
     std::cerr << "resolver-model fleet: unit " << unit << ": its logs disagree on " << fmt::format("{}", fmt::join(disagreeing, ", "))
-              << " (more than 4 combined standard errors; unit.json: disagreements)\n";
+              << " (one log beyond 4 standard errors of the unit's other logs; unit.json: disagreements)\n";
   }
   return true;
 }
@@ -231,6 +231,7 @@ struct UnitSummary {
   double ratio = 0.0;
   std::vector<std::string> proposed, disagreeing;
   std::vector<std::pair<std::string, double>> params;
+  std::map<std::string, double> std_errors;  ///< of params (NaN: none)
   std::size_t logs = 0;
 };
 
@@ -253,7 +254,10 @@ UnitSummary read_unit(const fs::path& file) {
     u.needed = j["needed"].is_null() ? "" : j["needed"].text;
     for (const auto& e : j["proposed"].items) u.proposed.push_back(e.text);
     for (const auto& e : j["disagreeing"].items) u.disagreeing.push_back(e.text);
-    for (const auto& [name, p] : j["params"].members) u.params.emplace_back(name, p["value"].number());
+    for (const auto& [name, p] : j["params"].members) {
+      u.params.emplace_back(name, p["value"].number());
+      u.std_errors[name] = p["stderr"].is_null() ? std::nan("") : p["stderr"].number();
+    }
     u.done = true;
   } catch (const std::exception& e) {
     u.reason = fmt::format("{}: unreadable ({})", file.string(), e.what());
@@ -370,7 +374,10 @@ struct FleetOutliers {
 };
 
 /// Units outside the spread: |value - median| > 4 robust spreads, with the parameter
-/// (only where the spread is > 0 over at least 3 units).
+/// (only where the spread is > 0 over at least 3 units), and by more than 3 of the
+/// unit's own standard errors: units that agree to a few microradians have a spread
+/// of their noise, and a unit 4 such spreads out is not odd when its own error covers
+/// it (a 20-unit run flagged a beta of -4.5e-6 rad before).
 FleetOutliers find_outliers(const std::vector<UnitSummary>& units, const ParamSummary& params,
                             const std::map<std::string, std::vector<double>>& values) {
   FleetOutliers o;
@@ -382,6 +389,8 @@ FleetOutliers find_outliers(const std::vector<UnitSummary>& units, const ParamSu
       if (!(s.spread > 0.0) || values.at(name).size() < 3) continue;
       const double z = (v - s.median) / s.spread;
       if (std::abs(z) <= 4.0) continue;
+      const auto se = u.std_errors.find(name);
+      if (se != u.std_errors.end() && std::isfinite(se->second) && std::abs(v - s.median) <= 3.0 * se->second) continue;
       o.json += (o.json.size() > 1 ? "," : "") + fmt::format("{{\"unit\":{},\"param\":{},\"value\":{},\"z\":{}}}",
                                                              json::str(u.unit), json::str(name), json::num(v),
                                                              json::num(z, 4));

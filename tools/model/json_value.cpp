@@ -46,6 +46,7 @@ class Parser {
 
   Json document() {
     Json v = value();
+    skip_space();
     if (pos_ != t_.size()) fail("trailing characters");
     return v;
   }
@@ -55,6 +56,16 @@ class Parser {
     throw std::runtime_error("JSON error at offset " + std::to_string(pos_) + ": " + what);
   }
   char peek() const { return pos_ < t_.size() ? t_[pos_] : '\0'; }
+  /// JSON's whitespace (RFC 8259: space, tab, CR, LF) around every token: a unit.json
+  /// pretty-printed by another tool (python -m json.tool, jq) reads as written.
+  void skip_space() {
+    while (peek() == ' ' || peek() == '\t' || peek() == '\n' || peek() == '\r') ++pos_;
+  }
+  /// The next non-space character.
+  char next() {
+    skip_space();
+    return peek();
+  }
   void expect(char c) {
     if (peek() != c) fail(std::string("expected '") + c + "'");
     ++pos_;
@@ -66,19 +77,21 @@ class Parser {
 
   Json value() {
     Json v;
-    const char c = peek();
+    const char c = next();
     if (c == '{') {
       v.kind = Json::Kind::kObject;
       ++pos_;
-      if (peek() == '}') {
+      if (next() == '}') {
         ++pos_;
         return v;
       }
       while (true) {
+        skip_space();
         std::string key = string_body();
+        skip_space();
         expect(':');
         v.members.emplace_back(std::move(key), value());
-        if (peek() == ',') {
+        if (next() == ',') {
           ++pos_;
           continue;
         }
@@ -89,13 +102,13 @@ class Parser {
     if (c == '[') {
       v.kind = Json::Kind::kArray;
       ++pos_;
-      if (peek() == ']') {
+      if (next() == ']') {
         ++pos_;
         return v;
       }
       while (true) {
         v.items.push_back(value());
-        if (peek() == ',') {
+        if (next() == ',') {
           ++pos_;
           continue;
         }
@@ -181,7 +194,12 @@ class Parser {
         case 't': out.push_back('\t'); break;
         case 'u': {
           if (pos_ + 4 > t_.size()) fail("short \\u escape");
-          const unsigned cp = static_cast<unsigned>(std::stoul(std::string(t_.substr(pos_, 4)), nullptr, 16));
+          unsigned cp = 0;
+          for (char h : t_.substr(pos_, 4)) {
+            const int d = h >= '0' && h <= '9' ? h - '0' : h >= 'a' && h <= 'f' ? h - 'a' + 10 : h >= 'A' && h <= 'F' ? h - 'A' + 10 : -1;
+            if (d < 0) fail("bad \\u escape");
+            cp = cp * 16 + static_cast<unsigned>(d);
+          }
           pos_ += 4;
           append_utf8(out, cp);
           break;

@@ -273,6 +273,34 @@ class SingleProcess(unittest.TestCase):
         self.assertIn("fleet.html", proc.stdout)
 
 
+class OutlierTolerance(unittest.TestCase):
+    """fleet --summarize on hand-written unit.json files (pretty-printed, as another tool writes
+    them): a unit far from the median in spreads is an outlier only when its own standard error
+    does not cover the distance (3 se)."""
+
+    def test_a_unit_its_own_error_covers_is_not_an_outlier(self):
+        out = work("tolerance")
+        shutil.rmtree(out, ignore_errors=True)
+        # Five units agreeing to 1e-6 (spread ~1e-6), one 30 spreads out with a 1e-6 error
+        # (an outlier) and one as far out with a 2e-5 error (1.5 of its own errors: not one).
+        units = {"u1": (0.030000, 1e-6), "u2": (0.030001, 1e-6), "u3": (0.029999, 1e-6),
+                 "u4": (0.0300005, 1e-6), "u5": (0.0299995, 1e-6), "odd": (0.03003, 1e-6),
+                 "noisy": (0.03003, 2e-5)}
+        for unit, (value, se) in units.items():
+            os.makedirs(os.path.join(out, unit))
+            with open(os.path.join(out, unit, "unit.json"), "w") as f:
+                json.dump({"unit": unit, "status": "done", "log": unit + ".log", "p_r": 3, "p": 3,
+                           "verdict": "explained", "residual_rms_rad": 3e-5, "noise_floor_rad": 3e-5,
+                           "residual_over_floor": 1.0, "effects": ["amplitude_imbalance"],
+                           "params": {"amplitude_imbalance.alpha": {"value": value, "stderr": se, "unit": "[1]"}},
+                           "proposed": [], "needed": None, "disagreeing": [], "disagreements": [],
+                           "log_rows": 1, "logs": []}, f, indent=2)
+        run([binary("resolver-model"), "fleet", "--summarize", out])
+        fleet = load(os.path.join(out, "fleet.json"))
+        self.assertEqual(fleet["units_done"], len(units))
+        self.assertEqual({o["unit"] for o in fleet["outliers"]}, {"odd"})
+
+
 class FleetPage(unittest.TestCase):
     """fleet.html of the single-process run."""
 
@@ -438,7 +466,8 @@ def main():
     os.makedirs(ARGS.work, exist_ok=True)
     loader = unittest.defaultTestLoader
     if ARGS.part == "single":
-        suite = unittest.TestSuite([loader.loadTestsFromTestCase(SingleProcess), loader.loadTestsFromTestCase(FleetPage)])
+        suite = unittest.TestSuite([loader.loadTestsFromTestCase(SingleProcess), loader.loadTestsFromTestCase(FleetPage),
+                                    loader.loadTestsFromTestCase(OutlierTolerance)])
     else:
         suite = loader.loadTestsFromTestCase(OnDask)
     result = unittest.TextTestRunner(verbosity=2).run(suite)
