@@ -59,12 +59,11 @@ missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-# npm: the build installs uPlot for the resolver-model report from the npm registry
-# (tools/model/web/package-lock.json). The machine images ship Node.js with npm; where
-# there is no npm at all, Debian's nodejs and npm packages provide it.
-command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)
+# No Node.js: the build fetches uPlot for the resolver-model report from the npm registry
+# with python3 (tools/model/web/fetch_locked_package.py, pinned by package-lock.json's
+# SHA-512); Debian's npm would bring ~340 node-* packages to a fresh machine.
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-deps: all ${#PACKAGES[@]} packages and npm present"
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
   exit 0
 fi
 
