@@ -11,7 +11,8 @@ zero against the resolver's (the mounting offset theta_0, any value) and the noi
   2. a third run whose alpha changed (0.033): it alone is named, on alpha;
   3. control: the model without the R/D loop (an effect that differs with speed): the two runs
      disagree on alpha, which is what a missing speed-dependent effect looks like;
-  4. bad input: a run without the reference beside runs with one (exit 1, naming the log and
+  4. report on two runs: the discovery loop adds the loop and ends explained, with a pooled section;
+  5. bad input: a run without the reference beside runs with one (exit 1, naming the log and
      the signal), a missing log (exit 3, naming it); a single log prints no "pool".
 Standard library only.
 """
@@ -116,6 +117,16 @@ def main():
     no_loop, _ = fit_json(model, [a, b], effects="amplitude_imbalance,quadrature")
     check({(str(a), "amplitude_imbalance.alpha"), (str(b), "amplitude_imbalance.alpha")} <= disagreeing(no_loop),
           "control: a model without the speed-dependent loop leaves the runs disagreeing on alpha")
+
+    # The discovery loop on the pooled runs (report): from alpha + beta it adds the R/D loop
+    # and ends explained; the page has the pooled section with both runs.
+    page = args.work / "pooled.html"
+    r = run([model, "report", a, b, "--effects", "amplitude_imbalance,quadrature", "--html", page])
+    check(r.returncode == 0 and r.stdout.startswith("explained") and "tracking_loop" in r.stdout,
+          f"report on two runs: the loop adds tracking_loop and explains them ({r.returncode}: {r.stdout.strip()})")
+    text = page.read_text(encoding="utf-8") if page.exists() else ""
+    check("The pooled logs" in text and a.name in text and b.name in text,
+          "the page has the pooled section naming both runs")
 
     # 4. bad input
     r = run([model, "fit", a, n, "--effects", MODEL])

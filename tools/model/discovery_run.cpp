@@ -12,9 +12,16 @@ namespace resolver {
 
 DiscoveryRun run_discovery(const DiscoveryInput& input, std::vector<std::string> effects,
                            const DiscoveryOptions& options, int max_steps, const std::function<void(int)>& on_step) {
+  // Prepared once: every step fits the same rows.
+  return run_discovery(std::make_shared<const PreparedLog>(prepare_log(input, options.prepare)), std::move(effects),
+                       options, max_steps, on_step);
+}
+
+DiscoveryRun run_discovery(std::shared_ptr<const PreparedLog> prepared, std::vector<std::string> effects,
+                           const DiscoveryOptions& options, int max_steps, const std::function<void(int)>& on_step) {
   DiscoveryRun run;
   max_steps = std::max(1, max_steps);
-  run.log = std::make_shared<const PreparedLog>(prepare_log(input, options.prepare));  // once: every step fits the same rows
+  run.log = std::move(prepared);
   const PreparedLog& log = *run.log;
   for (int step = 0; step < max_steps; ++step) {
     if (on_step) on_step(step + 1);

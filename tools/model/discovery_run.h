@@ -35,6 +35,11 @@ struct DiscoveryRun {
                                          const DiscoveryOptions& options, int max_steps,
                                          const std::function<void(int)>& on_step = {});
 
+/// The same on rows already prepared (a pooled log, pool.h).
+[[nodiscard]] DiscoveryRun run_discovery(std::shared_ptr<const PreparedLog> log, std::vector<std::string> effects,
+                                         const DiscoveryOptions& options, int max_steps,
+                                         const std::function<void(int)>& on_step = {});
+
 /// One line for the terminal: verdict, steps, final model and its residual.
 [[nodiscard]] std::string summarize_discovery(const DiscoveryRun& run);
 

@@ -281,7 +281,7 @@ std::string candidates_table(const Explanation& ex, bool currents) {
 }  // namespace
 
 std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, std::string_view log_path,
-                              double explained_ratio) {
+                              double explained_ratio, const std::string& pooled_section) {
   const Explanation& first = run.steps.front();
   const Explanation& last = run.steps.back();
   const ModelFit& f = last.fit;
@@ -294,7 +294,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
   o += fmt::format(
       "<p class=\"meta\">log <code>{}</code> · {} samples from {} frames · p<sub>r</sub> = {}, p = {}{} · "
       "position error against {} · signals fitted: {}</p>\n",
-      escape(log_path), log.input.samples.size(), log.frames, log.input.p_r, log.input.p,
+      escape(log_path), run.log->samples_in, log.frames, run.log->p_r, run.log->p,
       log.bench_info ? " (BENCH_INFO)" : " (assumed)",
       f.reference ? "the reference encoder" : "the speed-smoothed ideal angle",
       escape(fmt::format("{}", fmt::join(signals, ", "))));
@@ -345,6 +345,7 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
        outliers_section(f) + whiteness_and_directions(f);
   o += "<h2 id=\"candidates\">Candidates</h2>\n" + candidates_table(last, f.currents_used);
 
+  o += pooled_section;
   std::vector<std::string> notes = log.notes;
   if (log.bad_lines > 0) notes.push_back(fmt::format("{} malformed log lines skipped", log.bad_lines));
   if (log.problems > 0) notes.push_back(fmt::format("{} input problems counted (by reason above: a gap is counted, not skipped)", log.problems));

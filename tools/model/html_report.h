@@ -19,9 +19,10 @@
 
 namespace resolver {
 
-/// The HTML page. `log_path` is shown as given; `explained_ratio` is the option the run used.
+/// The HTML page. `log_path` is shown as given; `explained_ratio` is the option the run used;
+/// `pooled_section` (HTML, may be empty) goes before the notes: a pooled run's logs.
 [[nodiscard]] std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, std::string_view log_path,
-                                            double explained_ratio);
+                                            double explained_ratio, const std::string& pooled_section = "");
 
 /// Writes `text` to `path` (replacing it). Throws std::system_error
 /// "cannot write <path>: <reason>".

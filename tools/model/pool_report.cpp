@@ -26,12 +26,11 @@ std::string json_param(const ModelParameter& p) {
 
 }  // namespace
 
-std::string format_pool_text(const PooledExplanation& p) {
-  const ModelFit& f = p.pooled.fit;
+std::string format_pool_text(const std::vector<std::string>& names, const ModelFit& f, const LogComparison& logs) {
   std::string o = fmt::format(
       "\npooled over {} logs: the parameters above are shared; each log has its own reference zero, envelope "
       "amplitude and operating point (nuisance.*[log]). Each log's residual in the pooled fit (x its pooled floor):\n",
-      p.names.size());
+      names.size());
   o += fmt::format("  {:<32} {:>9}  {:<20} {:<20} {}\n", "log", "rows", "position_error", "sin_cos", "i_dq");
   for (const PartResidual& r : f.parts) {
     o += fmt::format("  {:<32} {:>9}  {:<20} {:<20} {}\n", r.name, r.rows, against_floor(r.position_rms, f, "position_error"),
@@ -40,11 +39,11 @@ std::string format_pool_text(const PooledExplanation& p) {
   o += fmt::format("\neach log fitted alone against the other logs' own fits (z = difference / its standard error; "
                    "beyond {:g} the log disagrees):\n",
                    kPoolDisagreementZ);
-  for (std::size_t i = 0; i < p.names.size(); ++i) {
-    if (!p.alone_failed[i].empty()) o += fmt::format("  {}: its own fit failed: {}\n", p.names[i], p.alone_failed[i]);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (!logs.alone_failed[i].empty()) o += fmt::format("  {}: its own fit failed: {}\n", names[i], logs.alone_failed[i]);
   }
   int shown = 0;
-  for (const PoolDisagreement& d : p.comparisons) {
+  for (const PoolDisagreement& d : logs.comparisons) {
     const bool disagrees = std::abs(d.z) > kPoolDisagreementZ;
     if (!disagrees && shown >= 3) break;  // the agreeing ones: the closest calls only
     // The relative change beside z: a real but tiny change (0.1 %) reads apart from a large one.
@@ -54,37 +53,36 @@ std::string format_pool_text(const PooledExplanation& p) {
                      disagrees ? "  DISAGREES" : "");
     ++shown;
   }
-  const auto beyond = std::count_if(p.comparisons.begin(), p.comparisons.end(),
+  const auto beyond = std::count_if(logs.comparisons.begin(), logs.comparisons.end(),
                                     [](const PoolDisagreement& d) { return std::abs(d.z) > kPoolDisagreementZ; });
   o += beyond == 0 ? fmt::format("  every log agrees with the others ({} comparisons within {:g} standard errors)\n",
-                                 p.comparisons.size(), kPoolDisagreementZ)
-                   : fmt::format("  {} of {} comparisons disagree\n", beyond, p.comparisons.size());
+                                 logs.comparisons.size(), kPoolDisagreementZ)
+                   : fmt::format("  {} of {} comparisons disagree\n", beyond, logs.comparisons.size());
   return o;
 }
 
-std::string format_pool_json(const PooledExplanation& p) {
-  const ModelFit& f = p.pooled.fit;
-  std::string logs;
-  for (std::size_t i = 0; i < p.names.size(); ++i) {
-    const PartResidual none{p.names[i], 0, std::nan(""), std::nan(""), std::nan("")};
+std::string format_pool_json(const std::vector<std::string>& names, const ModelFit& f, const LogComparison& logs) {
+  std::string per_log;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const PartResidual none{names[i], 0, std::nan(""), std::nan(""), std::nan("")};
     const PartResidual* r = i < f.parts.size() ? &f.parts[i] : &none;
     std::string alone, nuisance;
-    for (const ModelParameter& q : p.alone[i].params) alone += (alone.empty() ? "" : ",") + json_param(q);
+    for (const ModelParameter& q : logs.alone[i].params) alone += (alone.empty() ? "" : ",") + json_param(q);
     // This log's own constants ("nuisance.rd_constant[LOG]": its reference's zero ...), by their plain names.
-    const std::string suffix = "[" + p.names[i] + "]";
+    const std::string suffix = "[" + names[i] + "]";
     for (const ModelParameter& q : f.nuisance) {
       if (!q.name.ends_with(suffix)) continue;
       nuisance += fmt::format("{}{}:{}", nuisance.empty() ? "" : ",", json::str(q.name.substr(0, q.name.size() - suffix.size())),
                               json::num(q.value));
     }
-    logs += fmt::format("{}{{\"log\":{},\"rows\":{},\"position_rms_rad\":{},\"sincos_rms\":{},\"dq_rms_a\":{},"
+    per_log += fmt::format("{}{{\"log\":{},\"rows\":{},\"position_rms_rad\":{},\"sincos_rms\":{},\"dq_rms_a\":{},"
                         "\"nuisance\":{{{}}},\"alone\":{{\"params\":[{}],\"error\":{}}}}}",
-                        i ? "," : "", json::str(p.names[i]), r->rows, json::num(r->position_rms),
+                        i ? "," : "", json::str(names[i]), r->rows, json::num(r->position_rms),
                         json::num(r->sincos_rms), json::num(r->dq_rms), nuisance, alone,
-                        p.alone_failed[i].empty() ? "null" : json::str(p.alone_failed[i]));
+                        logs.alone_failed[i].empty() ? "null" : json::str(logs.alone_failed[i]));
   }
   std::string cmp;
-  for (const PoolDisagreement& d : p.comparisons) {
+  for (const PoolDisagreement& d : logs.comparisons) {
     cmp += fmt::format("{}{{\"log\":{},\"parameter\":{},\"value\":{},\"stderr\":{},\"others\":{},\"others_stderr\":{},"
                        "\"pooled\":{},\"z\":{},\"disagrees\":{}}}",
                        cmp.empty() ? "" : ",", json::str(d.log), json::str(d.parameter), json::num(d.value),
@@ -93,7 +91,7 @@ std::string format_pool_json(const PooledExplanation& p) {
                        std::abs(d.z) > kPoolDisagreementZ ? "true" : "false");
   }
   return fmt::format(",\"pool\":{{\"z_limit\":{},\"logs\":[{}],\"comparisons\":[{}]}}", json::num(kPoolDisagreementZ),
-                     logs, cmp);
+                     per_log, cmp);
 }
 
 }  // namespace resolver

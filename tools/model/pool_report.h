@@ -5,13 +5,17 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "daemon/core/discovery/pool.h"
 
 namespace resolver {
 
-[[nodiscard]] std::string format_pool_text(const PooledExplanation& p);
+/// `names`: the logs in pool order; `fit`: the pooled fit (its parts); `logs`: each log's own fit.
+[[nodiscard]] std::string format_pool_text(const std::vector<std::string>& names, const ModelFit& fit,
+                                           const LogComparison& logs);
 /// The "pool" member: `,"pool":{...}` (to end a fit's JSON object with).
-[[nodiscard]] std::string format_pool_json(const PooledExplanation& p);
+[[nodiscard]] std::string format_pool_json(const std::vector<std::string>& names, const ModelFit& fit,
+                                           const LogComparison& logs);
 
 }  // namespace resolver

@@ -17,6 +17,8 @@ struct PooledRun {
   DiscoveryOptions options;  ///< the untrusted inputs of every log are added, named by log
   bool explain = false;
   bool json = false;
+  std::string html_out;  ///< report: the page to write (then the discovery loop runs, at most max_steps)
+  int max_steps = 6;
   int jobs = 1;  ///< logs read at once (each read is one thread)
   /// Reads one log (a progress bar only when `quiet` is false: one log at a time).
   std::function<LogSamples(const std::string& log, bool quiet)> read;
@@ -25,7 +27,8 @@ struct PooledRun {
   std::function<std::vector<std::string>(const LogSamples&)> notes;
 };
 
-/// Reads, pools and fits; prints the text or JSON report to stdout; returns 0.
+/// Reads, pools and fits (or with html_out runs the discovery loop and writes the page);
+/// prints the text or JSON report (or the page's summary line) to stdout; returns 0.
 /// A log that cannot be read throws its reader's error; one the fit refuses, or
 /// logs that cannot be pooled, an InputError (data) naming the log.
 int run_pooled(const PooledRun& run);

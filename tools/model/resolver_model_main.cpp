@@ -359,7 +359,11 @@ void add_discovery_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
   CLI::App* report = subs.report = app.add_subcommand(
       "report", "run the discovery loop (explain, add the best candidate, repeat) and write an HTML page with plots");
   report->footer(sub_footer(kReportExamples));
-  report->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
+  report->add_option("LOG", a.logs,
+                     "log: candump -l, Vector ASC or CSV (default bench layout unless --config); two or more logs "
+                     "of one bench: the loop runs on them pooled (as fit A.log B.log)")
+      ->required();
+  report->add_option("--jobs", a.jobs, "pooled: read this many logs at once (default 1)")->check(CLI::Range(1, 256));
   report->add_option("--effects", a.effects_args, "starting model, as for explain (default amplitude_imbalance)");
   report->add_option("--html", a.html_out, "HTML file to write (self-contained: inline CSS and SVG)")->required();
   report->add_option("--max-steps", a.max_steps, "at most this many explain passes (default 6)")->check(CLI::Range(1, 20));
@@ -544,6 +548,10 @@ int run_on_logs(const Arguments& a, const Model& model, const resolver::Progress
   run.explain = a.command == Command::kExplain;
   run.json = a.json;
   run.jobs = a.jobs;
+  if (a.command == Command::kReport) {
+    run.html_out = a.html_out;
+    run.max_steps = a.max_steps;
+  }
   run.read = [&](const std::string& log, bool quiet) {
     Arguments one = a;
     one.log = log;

@@ -259,39 +259,60 @@ std::vector<PoolDisagreement> compare_with_pool(const ModelFit& pooled, const st
   return out;
 }
 
-PooledExplanation explain_pooled(const std::vector<const DiscoveryInput*>& inputs, const std::vector<std::string>& names,
-                                 std::span<const std::string> effects, const DiscoveryOptions& options, bool explain) {
-  PooledExplanation out;
-  out.names = names;
-  std::vector<PreparedLog> logs;
-  DiscoveryOptions alone_options = options;
-  alone_options.progress = nullptr;
+PooledLogs prepare_pooled(const std::vector<const DiscoveryInput*>& inputs, const std::vector<std::string>& names,
+                          const PrepareOptions& options) {
+  PooledLogs out;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     try {
-      logs.push_back(prepare_log(*inputs[i], options.prepare));
+      out.logs.push_back(prepare_log(*inputs[i], options));
     } catch (const std::invalid_argument& e) {
       throw std::invalid_argument(names[i] + ": " + e.what());
     }
+  }
+  out.pool = pool_logs(out.logs, names);
+  return out;
+}
+
+LogComparison compare_logs(const PooledLogs& pooled, const std::vector<std::string>& names, const ModelFit& fit,
+                           std::span<const std::string> effects, const DiscoveryOptions& options) {
+  LogComparison out;
+  DiscoveryOptions alone_options = options;
+  alone_options.progress = nullptr;
+  for (const PreparedLog& log : pooled.logs) {
     try {
-      out.alone.push_back(fit_prepared(logs.back(), effects, alone_options));
+      out.alone.push_back(fit_prepared(log, effects, alone_options));
       out.alone_failed.emplace_back();
     } catch (const std::invalid_argument& e) {
       out.alone.emplace_back();
       out.alone_failed.emplace_back(e.what());
     }
   }
-  const PreparedLog pool = pool_logs(std::move(logs), names);
-  if (explain) out.pooled = explain_prepared(pool, effects, options);
-  else out.pooled.fit = fit_prepared(pool, effects, options);
-  out.comparisons = compare_with_pool(out.pooled.fit, out.alone, names);
-  for (const PoolDisagreement& d : out.comparisons) {
-    if (std::abs(d.z) <= kPoolDisagreementZ) break;
-    out.pooled.fit.notes.push_back(fmt::format(
+  out.comparisons = compare_with_pool(fit, out.alone, names);
+  return out;
+}
+
+std::vector<std::string> disagreement_notes(const std::vector<PoolDisagreement>& comparisons) {
+  std::vector<std::string> out;
+  for (const PoolDisagreement& d : comparisons) {
+    if (std::abs(d.z) <= kPoolDisagreementZ) break;  // largest |z| first
+    out.push_back(fmt::format(
         "{} disagrees with the other logs on {}: {:.6g} +- {:.2g} fitted alone against their {:.6g} +- {:.2g} "
         "(z = {:.1f}): a parameter that changed between runs, a log of another sensor, or an effect the model "
         "lacks that differs between the logs (speed, direction, load)",
         d.log, d.parameter, d.value, d.std_error, d.others, d.others_std_error, d.z));
   }
+  return out;
+}
+
+PooledExplanation explain_pooled(const std::vector<const DiscoveryInput*>& inputs, const std::vector<std::string>& names,
+                                 std::span<const std::string> effects, const DiscoveryOptions& options, bool explain) {
+  PooledExplanation out;
+  out.names = names;
+  const PooledLogs pooled = prepare_pooled(inputs, names, options.prepare);
+  if (explain) out.pooled = explain_prepared(pooled.pool, effects, options);
+  else out.pooled.fit = fit_prepared(pooled.pool, effects, options);
+  out.logs = compare_logs(pooled, names, out.pooled.fit, effects, options);
+  for (std::string& n : disagreement_notes(out.logs.comparisons)) out.pooled.fit.notes.push_back(std::move(n));
   return out;
 }
 

@@ -49,18 +49,42 @@ inline constexpr double kPoolDisagreementZ = 4.0;
 [[nodiscard]] std::vector<PoolDisagreement> compare_with_pool(const ModelFit& pooled, const std::vector<ModelFit>& alone,
                                                               const std::vector<std::string>& names);
 
-/// A pooled fit or explanation with each log's own fit beside it.
-struct PooledExplanation {
-  Explanation pooled;                        ///< on every log (fit.parts: each log's residual)
-  std::vector<std::string> names;            ///< the logs, in pool order
-  std::vector<ModelFit> alone;               ///< each log fitted alone (same model)
-  std::vector<std::string> alone_failed;     ///< per log: why its own fit failed ("" = it did not)
-  std::vector<PoolDisagreement> comparisons; ///< compare_with_pool, largest |z| first
+/// Logs prepared alone and their pool (pool_logs of copies: each log's own fit needs its rows).
+struct PooledLogs {
+  std::vector<PreparedLog> logs;
+  PreparedLog pool;
 };
 
-/// Prepares each input alone (options.prepare), fits each alone, pools them and fits
-/// (explain: and explains) the pool. Throws std::invalid_argument naming the log
-/// when one cannot be prepared or the logs cannot be pooled (pool_logs).
+/// Prepares each input alone (options.prepare) and pools them. Throws
+/// std::invalid_argument naming the log when one cannot be prepared or the logs
+/// cannot be pooled (pool_logs).
+[[nodiscard]] PooledLogs prepare_pooled(const std::vector<const DiscoveryInput*>& inputs,
+                                        const std::vector<std::string>& names, const PrepareOptions& options);
+
+/// Each log fitted alone with `effects`, compared with the others (compare_with_pool).
+struct LogComparison {
+  std::vector<ModelFit> alone;               ///< each log fitted alone (same model)
+  std::vector<std::string> alone_failed;     ///< per log: why its own fit failed ("" = it did not)
+  std::vector<PoolDisagreement> comparisons; ///< largest |z| first
+};
+
+/// Fits every log of `pooled` alone with `effects` and compares them with each other
+/// (and `fit`, the pooled fit of the same effects, for its values).
+[[nodiscard]] LogComparison compare_logs(const PooledLogs& pooled, const std::vector<std::string>& names,
+                                         const ModelFit& fit, std::span<const std::string> effects,
+                                         const DiscoveryOptions& options);
+
+/// The notes that name each disagreeing log (into a fit's notes).
+[[nodiscard]] std::vector<std::string> disagreement_notes(const std::vector<PoolDisagreement>& comparisons);
+
+/// A pooled fit or explanation with each log's own fit beside it.
+struct PooledExplanation {
+  Explanation pooled;        ///< on every log (fit.parts: each log's residual; notes name disagreeing logs)
+  std::vector<std::string> names;  ///< the logs, in pool order
+  LogComparison logs;
+};
+
+/// prepare_pooled, the pooled fit (explain: and its explanation), compare_logs.
 [[nodiscard]] PooledExplanation explain_pooled(const std::vector<const DiscoveryInput*>& inputs,
                                                const std::vector<std::string>& names,
                                                std::span<const std::string> effects, const DiscoveryOptions& options,
