@@ -57,7 +57,7 @@ TEST(EffectsSamplingSkew, ConstantSpeedIsExactlyQuadratureWithBetaOmegaTau) {
       ASSERT_NEAR(s.c, q.c, 1e-12);
       const double eps = wrap_pi(theta - static_rd_angle(s));
       const double sig = sampling_skew_error(skew, theta, omega);
-      EXPECT_DOUBLE_EQ(sig, quadrature_error({beta}, theta));
+      EXPECT_DOUBLE_EQ(sig, quadrature_error({{"beta", beta}}, theta));
       max_residual = std::max(max_residual, std::abs(eps - sig));
       max_signature = std::max(max_signature, std::abs(sig));
     }

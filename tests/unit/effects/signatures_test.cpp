@@ -76,15 +76,15 @@ TEST(EffectsSignatures, QuadratureSignMatchesExactModel) {
   const ForwardChain chain = forward_chain({{"quadrature", "beta", beta}});
   const double theta = 0.5 * std::numbers::pi;
   EXPECT_NEAR(exact_error(chain, theta), -std::atan(std::sin(beta)), 1e-15);
-  EXPECT_NEAR(quadrature_error({beta}, theta), -beta, 1e-15);
+  EXPECT_NEAR(quadrature_error({{"beta", beta}}, theta), -beta, 1e-15);
   // atan(sin beta) = beta - beta^3/2 + ...: the signature is right to third order here.
-  EXPECT_NEAR(exact_error(chain, theta), quadrature_error({beta}, theta), beta * beta * beta);
+  EXPECT_NEAR(exact_error(chain, theta), quadrature_error({{"beta", beta}}, theta), beta * beta * beta);
 }
 
 TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
   for (const double beta : {-0.03, -0.004, 0.004, 0.01, 0.03}) {
     const ForwardChain chain = forward_chain({{"quadrature", "beta", beta}});
-    const Residual r = residual(chain, [&](double theta) { return quadrature_error({beta}, theta); });
+    const Residual r = residual(chain, [&](double theta) { return quadrature_error({{"beta", beta}}, theta); });
     // phi(beta) = atan2(sin theta, cos(theta + beta)); d phi/d beta = N/D with
     // N = sin theta sin(theta+beta), D = sin^2 theta + cos^2(theta+beta) = 1 - sin(2theta+beta) sin beta.
     // |N|, |N'|, |D'| <= 1, 1-|beta| <= D <= 1+|beta|, so |phi''| <= (2+|beta|)/(1-|beta|)^2 and the
@@ -213,7 +213,7 @@ TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {
   // The first-order error of the composed chain is the sum of the individual
   // effects' signatures (what the deleted small_signal_error summed).
   const auto first_order = [&](double theta) {
-    return amplitude_imbalance_error({0.003}, theta) + quadrature_error({0.002}, theta) +
+    return amplitude_imbalance_error({0.003}, theta) + quadrature_error({{"beta", 0.002}}, theta) +
            offsets_error({0.001, -0.0015}, theta) + harmonics_error(h, theta);
   };
   const Residual r = residual(chain, first_order);
