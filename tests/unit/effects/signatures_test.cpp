@@ -52,7 +52,8 @@ TEST(EffectsSignatures, IdealChainHasNoError) {
 TEST(EffectsSignatures, AmplitudeImbalanceMatchesHanselmanEq5) {
   for (const double alpha : {-0.05, -0.01, 0.003, 0.01, 0.05}) {
     const ForwardChain chain = forward_chain({{"amplitude_imbalance", "alpha", alpha}});
-    const Residual r = residual(chain, [&](double theta) { return amplitude_imbalance_error({alpha}, theta); });
+    const Residual r =
+        residual(chain, [&](double theta) { return amplitude_imbalance_error({{"alpha", alpha}}, theta); });
     // Exact: tan(phi) = tan(theta)/(1+alpha) gives
     //   eps = -sum_k q^k/k sin(2k theta), q = -alpha/(2+alpha),
     // so eps - (alpha/2) sin 2theta is bounded by the change of the first term,
@@ -102,7 +103,8 @@ TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
     const double o_s = offsets.first;  // (locals, not a structured binding: the lambda captures them)
     const double o_c = offsets.second;
     const ForwardChain chain = forward_chain({{"offsets", "o_s", o_s}, {"offsets", "o_c", o_c}});
-    const Residual r = residual(chain, [&](double theta) { return offsets_error({o_s, o_c}, theta); });
+    const Residual r =
+        residual(chain, [&](double theta) { return offsets_error({{"o_s", o_s}, {"o_c", o_c}}, theta); });
     const double bound = atan2_second_order_bound(std::hypot(o_s, o_c));
     EXPECT_LE(r.max_residual, bound) << o_s << "," << o_c;
     EXPECT_LT(bound, 0.05 * r.max_signature);
@@ -150,7 +152,7 @@ TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
   k3.k[3] = -0.002;
   for (int i = 0; i < 64; ++i) {
     const double theta = kTwoPi * i / 64.0;
-    EXPECT_NEAR(amplitude_imbalance_error({0.004}, theta), harmonics_error(k3, theta), 1e-15);
+    EXPECT_NEAR(amplitude_imbalance_error({{"alpha", 0.004}}, theta), harmonics_error(k3, theta), 1e-15);
   }
   // ...but the envelopes differ at first order: the effects are told apart there.
   const SinCos a = forward_chain({{"amplitude_imbalance", "alpha", 0.004}}).envelopes(0.3);
@@ -213,8 +215,8 @@ TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {
   // The first-order error of the composed chain is the sum of the individual
   // effects' signatures (what the deleted small_signal_error summed).
   const auto first_order = [&](double theta) {
-    return amplitude_imbalance_error({0.003}, theta) + quadrature_error({{"beta", 0.002}}, theta) +
-           offsets_error({0.001, -0.0015}, theta) + harmonics_error(h, theta);
+    return amplitude_imbalance_error({{"alpha", 0.003}}, theta) + quadrature_error({{"beta", 0.002}}, theta) +
+           offsets_error({{"o_s", 0.001}, {"o_c", -0.0015}}, theta) + harmonics_error(h, theta);
   };
   const Residual r = residual(chain, first_order);
   // Perturbation of the envelopes from the unit circle: d = d_lin + d_2 with
