@@ -198,15 +198,15 @@ TEST(SimEffects, CurrentEffectsRippleAtTheirOrders) {
     const ChainValues& v = c.chain;
     DqCurrents want{};
     if (k.order == 1) {
-      const CurrentOffsets off{v.get("current_offsets", "off_a"), v.get("current_offsets", "off_b")};
+      const CurrentOffsetsParams off(v.of(current_offsets_effect()));
       want = {current_offsets_ripple_1x(off), current_offsets_ripple_1x(off)};
     }
     if (k.order == 2) {
-      const CurrentGainMismatch g{v.get("current_gain_mismatch", "gain_a"), v.get("current_gain_mismatch", "gain_b")};
+      const CurrentGainMismatchParams g(v.of(current_gain_mismatch_effect()));
       const double a = current_gain_mismatch_ripple_2x(g, c.i_d_cmd, c.i_q_cmd);
       want = {a, a};
     }
-    if (k.order == 6) want = dead_time_ripple_6x(DeadTime{v.get("dead_time", "t_d")}, c.i_d_cmd, c.i_q_cmd);
+    if (k.order == 6) want = dead_time_ripple_6x(DeadTimeParams(v.of(dead_time_effect())), c.i_d_cmd, c.i_q_cmd);
     for (int h = 1; h < 8; ++h) {
       const auto i = static_cast<std::size_t>(h);
       const DqCurrents expect = h == k.order ? want : DqCurrents{};
