@@ -48,8 +48,9 @@ inline constexpr double kDeadTimeReferenceTime = 100e-6;
 /// The effect's parameters, listed once (param_set.h).
 inline constexpr std::array kDeadTimeParams{
     // 20 us is already an extreme dead time; it gives k_dt = 0.2 (dead_time.h).
-    ParamInfo{.name = "t_d", .unit = "[s]", .description = "inverter dead time (5th/7th current harmonics k_dt = t_d / 100 us)",
-              .min = 0.0, .max = 2e-5},
+    ParamInfo{.name = "t_d", .unit = "[s]",
+              .description = "inverter dead time (5th/7th current harmonics k_dt = t_d / 100 us)", .min = 0.0,
+              .max = 2e-5},
 };
 using DeadTimeParams = ParamSet<kDeadTimeParams>;
 

@@ -100,7 +100,7 @@ TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
     double peak = 0.0;
     for (const SimSample& s : run(c)) {
       const double eps_sc = wrap_pi(s.theta - std::atan2(s.sin_counts, s.cos_counts));
-      ASSERT_NEAR(eps_sc, sampling_skew_error({tau}, s.theta, omega), tol) << s.index;
+      ASSERT_NEAR(eps_sc, sampling_skew_error({{"tau", tau}}, s.theta, omega), tol) << s.index;
       // The R/D converter does not see the skew: half a 16-bit LSB.
       ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), 0.0, 0.5 * quantization_lsb(16) + 1e-12) << s.index;
       peak = std::max(peak, std::abs(eps_sc));
@@ -138,7 +138,7 @@ TEST(SimEffects, EnvelopeDriftScalesBothChannelsInTimeAndNoAngle) {
 TEST(SimEffects, EccentricityIsOneTimesMechanicalInBothAngles) {
   SimConfig c = quiet(200.0, 0.6);  // two mechanical turns
   c.chain.apply_spec("eccentricity:e=1e-3,phase=0.4");
-  const Eccentricity ecc{1e-3, 0.4};
+  const EccentricityParams ecc(c.chain.of(eccentricity_effect()));
   double peak = 0.0;
   for (const SimSample& s : run(c)) {
     const double expected = c.p_r * eccentricity_error(ecc, s.theta_m);
@@ -167,7 +167,7 @@ TEST(SimEffects, MountingOffsetGivesSteadyIdInTheReferenceFrameOnly) {
     // Drive frame: rounding plus |I| times half a 16-bit LSB of angle.
     const DqCurrents drive = sample_dq(s, s.rd_angle);
     ASSERT_NEAR(drive.d, 0.0, kDqRound + c.i_q_cmd * 0.5 * quantization_lsb(16)) << s.index;
-    ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), mounting_offset_error({0.2}, c.p_r, c.p),
+    ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), mounting_offset_error({{"theta_0", 0.2}}, c.p_r, c.p),
                 0.5 * quantization_lsb(16) + 1e-9);
   }
 }
