@@ -171,11 +171,12 @@ TEST(EffectsSignatures, EnvelopeDriftScalesTheRadiusAndNoAngle) {
         const double theta = kTwoPi * (i + 0.37) / 360.0;
         const SinCos sc = chain.envelopes(theta, t);
         ASSERT_NEAR(wrap_pi(theta - std::atan2(sc.s, sc.c)), 0.0, 1e-15) << "g=" << g << " t=" << t;
-        ASSERT_NEAR(std::hypot(sc.s, sc.c) - 1.0, envelope_drift_radius({g}, t), 1e-15) << "g=" << g << " t=" << t;
+        ASSERT_NEAR(std::hypot(sc.s, sc.c) - 1.0, envelope_drift_radius({{"g", g}}, t), 1e-15)
+            << "g=" << g << " t=" << t;
       }
     }
     // The radius moves by g t: at t = 3 s that is 3|g|, far above the rounding bound above.
-    EXPECT_NEAR(envelope_drift_radius({g}, 3.0), 3.0 * g, 1e-18);
+    EXPECT_NEAR(envelope_drift_radius({{"g", g}}, 3.0), 3.0 * g, 1e-18);
   }
   // Common to both channels: with an imbalance the angle error is the imbalance's alone
   // at every time (the drift scales s and (1 + alpha) c alike), and the gain multiplies
