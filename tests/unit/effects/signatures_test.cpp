@@ -115,11 +115,7 @@ TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
 TEST(EffectsSignatures, HarmonicsMatchHanselmanEq9) {
   const ForwardChain chain = forward_chain(
       {{"harmonics", "k0", 0.002}, {"harmonics", "k2", -0.001}, {"harmonics", "k3", 0.0015}, {"harmonics", "k7", 0.0005}});
-  Harmonics h;
-  h.k0 = 0.002;
-  h.k[2] = -0.001;
-  h.k[3] = 0.0015;
-  h.k[7] = 0.0005;
+  const HarmonicsParams h{{"k0", 0.002}, {"k2", -0.001}, {"k3", 0.0015}, {"k7", 0.0005}};
   const Residual r = residual(chain, [&](double theta) { return harmonics_error(h, theta); });
   // The harmonic part is an additive perturbation of length <= sqrt2 (|K_0| + sum |K_n|);
   // Hanselman eq. 9 is exactly its first-order atan2 term.
@@ -135,8 +131,8 @@ TEST(EffectsSignatures, OppositeSequenceHarmonicsLandOnNPlusOne) {
   for (const auto& [name, order] : {std::pair{"k3_opp", 3}, std::pair{"k2_opp", 2}}) {
     const double k = 0.002;
     const ForwardChain chain = forward_chain({{"harmonics", name, k}});
-    Harmonics h;
-    h.k_opp[static_cast<std::size_t>(order)] = k;
+    HarmonicsParams h;
+    h[harmonic_keys(order).opp] = k;
     const Residual r = residual(chain, [&](double theta) { return harmonics_error(h, theta); });
     EXPECT_LE(r.max_residual, atan2_second_order_bound(std::numbers::sqrt2 * k)) << name;
     // The grid's largest |sin((n + 1) theta)| is at least cos((n + 1) pi / kGrid): within 1e-5 relative.
@@ -148,8 +144,7 @@ TEST(EffectsSignatures, OppositeSequenceHarmonicsLandOnNPlusOne) {
 
 TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
   // Hanselman eq. 8-9: K_3 and alpha both give a 2theta error; K_3 = -alpha/2 mimics alpha to first order.
-  Harmonics k3;
-  k3.k[3] = -0.002;
+  const HarmonicsParams k3{{"k3", -0.002}};
   for (int i = 0; i < 64; ++i) {
     const double theta = kTwoPi * i / 64.0;
     EXPECT_NEAR(amplitude_imbalance_error({{"alpha", 0.004}}, theta), harmonics_error(k3, theta), 1e-15);
@@ -210,9 +205,7 @@ TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {
                                             {"offsets", "o_c", -0.0015},
                                             {"harmonics", "k0", 0.0005},
                                             {"harmonics", "k3", 0.0008}});
-  Harmonics h;
-  h.k0 = 0.0005;
-  h.k[3] = 0.0008;
+  const HarmonicsParams h{{"k0", 0.0005}, {"k3", 0.0008}};
   // The first-order error of the composed chain is the sum of the individual
   // effects' signatures (what the deleted small_signal_error summed).
   const auto first_order = [&](double theta) {
