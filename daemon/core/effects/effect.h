@@ -8,6 +8,11 @@
 //
 //   Effect (this file) ── one subclass per physical effect, one file pair each in
 //   │                     daemon/core/effects/, one line in registry.cpp
+//   ├─ parameters:        one constexpr ParamInfo list per effect (param_info.h): name,
+//   │                     unit, description, range, neutral value, written once. The
+//   │                     hooks, the effect's forward functions, the simulator and the
+//   │                     tests read and write values by name through the type
+//   │                     generated from that list, ParamSet<list> (param_set.h)
 //   ├─ forward hooks:     the simulator's chain calls them at the stage where the
 //   │                     effect acts (forward_chain.h):
 //   │                       motion      what the resolver sees of the true angle (delay, eccentricity, backlash)
