@@ -33,10 +33,13 @@ void require(bool ok, const std::string& message) {
   if (!ok) throw std::invalid_argument(message);
 }
 
+/// rd_bits' range and default: the quantization effect's list (quantization.h), the one place they are written.
+constexpr const ParamInfo& kRdBits = QuantizationParams::info("rd_bits");
+
 /// Makes rd_bits and the chain's quantization.rd_bits one value (see SimConfig::rd_bits).
 void reconcile_rd_bits(SimConfig& c) {
   const int from_chain = static_cast<int>(c.chain.get("quantization", "rd_bits"));
-  const int dflt = Quantization::kMaxBits;
+  const int dflt = static_cast<int>(kRdBits.neutral);
   if (from_chain != dflt && c.rd_bits != dflt && from_chain != c.rd_bits) {
     throw std::invalid_argument(fmt::format(
         "SimConfig: rd_bits = {} but chain quantization.rd_bits = {}; they are the same R/D resolution, set one "
@@ -45,15 +48,16 @@ void reconcile_rd_bits(SimConfig& c) {
   }
   const int bits = from_chain != dflt ? from_chain : c.rd_bits;
   c.rd_bits = bits;
-  if (bits >= Quantization::kMinBits && bits <= Quantization::kMaxBits) c.chain.set("quantization", "rd_bits", bits);
+  if (bits >= kRdBits.min && bits <= kRdBits.max) c.chain.set("quantization", "rd_bits", bits);
 }
 
 SimConfig validated(SimConfig c) {
   require(c.p_r >= 1 && c.p_r <= 255, fmt::format("SimConfig p_r (--p-r) = {}: resolver pole pairs must be 1..255 (u8 in BENCH_INFO)", c.p_r));
   require(c.p >= 1 && c.p <= 255, fmt::format("SimConfig p (--p) = {}: motor pole pairs must be 1..255 (u8 in BENCH_INFO)", c.p));
   reconcile_rd_bits(c);
-  require(c.rd_bits >= Quantization::kMinBits && c.rd_bits <= Quantization::kMaxBits,
-          fmt::format("SimConfig rd_bits (--rd-bits) = {}: R/D resolution must be 1..16 bits (u16 rd_angle field)", c.rd_bits));
+  require(c.rd_bits >= kRdBits.min && c.rd_bits <= kRdBits.max,
+          fmt::format("SimConfig rd_bits (--rd-bits) = {}: R/D resolution must be {}..{} bits (u16 rd_angle field)",
+                      c.rd_bits, kRdBits.min, kRdBits.max));
   require(c.sample_rate_hz >= 1.0 && c.sample_rate_hz <= 65535.0 && c.sample_rate_hz == std::round(c.sample_rate_hz),
           fmt::format("SimConfig sample_rate_hz (--sample-rate) = {}: must be a whole number of Hz in 1..65535 (u16 in BENCH_INFO)",
                       c.sample_rate_hz));

@@ -32,6 +32,7 @@
 #include "daemon/core/effects/chain_values.h"
 #include "daemon/core/effects/forward_chain.h"
 #include "daemon/core/effects/noise.h"
+#include "daemon/core/effects/quantization.h"
 #include "daemon/core/effects/tracking_loop.h"
 #include "drivers/can_frame.h"
 #include "tools/sim/speed_profile.h"
@@ -57,8 +58,8 @@ struct SimConfig {
   int p_r = 3;  ///< resolver pole pairs (Hwang: 6-pole resolver)
   int p = 3;    ///< motor pole pairs (Hwang: 6-pole PMSM)
   /// [bits] R/D resolution. Same quantity as chain.quantization.rd_bits: set either;
-  /// both non-default and different is an error.
-  int rd_bits = 16;
+  /// both non-default and different is an error. Default: the effect's neutral value.
+  int rd_bits = static_cast<int>(QuantizationParams::info("rd_bits").neutral);
   /// [Hz] control-sample rate: 3 frames per sample must fit a 1 Mbit/s bus
   /// (~8000 classic 8-byte frames/s), so 2 kHz (6000 frames/s) by default.
   double sample_rate_hz = 2000;

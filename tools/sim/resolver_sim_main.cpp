@@ -15,6 +15,7 @@
 
 #include "daemon/app/exit_codes.h"
 #include "daemon/core/effects/chain_values.h"
+#include "daemon/core/effects/quantization.h"
 #include "drivers/candump/candump_writer.h"
 #include "tools/sim/bench_simulator.h"
 #include "tools/sim/sim_truth.h"
@@ -49,6 +50,9 @@ Options can also come from --config FILE.toml (keys = long option names with '_'
 for '-', effects = ["spec", ...]); options on the command line win.
 )";
 
+/// --rd-bits' range and default: the quantization effect's list, the one place they are written.
+constexpr const resolver::ParamInfo& kRdBits = resolver::QuantizationParams::info("rd_bits");
+
 struct Options {
   std::string out;
   std::string truth;
@@ -58,7 +62,7 @@ struct Options {
   double duration = 5.0;
   int p_r = 3;
   int p = 3;
-  int rd_bits = 16;
+  int rd_bits = static_cast<int>(kRdBits.neutral);
   double sample_rate = 2000.0;
   double amplitude = 26000.0;
   double iq = 10.0;
@@ -202,7 +206,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
   }
   // --effect quantization:rd_bits=N and --rd-bits N are one setting.
   if (const int bits = static_cast<int>(c.chain.get("quantization", "rd_bits"));
-      app.get_option("--rd-bits")->count() == 0 && bits != 16) {
+      app.get_option("--rd-bits")->count() == 0 && bits != static_cast<int>(kRdBits.neutral)) {
     c.rd_bits = bits;
   }
   return c;
@@ -216,7 +220,8 @@ void add_options(CLI::App& app, Options& o) {
       ->excludes("--rpm");
   app.add_option("--p-r", o.p_r, "resolver pole pairs (default 3)")->check(CLI::Range(1, 255));
   app.add_option("--p", o.p, "motor pole pairs (default 3)")->check(CLI::Range(1, 255));
-  app.add_option("--rd-bits", o.rd_bits, "R/D converter resolution [bits] (default 16)")->check(CLI::Range(1, 16));
+  app.add_option("--rd-bits", o.rd_bits, fmt::format("R/D converter resolution [bits] (default {})", kRdBits.neutral))
+      ->check(CLI::Range(static_cast<int>(kRdBits.min), static_cast<int>(kRdBits.max)));
   app.add_option("--sample-rate", o.sample_rate, "control samples per second [Hz] (default 2000)")
       ->check(CLI::Range(1.0, 65535.0));
   app.add_option("--amplitude", o.amplitude, "sin/cos envelope amplitude [ADC counts] (default 26000)");

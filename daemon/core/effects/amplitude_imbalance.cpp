@@ -9,12 +9,12 @@
 
 namespace resolver {
 
-SinCos apply_amplitude_imbalance(const AmplitudeImbalance& p, const SinCos& in) {
-  return {in.s, (1.0 + p.alpha) * in.c};
+SinCos apply_amplitude_imbalance(const AmplitudeImbalanceParams& p, const SinCos& in) {
+  return {in.s, (1.0 + p["alpha"]) * in.c};
 }
 
-double amplitude_imbalance_error(const AmplitudeImbalance& p, double theta) {
-  return 0.5 * p.alpha * std::sin(2.0 * theta);
+double amplitude_imbalance_error(const AmplitudeImbalanceParams& p, double theta) {
+  return 0.5 * p["alpha"] * std::sin(2.0 * theta);
 }
 
 }  // namespace resolver
@@ -23,12 +23,6 @@ double amplitude_imbalance_error(const AmplitudeImbalance& p, double theta) {
 
 namespace resolver {
 namespace {
-
-constexpr std::array kParams{
-    ParamInfo{.name = "alpha", .unit = "[1]", .description = "relative gain error of the cos channel", .min = -0.5,
-              .max = 0.5},
-};
-constexpr std::size_t kAlpha = param_index(kParams, "alpha");
 
 /// The R/D angle's error for a gain (1 + alpha) on the cos channel is exactly
 ///   eps = -sum_n (-r)^n / n sin(2 n theta),  r = alpha / (2 + alpha)
@@ -44,15 +38,17 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
                      "Hanselman eq. 4-5, Hwang eq. 6, 10, 15-16",
                      "a gain error of the cos channel: position error at 2 theta in phase with sin 2 theta, "
                      "independent of speed, and a cos-envelope amplitude off by alpha"},
-                    kParams, EffectStage::kWindings) {}
+                    kAmplitudeImbalanceParams, EffectStage::kWindings) {}
   void validate(Values v) const override {
-    if (!(v[kAlpha] > -1.0)) throw std::invalid_argument("amplitude_imbalance.alpha must be > -1 (a cos gain 1 + alpha > 0)");
+    if (!(AmplitudeImbalanceParams(v)["alpha"] > -1.0)) {
+      throw std::invalid_argument("amplitude_imbalance.alpha must be > -1 (a cos gain 1 + alpha > 0)");
+    }
   }
   void windings(Values v, WindingStage stage, double /*theta*/, SinCos& env) const override {
-    if (stage == WindingStage::kGain) env = apply_amplitude_imbalance(AmplitudeImbalance{v[kAlpha]}, env);
+    if (stage == WindingStage::kGain) env = apply_amplitude_imbalance(AmplitudeImbalanceParams(v), env);
   }
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignatureColumns& out) const override {
-    const double a = v[kAlpha];
+    const double a = AmplitudeImbalanceParams(v)["alpha"];
     const double r = a / (2.0 + a);
     const double dr = 2.0 / ((2.0 + a) * (2.0 + a));
     // d/dr of -sum (-r)^n / n sin(2n theta) = sum (-r)^(n-1) sin(2n theta).
@@ -61,12 +57,12 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
       rd += pw * b.rd_sin(2 * n);
       pw *= -r;
     }
-    out.col(0) = envelope_column(b, dr * rd, 0.0, b.env_cos(1));
+    out.col(AmplitudeImbalanceParams::index("alpha")) = envelope_column(b, dr * rd, 0.0, b.env_cos(1));
   }
   [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
-    const double a = v[kAlpha];
+    const double a = AmplitudeImbalanceParams(v)["alpha"];
     const double r = a / (2.0 + a);
     double pw = -r;
     for (int n = 1; n <= kSeriesTerms; ++n) {
@@ -88,7 +84,8 @@ const Effect& amplitude_imbalance_effect() {
 }
 
 std::string amplitude_imbalance_alpha_name() {
-  return std::string(amplitude_imbalance_effect().name()) + "." + std::string(kParams[kAlpha].name);
+  return std::string(amplitude_imbalance_effect().name()) + "." +
+         std::string(AmplitudeImbalanceParams::info("alpha").name);
 }
 
 }  // namespace resolver

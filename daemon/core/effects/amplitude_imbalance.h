@@ -11,24 +11,27 @@
 // alpha^2/8), see tests/unit/effects for the bound.
 #pragma once
 
+#include <array>
 #include <string>
 
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
 
-struct AmplitudeImbalance {
-  /// [1] relative gain error of the cos channel (range: kParams in amplitude_imbalance.cpp).
-  double alpha = 0.0;
-  [[nodiscard]] bool active() const { return alpha != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kAmplitudeImbalanceParams{
+    ParamInfo{.name = "alpha", .unit = "[1]", .description = "relative gain error of the cos channel", .min = -0.5,
+              .max = 0.5},
 };
+using AmplitudeImbalanceParams = ParamSet<kAmplitudeImbalanceParams>;
 
 /// Forward model: returns `in` with the cos channel scaled by (1 + alpha).
-[[nodiscard]] SinCos apply_amplitude_imbalance(const AmplitudeImbalance& p, const SinCos& in);
+[[nodiscard]] SinCos apply_amplitude_imbalance(const AmplitudeImbalanceParams& p, const SinCos& in);
 
 /// Small-alpha position error eps = theta - phi [rad] at resolver angle theta [rad]
 /// (Hanselman eq. 5, Hwang eq. 10).
-[[nodiscard]] double amplitude_imbalance_error(const AmplitudeImbalance& p, double theta);
+[[nodiscard]] double amplitude_imbalance_error(const AmplitudeImbalanceParams& p, double theta);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/param_set.h"
 
 namespace resolver {
 namespace {
@@ -13,7 +14,8 @@ constexpr std::array kParams{
     ParamInfo{.name = "h", .unit = "[rad]", .description = "width of the play between reference and resolver (mechanical rad)",
               .min = 0.0, .max = 0.5, .nonlinear = true},
 };
-constexpr std::size_t kH = param_index(kParams, "h");
+/// Typed, named access to the values of kParams (param_set.h).
+using BacklashParams = ParamSet<kParams>;
 
 /// [rad, mechanical] the play's lag in the direction of motion: h/2 once taken up,
 /// running from -h/2 to +h/2 over the take-up after a reversal.
@@ -36,7 +38,7 @@ class BacklashEffect final : public BasicEffect {
   [[nodiscard]] Needs identifiable_with() const override { return Needs::kReversal; }
   [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double omega_m, MotionState& state,
                                        bool commit) const override {
-    const double half = 0.5 * v[kH];
+    const double half = 0.5 * BacklashParams(v)["h"];
     if (half <= 0.0) return theta_m;
     // Start with the gap taken up in the direction of the first motion (forward at rest).
     const double previous = state.started ? state.value : theta_m - (omega_m < 0.0 ? -half : half);
@@ -50,23 +52,23 @@ class BacklashEffect final : public BasicEffect {
   // Once the play is taken up: eps = p_r (h/2) sign(omega), a direction term.
   [[nodiscard]] bool has_motion_terms() const override { return true; }
   [[nodiscard]] MotionTerms motion_terms(Values v, int p_r) const override {
-    return {.per_direction_rad = 0.5 * static_cast<double>(p_r) * v[kH]};
+    return {.per_direction_rad = 0.5 * static_cast<double>(p_r) * BacklashParams(v)["h"]};
   }
   // Steady motion: eps = p_r (h/2) direction. During the take-up after a reversal
   // (travel D < h from the turning point) the resolver stands still: eps_m runs
   // from +h/2 to -h/2 of the new direction, eps = p_r direction (D - h/2).
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
-    t.shift -= static_cast<double>(row.p_r) * row.direction * eps_m(row, v[kH]);
+    t.shift -= static_cast<double>(row.p_r) * row.direction * eps_m(row, BacklashParams(v)["h"]);
   }
   void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignatureColumns& out) const override {
     const double k = 0.5 * static_cast<double>(row.p_r) * row.direction;
-    const bool taking_up = row.since_reversal < v[kH];
-    out.col(0) = shift_column(taking_up ? -k : k, taking_up ? k : -k);
+    const bool taking_up = row.since_reversal < BacklashParams(v)["h"];
+    out.col(BacklashParams::index("h")) = shift_column(taking_up ? -k : k, taking_up ? k : -k);
   }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
-    const double eps = static_cast<double>(row.p_r) * row.direction * eps_m(row, v[kH]);
+    const double eps = static_cast<double>(row.p_r) * row.direction * eps_m(row, BacklashParams(v)["h"]);
     out += shift_column(eps, -eps);
   }
 };

@@ -3,6 +3,7 @@
 #include <array>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/param_set.h"
 
 namespace resolver {
 namespace {
@@ -12,7 +13,8 @@ constexpr std::array kParams{
               .description = "delay of the analog cos path against sin, before the converter", .min = -1e-3,
               .max = 1e-3},
 };
-constexpr std::size_t kTau = param_index(kParams, "tau");
+/// Typed, named access to the values of kParams (param_set.h).
+using ChannelDelayParams = ParamSet<kParams>;
 
 class ChannelDelayEffect final : public BasicEffect {
  public:
@@ -26,11 +28,13 @@ class ChannelDelayEffect final : public BasicEffect {
                     kParams, EffectStage::kChannels) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   void channel_timing(Values v, ChannelTiming& timing) const override {
-    timing.converter_cos_dt -= v[kTau];
-    timing.dsp_cos_dt -= v[kTau];
+    const double tau = ChannelDelayParams(v)["tau"];
+    timing.converter_cos_dt -= tau;
+    timing.dsp_cos_dt -= tau;
   }
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
-    out.col(0) = envelope_column(b, 0.5 * row.omega * (1.0 - b.rd_cos(2)), 0.0, row.omega * b.env_sin(1));
+    out.col(ChannelDelayParams::index("tau")) =
+        envelope_column(b, 0.5 * row.omega * (1.0 - b.rd_cos(2)), 0.0, row.omega * b.env_sin(1));
   }
 };
 

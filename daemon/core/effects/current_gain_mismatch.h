@@ -19,29 +19,35 @@
 // Compensation: divide the measured a, b currents by (1 + gain).
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/phase_currents.h"
 
 namespace resolver {
 
-struct CurrentGainMismatch {
-  double gain_a = 0.0;  ///< [1] relative gain error of the phase a sensor; > -1
-  double gain_b = 0.0;  ///< [1] relative gain error of the phase b sensor; > -1
-  [[nodiscard]] bool active() const { return gain_a != 0.0 || gain_b != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kCurrentGainMismatchParams{
+    ParamInfo{.name = "gain_a", .unit = "[1]", .description = "relative gain error of the phase a current sensor",
+              .min = -0.5, .max = 0.5},
+    ParamInfo{.name = "gain_b", .unit = "[1]", .description = "relative gain error of the phase b current sensor",
+              .min = -0.5, .max = 0.5},
 };
+using CurrentGainMismatchParams = ParamSet<kCurrentGainMismatchParams>;
 
 /// Forward model: the measured phase currents [A].
-[[nodiscard]] PhaseCurrents apply_current_gain_mismatch(const CurrentGainMismatch& p, const PhaseCurrents& in);
+[[nodiscard]] PhaseCurrents apply_current_gain_mismatch(const CurrentGainMismatchParams& p, const PhaseCurrents& in);
 
 /// Signature: the dq error [A] in the frame at theta_e [rad] when the machine carries
 /// (i_d, i_q) [A] in that frame (ideal currents). Exact.
-[[nodiscard]] DqCurrents current_gain_mismatch_dq_error(const CurrentGainMismatch& p, double i_d, double i_q,
-                                                        double theta_e);
+[[nodiscard]] DqCurrents current_gain_mismatch_dq_error(const CurrentGainMismatchParams& p, double i_d,
+                                                        double i_q, double theta_e);
 
 /// [A] amplitude A_2 of the 2x theta_e ripple on i_d (and on i_q) at current (i_d, i_q) [A].
-[[nodiscard]] double current_gain_mismatch_ripple_2x(const CurrentGainMismatch& p, double i_d, double i_q);
+[[nodiscard]] double current_gain_mismatch_ripple_2x(const CurrentGainMismatchParams& p, double i_d, double i_q);
 
-/// Compensation: undoes the gains on measured currents [A] (gains: kParams in current_gain_mismatch.cpp).
-[[nodiscard]] PhaseCurrents compensate_current_gain_mismatch(const CurrentGainMismatch& p,
+/// Compensation: undoes the gains on measured currents [A] .
+[[nodiscard]] PhaseCurrents compensate_current_gain_mismatch(const CurrentGainMismatchParams& p,
                                                              const PhaseCurrents& measured);
 
 /// The registry unit of this effect (registry.h).

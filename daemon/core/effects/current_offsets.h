@@ -19,27 +19,33 @@
 // Compensation: subtract the offsets (measured at zero current).
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/phase_currents.h"
 
 namespace resolver {
 
-struct CurrentOffsets {
-  double off_a = 0.0;  ///< [A] offset of the phase a sensor
-  double off_b = 0.0;  ///< [A] offset of the phase b sensor
-  [[nodiscard]] bool active() const { return off_a != 0.0 || off_b != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kCurrentOffsetsParams{
+    ParamInfo{.name = "off_a", .unit = "[A]", .description = "offset of the phase a current sensor", .min = -1000.0,
+              .max = 1000.0},
+    ParamInfo{.name = "off_b", .unit = "[A]", .description = "offset of the phase b current sensor", .min = -1000.0,
+              .max = 1000.0},
 };
+using CurrentOffsetsParams = ParamSet<kCurrentOffsetsParams>;
 
 /// Forward model: the measured phase currents [A].
-[[nodiscard]] PhaseCurrents apply_current_offsets(const CurrentOffsets& p, const PhaseCurrents& in);
+[[nodiscard]] PhaseCurrents apply_current_offsets(const CurrentOffsetsParams& p, const PhaseCurrents& in);
 
 /// Signature: the dq error [A] the offsets add in the frame at theta_e [rad] (exact).
-[[nodiscard]] DqCurrents current_offsets_dq_error(const CurrentOffsets& p, double theta_e);
+[[nodiscard]] DqCurrents current_offsets_dq_error(const CurrentOffsetsParams& p, double theta_e);
 
 /// [A] amplitude of the 1x theta_e ripple on i_d (and on i_q): hypot(off_a, off_b/sqrt3).
-[[nodiscard]] double current_offsets_ripple_1x(const CurrentOffsets& p);
+[[nodiscard]] double current_offsets_ripple_1x(const CurrentOffsetsParams& p);
 
 /// Compensation: removes the offsets from measured currents [A].
-[[nodiscard]] PhaseCurrents compensate_current_offsets(const CurrentOffsets& p, const PhaseCurrents& measured);
+[[nodiscard]] PhaseCurrents compensate_current_offsets(const CurrentOffsetsParams& p, const PhaseCurrents& measured);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

@@ -35,29 +35,38 @@
 // would feed the square-wave voltage forward instead.
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/phase_currents.h"
 
 namespace resolver {
 
-struct DeadTime {
-  /// [s] the dead time that gives k_dt = 1 (see the header comment).
-  static constexpr double kReferenceTime = 100e-6;
-  double t_d = 0.0;  ///< [s] inverter dead time; >= 0
-  [[nodiscard]] bool active() const { return t_d != 0.0; }
-  /// [1] relative amplitude of each of the 5th and 7th current harmonics.
-  [[nodiscard]] double k_dt() const { return t_d / kReferenceTime; }
+/// [s] the dead time that gives k_dt = 1 (see the header comment).
+inline constexpr double kDeadTimeReferenceTime = 100e-6;
+
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kDeadTimeParams{
+    // 20 us is already an extreme dead time; it gives k_dt = 0.2 (dead_time.h).
+    ParamInfo{.name = "t_d", .unit = "[s]",
+              .description = "inverter dead time (5th/7th current harmonics k_dt = t_d / 100 us)", .min = 0.0,
+              .max = 2e-5},
 };
+using DeadTimeParams = ParamSet<kDeadTimeParams>;
+
+/// [1] relative amplitude of each of the 5th and 7th current harmonics, t_d / kDeadTimeReferenceTime.
+[[nodiscard]] constexpr double dead_time_k_dt(const DeadTimeParams& p) { return p["t_d"] / kDeadTimeReferenceTime; }
 
 /// Forward model: the phase currents [A] with the 5th/7th distortion added to the
 /// balanced fundamental `fundamental` (zero sum). The result still sums to zero.
-[[nodiscard]] PhaseCurrents apply_dead_time(const DeadTime& p, const PhaseCurrents& fundamental);
+[[nodiscard]] PhaseCurrents apply_dead_time(const DeadTimeParams& p, const PhaseCurrents& fundamental);
 
 /// Signature: the dq distortion [A] in the frame at theta_e [rad] when the fundamental is
 /// (i_d, i_q) [A] in that frame.
-[[nodiscard]] DqCurrents dead_time_dq_error(const DeadTime& p, double i_d, double i_q, double theta_e);
+[[nodiscard]] DqCurrents dead_time_dq_error(const DeadTimeParams& p, double i_d, double i_q, double theta_e);
 
 /// [A] amplitudes of the 6x theta_e ripple on i_d (2 k_dt |i_q|) and on i_q (2 k_dt |i_d|).
-[[nodiscard]] DqCurrents dead_time_ripple_6x(const DeadTime& p, double i_d, double i_q);
+[[nodiscard]] DqCurrents dead_time_ripple_6x(const DeadTimeParams& p, double i_d, double i_q);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

@@ -21,23 +21,31 @@
 // theta_m ~= theta_seen_m - e sin(theta_seen_m + phase), error <= e^2.
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
+
 namespace resolver {
 
-struct Eccentricity {
-  double e = 0.0;      ///< [rad, mechanical] amplitude of the 1x angle error (range: kParams in eccentricity.cpp)
-  double phase = 0.0;  ///< [rad, mechanical] phase of the 1x angle error
-  [[nodiscard]] bool active() const { return e != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kEccentricityParams{
+    ParamInfo{.name = "e", .unit = "[rad]", .description = "amplitude of the 1x angle error (mechanical rad)",
+              .min = -0.5, .max = 0.5, .polar = Polar::kAmplitude},
+    ParamInfo{.name = "phase", .unit = "[rad]", .description = "phase of the 1x angle error (mechanical rad)",
+              .min = -10.0, .max = 10.0, .polar = Polar::kPhase},
 };
+using EccentricityParams = ParamSet<kEccentricityParams>;
 
-/// Forward model: the mechanical angle the resolver sees [rad] at true theta_m [rad] (continuous in, continuous out).
-[[nodiscard]] double eccentric_angle(const Eccentricity& p, double theta_m);
+/// Forward model: the mechanical angle the resolver sees [rad] at true theta_m [rad]
+/// (continuous in, continuous out).
+[[nodiscard]] double eccentric_angle(const EccentricityParams& p, double theta_m);
 
 /// Position error eps_m = theta_m - theta_seen_m [rad, mechanical] at true theta_m (exact).
-[[nodiscard]] double eccentricity_error(const Eccentricity& p, double theta_m);
+[[nodiscard]] double eccentricity_error(const EccentricityParams& p, double theta_m);
 
 /// Compensation: the true mechanical angle [rad] whose eccentric image is theta_seen_m
 /// [rad], to |error| <= 1e-15 rad (plus rounding) for |e| <= 0.5. Requires |e| < 1.
-[[nodiscard]] double compensate_eccentricity(const Eccentricity& p, double theta_seen_m);
+[[nodiscard]] double compensate_eccentricity(const EccentricityParams& p, double theta_seen_m);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

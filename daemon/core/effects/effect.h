@@ -8,6 +8,11 @@
 //
 //   Effect (this file) ── one subclass per physical effect, one file pair each in
 //   │                     daemon/core/effects/, one line in registry.cpp
+//   ├─ parameters:        one constexpr ParamInfo list per effect (param_info.h): name,
+//   │                     unit, description, range, neutral value, written once. The
+//   │                     hooks, the effect's forward functions, the simulator and the
+//   │                     tests read and write values by name through the type
+//   │                     generated from that list, ParamSet<list> (param_set.h)
 //   ├─ forward hooks:     the simulator's chain calls them at the stage where the
 //   │                     effect acts (forward_chain.h):
 //   │                       motion      what the resolver sees of the true angle (delay, eccentricity, backlash)
@@ -43,56 +48,12 @@
 #include <string_view>
 #include <vector>
 
+#include "daemon/core/effects/param_info.h"
 #include "daemon/core/effects/phase_currents.h"
 #include "daemon/core/effects/sin_cos.h"
 #include "daemon/core/effects/signature.h"
 
 namespace resolver {
-
-/// How the fit parameterises a nonlinear parameter internally.
-enum class FitScale : std::uint8_t {
-  kLinear,         ///< the value itself
-  kInverseSquare,  ///< 1 / value^2 (tracking_loop omega_n: 0 = ideal converter is 1/omega_n^2 = 0)
-};
-
-/// Two parameters that form an amplitude and a phase (eccentricity e, phase): the
-/// forward model and every output use them, the signature's two columns are the
-/// derivatives with respect to the Cartesian pair x = amplitude cos(phase),
-/// y = amplitude sin(phase), which the fit solves for (a phase is not identifiable
-/// at amplitude 0).
-enum class Polar : std::uint8_t { kNone, kAmplitude, kPhase };
-
-/// One parameter of an effect, listed once.
-struct ParamInfo {
-  std::string_view name;
-  std::string_view unit;         ///< e.g. "[rad]", "[1]", "[s]"
-  std::string_view description;  ///< one line
-  double min = 0.0;              ///< smallest accepted value (inclusive)
-  double max = 0.0;              ///< largest accepted value (inclusive)
-  double neutral = 0.0;          ///< the value at which the effect does nothing
-  bool integer = false;          ///< must be a whole number
-  bool listed = true;            ///< shown in --list-effects (false for the long tail, e.g. k6..k20)
-  /// Enters the signals nonlinearly (tracking_loop omega_n, delay d): fitted by
-  /// Gauss-Newton / Levenberg-Marquardt with numeric derivatives; the others are
-  /// linear coefficients of the effect's signature columns.
-  bool nonlinear = false;
-  FitScale scale = FitScale::kLinear;  ///< nonlinear parameters only
-  Polar polar = Polar::kNone;
-  /// Part of the effect when a model names it without a parameter list (e.g.
-  /// "harmonics" fits k3; "harmonics(k5,k3_opp)" chooses others).
-  bool default_fit = true;
-};
-
-/// The index of parameter `name` in an effect's ParamInfo list, at compile time:
-/// effects read their values by name (v[param_index(kParams, "beta")]), so a value
-/// cannot be read from the wrong slot and a name the list lacks does not compile.
-template <std::size_t N>
-consteval std::size_t param_index(const std::array<ParamInfo, N>& params, std::string_view name) {
-  for (std::size_t i = 0; i < N; ++i) {
-    if (params[i].name == name) return i;
-  }
-  throw "param_index: the effect has no parameter of this name";  // not a constant expression: fails to compile
-}
 
 /// Where in the chain an effect acts (for the catalog and for which signals it can change).
 enum class EffectStage : std::uint8_t {
@@ -148,9 +109,6 @@ struct HarmonicOrders {
   int theta_m = 0;
   int theta_e = 0;
 };
-
-/// The parameter values of one effect, in the order of its params().
-using Values = std::span<const double>;
 
 /// What discovery's residual shows, for effects whose candidates follow it.
 class ResidualSpectrum {

@@ -37,21 +37,29 @@
 // 1 + alpha/2 drifts) is what this effect can take from it, never the angle error.
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
 
-struct EnvelopeDrift {
-  double g = 0.0;  ///< [1/s] relative drift of the common envelope gain; 1 + g t > 0 over the log
-  [[nodiscard]] bool active() const { return g != 0.0; }
+/// The effect's parameters, listed once (param_set.h). g's range: ten times the
+/// fastest realistic warm-up (~1e-3 /s, above), as the other effects' ranges leave
+/// room above the realistic, so the fit is never held at a bound by a real log.
+inline constexpr std::array kEnvelopeDriftParams{
+    ParamInfo{.name = "g", .unit = "[1/s]",
+              .description = "drift rate of the common sin/cos gain: both x (1 + g t), t from the first sample",
+              .min = -0.01, .max = 0.01},
 };
+using EnvelopeDriftParams = ParamSet<kEnvelopeDriftParams>;
 
 /// Forward model: both envelopes scaled by (1 + g t), t [s] since the log's first sample.
-[[nodiscard]] SinCos apply_envelope_drift(const EnvelopeDrift& p, double t, const SinCos& in);
+[[nodiscard]] SinCos apply_envelope_drift(const EnvelopeDriftParams& p, double t, const SinCos& in);
 
 /// The radius deviation sqrt(s^2 + c^2) - 1 of ideal envelopes under the drift at time t [s]
 /// (exactly g t; the position error is exactly 0).
-[[nodiscard]] double envelope_drift_radius(const EnvelopeDrift& p, double t);
+[[nodiscard]] double envelope_drift_radius(const EnvelopeDriftParams& p, double t);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/param_set.h"
 
 namespace resolver {
 namespace {
@@ -34,13 +36,30 @@ constexpr std::array<ParamInfo, 2 * kMaxMechanicalOrder> make_params() {
   return out;
 }
 constexpr auto kParams = make_params();
+/// Typed, named access to the values of kParams (param_set.h).
+using MechanicalHarmonicsParams = ParamSet<kParams>;
 
-double seen_mech(Values v, double theta_m) {
+/// The pair (a_n, b_n) of one order n, found by name in the list.
+struct OrderKeys {
+  MechanicalHarmonicsParams::Key a;
+  MechanicalHarmonicsParams::Key b;
+};
+template <std::size_t... I>
+consteval std::array<OrderKeys, sizeof...(I)> make_keys(std::index_sequence<I...> /*orders*/) {
+  using Key = MechanicalHarmonicsParams::Key;
+  return {OrderKeys{Key(kNames[2 * I]), Key(kNames[2 * I + 1])}...};
+}
+constexpr auto kOrderKeys = make_keys(std::make_index_sequence<kMaxMechanicalOrder>{});
+/// The keys of order n = 1..kMaxMechanicalOrder (not checked).
+constexpr const OrderKeys& order_keys(int n) { return kOrderKeys[static_cast<std::size_t>(n - 1)]; }
+
+double seen_mech(const MechanicalHarmonicsParams& p, double theta_m) {
   double out = theta_m;
-  for (std::size_t i = 0; i + 1 < v.size(); i += 2) {
-    if (v[i] == 0.0 && v[i + 1] == 0.0) continue;
-    const double n = static_cast<double>(i / 2 + 1);
-    out += v[i] * std::sin(n * theta_m) + v[i + 1] * std::cos(n * theta_m);
+  for (int order = 1; order <= kMaxMechanicalOrder; ++order) {
+    const OrderKeys& k = order_keys(order);
+    if (p[k.a] == 0.0 && p[k.b] == 0.0) continue;
+    const auto n = static_cast<double>(order);
+    out += p[k.a] * std::sin(n * theta_m) + p[k.b] * std::cos(n * theta_m);
   }
   return out;
 }
@@ -57,7 +76,14 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
                     kParams, EffectStage::kMotion) {}
   [[nodiscard]] HarmonicOrders orders(std::span<const int> params) const override {
     int top = 0;
-    for (int p : params) top = std::max(top, p / 2 + 1);
+    for (int p : params) {
+      for (int n = 1; n <= kMaxMechanicalOrder; ++n) {
+        const OrderKeys& k = order_keys(n);
+        if (static_cast<std::size_t>(p) == k.a.index() || static_cast<std::size_t>(p) == k.b.index()) {
+          top = std::max(top, n);
+        }
+      }
+    }
     return {.theta_m = top};
   }
   [[nodiscard]] bool needs_reference() const override { return true; }
@@ -81,8 +107,12 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
     return out;
   }
   void validate(Values v) const override {
+    const MechanicalHarmonicsParams p(v);
     double sum = 0.0;
-    for (std::size_t i = 0; i < v.size(); ++i) sum += static_cast<double>(i / 2 + 1) * std::abs(v[i]);
+    for (int n = 1; n <= kMaxMechanicalOrder; ++n) {
+      sum += static_cast<double>(n) * std::abs(p[order_keys(n).a]);
+      sum += static_cast<double>(n) * std::abs(p[order_keys(n).b]);
+    }
     if (!(sum < 1.0)) {
       throw std::invalid_argument(
           "mechanical_harmonics: sum of n (|a_n| + |b_n|) must be < 1 so the resolver keeps turning one way");
@@ -90,18 +120,17 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
   }
   [[nodiscard]] double seen_mech_angle(Values v, double theta_m, double /*omega_m*/, MotionState& /*state*/,
                                        bool /*commit*/) const override {
-    return seen_mech(v, theta_m);
+    return seen_mech(MechanicalHarmonicsParams(v), theta_m);
   }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
-    t.shift += static_cast<double>(row.p_r) * (seen_mech(v, row.theta_m) - row.theta_m);
+    t.shift += static_cast<double>(row.p_r) * (seen_mech(MechanicalHarmonicsParams(v), row.theta_m) - row.theta_m);
   }
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
     const double pr = row.p_r;
     for (int n = 1; n <= kMaxMechanicalOrder; ++n) {
-      const auto i = static_cast<std::size_t>(2 * (n - 1));
-      out.col(i) = shift_column(-pr * b.rd_mech_sin(n), pr * b.env_mech_sin(n));
-      out.col(i + 1) = shift_column(-pr * b.rd_mech_cos(n), pr * b.env_mech_cos(n));
+      out.col(order_keys(n).a.index()) = shift_column(-pr * b.rd_mech_sin(n), pr * b.env_mech_sin(n));
+      out.col(order_keys(n).b.index()) = shift_column(-pr * b.rd_mech_cos(n), pr * b.env_mech_cos(n));
     }
   }
 };

@@ -9,17 +9,17 @@
 
 namespace resolver {
 
-double mounting_offset_resolver_shift(const MountingOffset& m, int p_r, int p) {
-  return m.theta_0 * static_cast<double>(p_r) / static_cast<double>(p);
+double mounting_offset_resolver_shift(const MountingOffsetParams& m, int p_r, int p) {
+  return m["theta_0"] * static_cast<double>(p_r) / static_cast<double>(p);
 }
 
-DqCurrents mounting_offset_rotor_currents(const MountingOffset& m, double i_d_cmd, double i_q_cmd) {
-  const double c = std::cos(m.theta_0);
-  const double s = std::sin(m.theta_0);
+DqCurrents mounting_offset_rotor_currents(const MountingOffsetParams& m, double i_d_cmd, double i_q_cmd) {
+  const double c = std::cos(m["theta_0"]);
+  const double s = std::sin(m["theta_0"]);
   return {i_d_cmd * c - i_q_cmd * s, i_d_cmd * s + i_q_cmd * c};
 }
 
-double mounting_offset_error(const MountingOffset& m, int p_r, int p) {
+double mounting_offset_error(const MountingOffsetParams& m, int p_r, int p) {
   return -mounting_offset_resolver_shift(m, p_r, p);
 }
 
@@ -29,8 +29,8 @@ double estimate_mounting_offset(double i_d_ref, double i_q_ref, double i_d_cmd, 
   return wrap_pi(std::atan2(i_q_ref, i_d_ref) - std::atan2(i_q_cmd, i_d_cmd));
 }
 
-double compensate_mounting_offset(const MountingOffset& m, double theta_e_drive) {
-  return theta_e_drive - m.theta_0;
+double compensate_mounting_offset(const MountingOffsetParams& m, double theta_e_drive) {
+  return theta_e_drive - m["theta_0"];
 }
 
 }  // namespace resolver
@@ -38,13 +38,6 @@ double compensate_mounting_offset(const MountingOffset& m, double theta_e_drive)
 // ---- registry unit ------------------------------------------------------------
 namespace resolver {
 namespace {
-
-constexpr std::array kParams{
-    ParamInfo{.name = "theta_0", .unit = "[rad]",
-              .description = "drive (resolver) zero ahead of the rotor d axis (motor electrical rad)", .min = -kPi,
-              .max = kPi},
-};
-constexpr std::size_t kTheta0 = param_index(kParams, "theta_0");
 
 class MountingOffsetEffect final : public BasicEffect {
  public:
@@ -55,23 +48,23 @@ class MountingOffsetEffect final : public BasicEffect {
                      "docs/ARCHITECTURE.md section 7; mounting_offset.h",
                      "the resolver is mounted at an angle: a constant position error against the reference, the same "
                      "at every speed and in both directions"},
-                    kParams, EffectStage::kMotion) {}
+                    kMountingOffsetParams, EffectStage::kMotion) {}
   [[nodiscard]] bool needs_reference() const override { return true; }
   [[nodiscard]] bool needs_aligned_reference() const override { return true; }
   [[nodiscard]] double resolver_angle_shift(Values v, int p_r, int p) const override {
-    return mounting_offset_resolver_shift(MountingOffset{v[kTheta0]}, p_r, p);
+    return mounting_offset_resolver_shift(MountingOffsetParams(v), p_r, p);
   }
-  [[nodiscard]] double drive_frame_offset(Values v) const override { return v[kTheta0]; }
+  [[nodiscard]] double drive_frame_offset(Values v) const override { return MountingOffsetParams(v)["theta_0"]; }
   // The windings' errors turn with the seen angle (signature.h's BasisTransform::shift).
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& row, Values v, BasisTransform& t) const override {
-    t.shift += static_cast<double>(row.p_r) / static_cast<double>(row.p) * v[kTheta0];
+    t.shift += static_cast<double>(row.p_r) / static_cast<double>(row.p) * MountingOffsetParams(v)["theta_0"];
   }
   // The dq currents against the reference show the offset only as a steady
   // current, which the operating point (the fit's DC i_d, i_q) absorbs: no dq column.
   void signature(const SignatureRow& row, const AngleBasis& /*b*/, Values /*v*/, SignatureColumns& out) const override {
     const double r = static_cast<double>(row.p_r) / static_cast<double>(row.p);
-    out.col(0) = shift_column(-r, r);
+    out.col(MountingOffsetParams::index("theta_0")) = shift_column(-r, r);
   }
 };
 

@@ -27,33 +27,40 @@
 // reference-frame currents (estimate_mounting_offset) or from the mean eps.
 #pragma once
 
+#include <array>
+
+#include "daemon/core/angles.h"
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/phase_currents.h"
 
 namespace resolver {
 
-struct MountingOffset {
-  /// [rad, motor electrical] drive (resolver) zero ahead of the rotor d axis.
-  double theta_0 = 0.0;
-  [[nodiscard]] bool active() const { return theta_0 != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kMountingOffsetParams{
+    ParamInfo{.name = "theta_0", .unit = "[rad]",
+              .description = "drive (resolver) zero ahead of the rotor d axis (motor electrical rad)", .min = -kPi,
+              .max = kPi},
 };
+using MountingOffsetParams = ParamSet<kMountingOffsetParams>;
 
 /// Forward model 1: the shift of the resolver electrical angle (p_r / p) theta_0 [rad].
 /// p_r, p >= 1 (not checked).
-[[nodiscard]] double mounting_offset_resolver_shift(const MountingOffset& m, int p_r, int p);
+[[nodiscard]] double mounting_offset_resolver_shift(const MountingOffsetParams& m, int p_r, int p);
 
 /// Forward model 2: the commanded current vector (i_d*, i_q*) [A] of the drive frame,
 /// expressed in the rotor frame (rotation by theta_0).
-[[nodiscard]] DqCurrents mounting_offset_rotor_currents(const MountingOffset& m, double i_d_cmd, double i_q_cmd);
+[[nodiscard]] DqCurrents mounting_offset_rotor_currents(const MountingOffsetParams& m, double i_d_cmd,
+                                                        double i_q_cmd);
 
 /// Signature: the constant position error eps [rad, resolver electrical] against the reference.
-[[nodiscard]] double mounting_offset_error(const MountingOffset& m, int p_r, int p);
+[[nodiscard]] double mounting_offset_error(const MountingOffsetParams& m, int p_r, int p);
 
 /// Estimate of theta_0 [rad, motor electrical, in [-pi, pi)] from the steady rotor-frame
 /// (reference-angle) currents [A] and the command [A]. Returns 0 when either vector is zero.
 [[nodiscard]] double estimate_mounting_offset(double i_d_ref, double i_q_ref, double i_d_cmd, double i_q_cmd);
 
 /// Compensation: the rotor electrical angle [rad] from the drive's theta_e_drive [rad].
-[[nodiscard]] double compensate_mounting_offset(const MountingOffset& m, double theta_e_drive);
+[[nodiscard]] double compensate_mounting_offset(const MountingOffsetParams& m, double theta_e_drive);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

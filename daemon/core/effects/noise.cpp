@@ -1,5 +1,7 @@
 #include "daemon/core/effects/noise.h"
+
 #include <array>
+
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
@@ -15,25 +17,17 @@ double gaussian_noise(NoiseEngine& engine, double sigma) {
 // ---- registry unit ------------------------------------------------------------
 namespace {
 
-constexpr std::array kParams{
-    ParamInfo{.name = "sigma_sc", .unit = "[counts]", .description = "white noise on each sin/cos ADC sample",
-              .min = 0.0, .max = 32767.0},
-    ParamInfo{.name = "sigma_i", .unit = "[A]", .description = "white noise on each phase current sample",
-              .min = 0.0, .max = 1000.0},
-};
-constexpr std::size_t kSigmaSc = param_index(kParams, "sigma_sc");
-constexpr std::size_t kSigmaI = param_index(kParams, "sigma_i");
-
 class NoiseEffect final : public BasicEffect {
  public:
   NoiseEffect()
       : BasicEffect({"noise", "white noise on sin/cos samples and phase currents; sets the floor", "docs/ARCHITECTURE.md section 7",
                      "measurement noise: the floor every residual is compared with"},
-                    kParams, EffectStage::kNoise) {}
+                    kNoiseParams, EffectStage::kNoise) {}
   [[nodiscard]] bool fittable() const override { return false; }
   void impairments(Values v, Impairments& imp) const override {
-    imp.sigma_sc += v[kSigmaSc];
-    imp.sigma_i += v[kSigmaI];
+    const NoiseParams p(v);
+    imp.sigma_sc += p["sigma_sc"];
+    imp.sigma_i += p["sigma_i"];
   }
 };
 
@@ -43,8 +37,7 @@ constexpr std::array kOutlierParams{
     ParamInfo{.name = "size", .unit = "[counts]", .description = "size of each spike (random sign)", .min = 0.0,
               .max = 65535.0},
 };
-constexpr std::size_t kRate = param_index(kOutlierParams, "rate");
-constexpr std::size_t kSize = param_index(kOutlierParams, "size");
+using OutlierParams = ParamSet<kOutlierParams>;
 
 class OutliersEffect final : public BasicEffect {
  public:
@@ -54,8 +47,9 @@ class OutliersEffect final : public BasicEffect {
                     kOutlierParams, EffectStage::kNoise) {}
   [[nodiscard]] bool fittable() const override { return false; }
   void impairments(Values v, Impairments& imp) const override {
-    imp.outlier_rate += v[kRate];
-    imp.outlier_size = v[kSize];
+    const OutlierParams p(v);
+    imp.outlier_rate += p["rate"];
+    imp.outlier_size = p["size"];
   }
 };
 

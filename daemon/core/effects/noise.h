@@ -9,16 +9,22 @@
 // normal distribution's algorithm is implementation-defined).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <random>
 
+#include "daemon/core/effects/param_set.h"
+
 namespace resolver {
 
-struct Noise {
-  double sigma_sc = 0.0;  ///< [counts] standard deviation on each sin/cos ADC sample
-  double sigma_i = 0.0;   ///< [A] standard deviation on each phase current sample
-  [[nodiscard]] bool active() const { return sigma_sc != 0.0 || sigma_i != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kNoiseParams{
+    ParamInfo{.name = "sigma_sc", .unit = "[counts]", .description = "white noise on each sin/cos ADC sample",
+              .min = 0.0, .max = 32767.0},
+    ParamInfo{.name = "sigma_i", .unit = "[A]", .description = "white noise on each phase current sample",
+              .min = 0.0, .max = 1000.0},
 };
+using NoiseParams = ParamSet<kNoiseParams>;
 
 /// The one random engine type of the effect models.
 using NoiseEngine = std::mt19937_64;

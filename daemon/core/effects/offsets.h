@@ -9,21 +9,27 @@
 // (the Hessian of atan2 has norm 1/r^2).
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
 
-struct Offsets {
-  double o_s = 0.0;  ///< [fraction of amplitude] offset of the sin channel (range: kParams in offsets.cpp)
-  double o_c = 0.0;  ///< [fraction of amplitude] offset of the cos channel (range: kParams in offsets.cpp)
-  [[nodiscard]] bool active() const { return o_s != 0.0 || o_c != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kOffsetsParams{
+    ParamInfo{.name = "o_s", .unit = "[fraction of amplitude]", .description = "DC offset of the sin channel",
+              .min = -0.5, .max = 0.5},
+    ParamInfo{.name = "o_c", .unit = "[fraction of amplitude]", .description = "DC offset of the cos channel",
+              .min = -0.5, .max = 0.5},
 };
+using OffsetsParams = ParamSet<kOffsetsParams>;
 
 /// Forward model: adds the offsets to the envelopes.
-[[nodiscard]] SinCos apply_offsets(const Offsets& p, const SinCos& in);
+[[nodiscard]] SinCos apply_offsets(const OffsetsParams& p, const SinCos& in);
 
 /// Small-offset position error eps = theta - phi [rad] at resolver angle theta [rad].
-[[nodiscard]] double offsets_error(const Offsets& p, double theta);
+[[nodiscard]] double offsets_error(const OffsetsParams& p, double theta);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

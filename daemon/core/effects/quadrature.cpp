@@ -8,22 +8,16 @@
 
 namespace resolver {
 
-SinCos quadrature_fundamental(const Quadrature& p, double theta) {
-  return {std::sin(theta), std::cos(theta + p.beta)};
+SinCos quadrature_fundamental(const QuadratureParams& p, double theta) {
+  return {std::sin(theta), std::cos(theta + p["beta"])};
 }
 
-double quadrature_error(const Quadrature& p, double theta) {
-  return -0.5 * p.beta * (1.0 - std::cos(2.0 * theta));
+double quadrature_error(const QuadratureParams& p, double theta) {
+  return -0.5 * p["beta"] * (1.0 - std::cos(2.0 * theta));
 }
 
 // ---- registry unit ------------------------------------------------------------
 namespace {
-
-constexpr std::array kParams{
-    ParamInfo{.name = "beta", .unit = "[rad]", .description = "misalignment of the cos winding", .min = -0.5,
-              .max = 0.5},
-};
-constexpr std::size_t kBeta = param_index(kParams, "beta");
 
 class QuadratureEffect final : public BasicEffect {
  public:
@@ -32,23 +26,25 @@ class QuadratureEffect final : public BasicEffect {
                      "Hanselman eq. 6-7 (sign checked: eps = theta - phi)",
                      "the cos winding is not at 90 degrees: position error at 2 theta in phase with cos 2 theta plus "
                      "a constant, independent of speed, seen by the R/D angle and the sin/cos signals alike"},
-                    kParams, EffectStage::kWindings) {}
+                    kQuadratureParams, EffectStage::kWindings) {}
   void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {
-    if (stage == WindingStage::kFundamental) env = quadrature_fundamental(Quadrature{v[kBeta]}, theta);
+    if (stage == WindingStage::kFundamental) env = quadrature_fundamental(QuadratureParams(v), theta);
   }
   // rd: -(1/2)(1 - cos 2theta) per unit beta, through the converter (first order;
   // the omitted terms are O(beta^2)). c: the exact derivative of cos(theta + beta).
   void signature(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignatureColumns& out) const override {
     const double th = b.env_angle();
-    out.col(0) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + v[kBeta]));
+    const QuadratureParams p(v);
+    out.col(p.index("beta")) = envelope_column(b, -0.5 * (1.0 - b.rd_cos(2)), 0.0, -std::sin(th + p["beta"]));
   }
   [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& /*row*/, const AngleBasis& b, Values v, SignalValues& out) const override {
     const double th = b.env_angle();
-    out.rd += -0.5 * v[kBeta] * (1.0 - b.rd_cos(2));
+    const QuadratureParams p(v);
+    out.rd += -0.5 * p["beta"] * (1.0 - b.rd_cos(2));
     // The pair (sin th, cos(th + beta)) exactly.
-    const double sn = b.env_sin(1), cq = std::cos(th + v[kBeta]);
+    const double sn = b.env_sin(1), cq = std::cos(th + p["beta"]);
     out.sa += wrap_pi(th - std::atan2(sn, cq));
     out.sr += std::hypot(sn, cq) - 1.0;
   }

@@ -14,22 +14,26 @@
 // and the omitted terms are O(beta^2).
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
 
-struct Quadrature {
-  /// [rad] spatial misalignment of the cos winding; |beta| < pi/2.
-  double beta = 0.0;
-  [[nodiscard]] bool active() const { return beta != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kQuadratureParams{
+    ParamInfo{.name = "beta", .unit = "[rad]", .description = "misalignment of the cos winding", .min = -0.5,
+              .max = 0.5},
 };
+using QuadratureParams = ParamSet<kQuadratureParams>;
 
 /// Forward model: fundamental envelopes {sin(theta), cos(theta + beta)} at resolver angle theta [rad].
-[[nodiscard]] SinCos quadrature_fundamental(const Quadrature& p, double theta);
+[[nodiscard]] SinCos quadrature_fundamental(const QuadratureParams& p, double theta);
 
 /// Small-beta position error eps = theta - phi [rad] = -(beta/2)(1 - cos 2theta)
 /// (Hanselman eq. 7 with the sign checked against the exact model, see above).
-[[nodiscard]] double quadrature_error(const Quadrature& p, double theta);
+[[nodiscard]] double quadrature_error(const QuadratureParams& p, double theta);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

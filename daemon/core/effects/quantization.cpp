@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "daemon/core/angles.h"
-#include <array>
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
@@ -15,7 +14,7 @@ std::uint16_t quantize_rd_angle(double phi, int rd_bits) {
   const auto code = static_cast<std::int64_t>(std::llround(wrap_2pi(phi) / kTwoPi * steps));
   // Rounding just below 2pi gives code == 2^rd_bits, which is angle 0.
   const std::int64_t wrapped = code & ((std::int64_t{1} << rd_bits) - 1);
-  return static_cast<std::uint16_t>(wrapped << (Quantization::kMaxBits - rd_bits));
+  return static_cast<std::uint16_t>(wrapped << (kRdFieldBits - rd_bits));
 }
 
 double rd_counts_to_angle(std::uint16_t counts) { return static_cast<double>(counts) * (kTwoPi / 65536.0); }
@@ -23,21 +22,16 @@ double rd_counts_to_angle(std::uint16_t counts) { return static_cast<double>(cou
 // ---- registry unit ------------------------------------------------------------
 namespace {
 
-constexpr std::array kParams{
-    ParamInfo{.name = "rd_bits", .unit = "[bits]", .description = "R/D converter resolution",
-              .min = Quantization::kMinBits, .max = Quantization::kMaxBits, .neutral = Quantization::kMaxBits,
-              .integer = true},
-};
-constexpr std::size_t kRdBits = param_index(kParams, "rd_bits");
-
 class QuantizationEffect final : public BasicEffect {
  public:
   QuantizationEffect()
       : BasicEffect({"quantization", "R/D angle rounded to 2pi/2^rd_bits; uniform +-1/2 LSB", "Hanselman Table I",
                      "the converter's resolution: a uniform error of +-1/2 LSB that sets part of the floor"},
-                    kParams, EffectStage::kConverter) {}
+                    kQuantizationParams, EffectStage::kConverter) {}
   [[nodiscard]] bool fittable() const override { return false; }
-  void converter(Values v, ConverterSpec& spec) const override { spec.rd_bits = static_cast<int>(v[kRdBits]); }
+  void converter(Values v, ConverterSpec& spec) const override {
+    spec.rd_bits = static_cast<int>(QuantizationParams(v)["rd_bits"]);
+  }
 };
 
 }  // namespace

@@ -8,22 +8,29 @@
 // angle, RMS LSB / sqrt(12).
 #pragma once
 
+#include <array>
 #include <cstdint>
+
+#include "daemon/core/effects/param_set.h"
 
 namespace resolver {
 
-struct Quantization {
-  static constexpr int kMinBits = 1;
-  static constexpr int kMaxBits = 16;  ///< the u16 field's own resolution: no extra quantization
-  int rd_bits = kMaxBits;              ///< [bits] R/D converter resolution, kMinBits..kMaxBits
-  [[nodiscard]] bool active() const { return rd_bits != kMaxBits; }
-};
+/// [bits] the u16 rd_angle field's own resolution (docs/ARCHITECTURE.md §4): a
+/// converter this fine adds no quantization, so it is also rd_bits' largest and neutral value.
+inline constexpr int kRdFieldBits = 16;
 
-/// One LSB of an rd_bits converter [rad]. rd_bits must be in 1..16 (not checked here).
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kQuantizationParams{
+    ParamInfo{.name = "rd_bits", .unit = "[bits]", .description = "R/D converter resolution", .min = 1,
+              .max = kRdFieldBits, .neutral = kRdFieldBits, .integer = true},
+};
+using QuantizationParams = ParamSet<kQuantizationParams>;
+
+/// One LSB of an rd_bits converter [rad]. rd_bits must be in its listed range (not checked here).
 [[nodiscard]] double quantization_lsb(int rd_bits);
 
 /// Rounds phi [rad, any range] to rd_bits and returns the u16 field value
-/// (0..65535 = 0..2pi, low 16 - rd_bits bits zero). rd_bits must be in 1..16.
+/// (0..65535 = 0..2pi, low 16 - rd_bits bits zero). rd_bits must be in its listed range.
 [[nodiscard]] std::uint16_t quantize_rd_angle(double phi, int rd_bits);
 
 /// The angle [rad] in [0, 2pi) a u16 rd_angle field value stands for.

@@ -1,19 +1,20 @@
 #include "daemon/core/effects/sampling_skew.h"
 
-#include <cmath>
 #include <array>
+#include <cmath>
+
 #include "daemon/core/effects/effect.h"
 
 namespace resolver {
 
-double sampling_skew_beta(const SamplingSkew& p, double omega) { return omega * p.tau; }
+double sampling_skew_beta(const SamplingSkewParams& p, double omega) { return omega * p["tau"]; }
 
-double sampling_skew_error(const SamplingSkew& p, double theta, double omega) {
+double sampling_skew_error(const SamplingSkewParams& p, double theta, double omega) {
   // Quadrature signature (quadrature.h) with beta = omega tau.
   return -0.5 * sampling_skew_beta(p, omega) * (1.0 - std::cos(2.0 * theta));
 }
 
-SinCos compensate_sampling_skew(const SamplingSkew& p, const SinCos& sampled, double omega_hat) {
+SinCos compensate_sampling_skew(const SamplingSkewParams& p, const SinCos& sampled, double omega_hat) {
   // c = cos(theta + beta) = cos(theta) cos(beta) - sin(theta) sin(beta), s = sin(theta).
   const double beta = sampling_skew_beta(p, omega_hat);
   return {sampled.s, (sampled.c + sampled.s * std::sin(beta)) / std::cos(beta)};
@@ -21,12 +22,6 @@ SinCos compensate_sampling_skew(const SamplingSkew& p, const SinCos& sampled, do
 
 // ---- registry unit ------------------------------------------------------------
 namespace {
-
-constexpr std::array kParams{
-    ParamInfo{.name = "tau", .unit = "[s]", .description = "delay of the DSP's cos sample after the sin sample",
-              .min = -1e-3, .max = 1e-3},
-};
-constexpr std::size_t kTau = param_index(kParams, "tau");
 
 class SamplingSkewEffect final : public BasicEffect {
  public:
@@ -37,12 +32,14 @@ class SamplingSkewEffect final : public BasicEffect {
                      "docs/ARCHITECTURE.md section 7, Hanselman eq. 6-7 via beta = omega tau",
                      "the cos channel is sampled after the sin channel: a quadrature-like error of the sin/cos pair "
                      "that grows with speed and that the R/D angle does not show"},
-                    kParams, EffectStage::kChannels) {}
+                    kSamplingSkewParams, EffectStage::kChannels) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
-  void channel_timing(Values v, ChannelTiming& timing) const override { timing.dsp_cos_dt += v[kTau]; }
+  void channel_timing(Values v, ChannelTiming& timing) const override {
+    timing.dsp_cos_dt += SamplingSkewParams(v)["tau"];
+  }
   // c = C(theta(t + tau)) = cos(theta + omega tau): dc/dtau = -omega sin theta (first order).
   void signature(const SignatureRow& row, const AngleBasis& b, Values /*v*/, SignatureColumns& out) const override {
-    out.col(0) = envelope_column(b, 0.0, 0.0, -row.omega * b.env_sin(1));
+    out.col(SamplingSkewParams::index("tau")) = envelope_column(b, 0.0, 0.0, -row.omega * b.env_sin(1));
   }
 };
 

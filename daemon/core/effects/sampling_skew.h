@@ -22,15 +22,19 @@
 // (exact for the fundamental at constant speed; residual O(tau |omega - omega_hat|)).
 #pragma once
 
+#include <array>
+
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
 
-struct SamplingSkew {
-  /// [s] delay of the cos sample after the sin sample (negative: cos first).
-  double tau = 0.0;
-  [[nodiscard]] bool active() const { return tau != 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kSamplingSkewParams{
+    ParamInfo{.name = "tau", .unit = "[s]", .description = "delay of the DSP's cos sample after the sin sample",
+              .min = -1e-3, .max = 1e-3},
 };
+using SamplingSkewParams = ParamSet<kSamplingSkewParams>;
 
 /// Forward model: the sampled pair, sin channel from the envelopes at the sin
 /// instant, cos channel from the envelopes at the cos instant (t + tau).
@@ -40,17 +44,18 @@ struct SamplingSkew {
 
 /// [rad] the equivalent quadrature error beta = omega tau at resolver electrical
 /// speed omega [rad/s] (docs/ARCHITECTURE.md §7). Grows linearly with speed.
-[[nodiscard]] double sampling_skew_beta(const SamplingSkew& p, double omega);
+[[nodiscard]] double sampling_skew_beta(const SamplingSkewParams& p, double omega);
 
 /// Small-(omega tau) position error eps = theta - phi [rad] of the angle computed
 /// from the sampled sin/cos at resolver angle theta [rad] and constant speed
 /// omega [rad/s]: -(omega tau / 2)(1 - cos 2theta). Omitted terms O((omega tau)^2).
-[[nodiscard]] double sampling_skew_error(const SamplingSkew& p, double theta, double omega);
+[[nodiscard]] double sampling_skew_error(const SamplingSkewParams& p, double theta, double omega);
 
 /// Compensation: the sampled pair with the cos channel moved back to the sin
 /// instant, assuming constant speed omega_hat [rad/s] and a sinusoidal fundamental.
 /// Requires |omega_hat tau| < pi/2 (not checked).
-[[nodiscard]] SinCos compensate_sampling_skew(const SamplingSkew& p, const SinCos& sampled, double omega_hat);
+[[nodiscard]] SinCos compensate_sampling_skew(const SamplingSkewParams& p, const SinCos& sampled,
+                                             double omega_hat);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/param_set.h"
 
 namespace resolver {
 
@@ -68,8 +69,8 @@ constexpr std::array kParams{
     ParamInfo{.name = "zeta", .unit = "[1]", .description = "closed-loop damping ratio", .min = 0.01, .max = 10.0,
               .neutral = 0.7, .nonlinear = true, .default_fit = false},
 };
-constexpr std::size_t kOmegaN = param_index(kParams, "omega_n");
-constexpr std::size_t kZeta = param_index(kParams, "zeta");
+/// Typed, named access to the values of kParams (param_set.h).
+using TrackingLoopParams = ParamSet<kParams>;
 
 class TrackingLoopEffect final : public BasicEffect {
  public:
@@ -81,25 +82,29 @@ class TrackingLoopEffect final : public BasicEffect {
                     kParams, EffectStage::kConverter) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChangeOrSinCos; }
-  [[nodiscard]] bool active(Values v) const override { return v[kOmegaN] > 0.0; }
+  [[nodiscard]] bool active(Values v) const override { return TrackingLoopParams(v)["omega_n"] > 0.0; }
   void validate(Values v) const override {
-    if (v[kOmegaN] > 0.0 && !(v[kZeta] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
+    const TrackingLoopParams p(v);
+    if (p["omega_n"] > 0.0 && !(p["zeta"] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
   }
   void converter(Values v, ConverterSpec& spec) const override {
-    spec.omega_n = v[kOmegaN];
-    spec.zeta = v[kZeta];
+    const TrackingLoopParams p(v);
+    spec.omega_n = p["omega_n"];
+    spec.zeta = p["zeta"];
   }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override {
-    t.omega_n = v[kOmegaN];
-    t.zeta = v[kZeta];
+    const TrackingLoopParams p(v);
+    t.omega_n = p["omega_n"];
+    t.zeta = p["zeta"];
   }
   // Both parameters act through the basis (every other effect's rd harmonics),
   // so they have no columns of their own; the fit differentiates numerically.
   // The loop's own term: a type-II loop lags a constant acceleration a by a / omega_n^2.
   [[nodiscard]] bool linear_in_params() const override { return false; }
   void contribution(const SignatureRow& row, const AngleBasis& /*b*/, Values v, SignalValues& out) const override {
-    if (v[kOmegaN] > 0.0) out.rd += row.accel / (v[kOmegaN] * v[kOmegaN]);
+    const double omega_n = TrackingLoopParams(v)["omega_n"];
+    if (omega_n > 0.0) out.rd += row.accel / (omega_n * omega_n);
   }
 };
 

@@ -33,16 +33,16 @@ SinCos dsp_sample(const ForwardChain& chain, double theta_at_sin, double theta_a
 }
 
 TEST(EffectsSamplingSkew, ConstantSpeedIsExactlyQuadratureWithBetaOmegaTau) {
-  const SamplingSkew skew{2e-5};  // [s]
-  const ForwardChain skewed = forward_chain({{"sampling_skew", "tau", skew.tau}});
+  const SamplingSkewParams skew{{"tau", 2e-5}};  // [s]
+  const ForwardChain skewed = forward_chain({{"sampling_skew", "tau", skew["tau"]}});
   // The skew is the DSP's: its cos sample is tau late, the converter's input is not.
-  ASSERT_EQ(skewed.timing().dsp_cos_dt, skew.tau);
+  ASSERT_EQ(skewed.timing().dsp_cos_dt, skew["tau"]);
   ASSERT_EQ(skewed.timing().converter_cos_dt, 0.0);
   // Two resolver electrical speeds [rad/s]: 3 pole pairs at ~1000 and ~3000 r/min.
   double amplitude_slow = 0.0;
   double amplitude_fast = 0.0;
   for (const double omega : {314.0, 942.0}) {
-    const double beta = omega * skew.tau;
+    const double beta = omega * skew["tau"];
     const ForwardChain quad = forward_chain({{"quadrature", "beta", beta}});
     EXPECT_DOUBLE_EQ(sampling_skew_beta(skew, omega), beta);
     double max_residual = 0.0;
@@ -57,7 +57,7 @@ TEST(EffectsSamplingSkew, ConstantSpeedIsExactlyQuadratureWithBetaOmegaTau) {
       ASSERT_NEAR(s.c, q.c, 1e-12);
       const double eps = wrap_pi(theta - static_rd_angle(s));
       const double sig = sampling_skew_error(skew, theta, omega);
-      EXPECT_DOUBLE_EQ(sig, quadrature_error({beta}, theta));
+      EXPECT_DOUBLE_EQ(sig, quadrature_error({{"beta", beta}}, theta));
       max_residual = std::max(max_residual, std::abs(eps - sig));
       max_signature = std::max(max_signature, std::abs(sig));
     }
@@ -84,7 +84,8 @@ TEST(EffectsSamplingSkew, UnderAccelerationDiffersFromQuadratureByTauSquared) {
     const double omega = omega0 + accel * t;
     const double theta_later = omega0 * (t + tau) + 0.5 * accel * (t + tau) * (t + tau);
     const SinCos s = dsp_sample(skewed, theta, theta_later);
-    const SinCos q = forward_chain({{"quadrature", "beta", sampling_skew_beta({tau}, omega)}}).envelopes(theta);
+    const double beta = sampling_skew_beta({{"tau", tau}}, omega);
+    const SinCos q = forward_chain({{"quadrature", "beta", beta}}).envelopes(theta);
     max_diff = std::max(max_diff, std::abs(s.c - q.c));
   }
   // theta(t + tau) - (theta + omega(t) tau) = a tau^2 / 2 and cos is 1-Lipschitz.
@@ -94,8 +95,8 @@ TEST(EffectsSamplingSkew, UnderAccelerationDiffersFromQuadratureByTauSquared) {
 }
 
 TEST(EffectsSamplingSkew, CompensationRestoresTheAngle) {
-  const SamplingSkew skew{2e-5};  // [s]
-  const ForwardChain chain = forward_chain({{"sampling_skew", "tau", skew.tau}});
+  const SamplingSkewParams skew{{"tau", 2e-5}};  // [s]
+  const ForwardChain chain = forward_chain({{"sampling_skew", "tau", skew["tau"]}});
   const double omega = 942.0;
   double max_left = 0.0;
   for (int i = 0; i < 360; ++i) {
@@ -107,19 +108,20 @@ TEST(EffectsSamplingSkew, CompensationRestoresTheAngle) {
     // A 1 % speed error leaves c' = cos(theta) cos(beta)/cos(beta') + sin(theta) (sin beta' - sin beta)/cos beta':
     // a quadrature-like error of d_beta = beta' - beta (peak d_beta, plus its own O(d_beta^2) remainder) and a
     // gain error cos(beta)/cos(beta') - 1 <= beta d_beta (peak eps beta d_beta / 2).
-    const double beta = omega * skew.tau;
+    const double beta = omega * skew["tau"];
     const double d_beta = 0.01 * beta;
     const double left = wrap_pi(theta - static_rd_angle(compensate_sampling_skew(skew, sampled, 1.01 * omega)));
     EXPECT_LE(std::abs(left), d_beta * (1.0 + beta) + quadrature_bound(d_beta));
     max_left = std::max(max_left, std::abs(left));
   }
-  EXPECT_GT(max_left, 0.9 * 0.01 * omega * skew.tau) << "a wrong speed must leave an error";
+  EXPECT_GT(max_left, 0.9 * 0.01 * omega * skew["tau"]) << "a wrong speed must leave an error";
 }
 
 TEST(EffectsEccentricity, IsAOneTimesMechanicalError) {
-  const Eccentricity ecc{1e-3, 0.7};
+  const EccentricityParams ecc{{"e", 1e-3}, {"phase", 0.7}};
   const int p_r = 3;
-  ForwardChain chain = forward_chain({{"eccentricity", "e", ecc.e}, {"eccentricity", "phase", ecc.phase}}, p_r, 3);
+  ForwardChain chain =
+      forward_chain({{"eccentricity", "e", ecc["e"]}, {"eccentricity", "phase", ecc["phase"]}}, p_r, 3);
   // Through the whole envelope path and an ideal converter: eps = p_r eps_m exactly.
   double c1 = 0.0;
   double s1 = 0.0;
@@ -148,22 +150,22 @@ TEST(EffectsEccentricity, CompensationInvertsTheForwardModel) {
   std::uniform_real_distribution<double> angle(-20.0, 20.0);
   std::uniform_real_distribution<double> amp(-0.5, 0.5);
   for (int n = 0; n < 2000; ++n) {
-    const Eccentricity ecc{amp(rng), angle(rng)};
+    const EccentricityParams ecc{{"e", amp(rng)}, {"phase", angle(rng)}};
     const double theta_m = angle(rng);
     const double seen = eccentric_angle(ecc, theta_m);
     // The fixed-point iteration converges to rounding (|theta| <= 20: a few ulps of 20).
-    ASSERT_NEAR(compensate_eccentricity(ecc, seen), theta_m, 1e-13) << ecc.e;
+    ASSERT_NEAR(compensate_eccentricity(ecc, seen), theta_m, 1e-13) << ecc["e"];
     // The first-order inverse is wrong by |e (sin(seen + phase) - sin(theta_m + phase))| <= e^2.
-    const double first_order = seen - ecc.e * std::sin(seen + ecc.phase);
-    ASSERT_LE(std::abs(first_order - theta_m), ecc.e * ecc.e + 1e-13);
+    const double first_order = seen - ecc["e"] * std::sin(seen + ecc["phase"]);
+    ASSERT_LE(std::abs(first_order - theta_m), ecc["e"] * ecc["e"] + 1e-13);
   }
 }
 
 TEST(EffectsMountingOffset, ShiftsTheResolverAndRotatesTheCurrents) {
-  const MountingOffset mounting{0.1};  // [rad, motor electrical]
+  const MountingOffsetParams mounting{{"theta_0", 0.1}};  // [rad, motor electrical]
   const int p_r = 2;
   const int p = 4;
-  ForwardChain chain = forward_chain({{"mounting_offset", "theta_0", mounting.theta_0}}, p_r, p);
+  ForwardChain chain = forward_chain({{"mounting_offset", "theta_0", mounting["theta_0"]}}, p_r, p);
   const double i_q = 10.0;
   for (int i = 0; i < 72; ++i) {
     const double theta_m = kTwoPi * (i + 0.3) / 72.0;

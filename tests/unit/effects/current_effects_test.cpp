@@ -81,7 +81,7 @@ void expect_only(const Spectrum& s, int order, DqCurrents mean, DqCurrents ampli
 
 TEST(EffectsCurrentOffsets, RippleAtOneTimesThetaE) {
   for (const auto& [off_a, off_b] : {std::pair{0.05, -0.03}, std::pair{0.0, 0.1}, std::pair{-0.2, 0.0}}) {
-    const CurrentOffsets offsets{off_a, off_b};
+    const CurrentOffsetsParams offsets{{"off_a", off_a}, {"off_b", off_b}};
     const ForwardChain chain = forward_chain({{"current_offsets", "off_a", off_a}, {"current_offsets", "off_b", off_b}});
     const double i_d = -2.0;
     const double i_q = 10.0;
@@ -114,7 +114,7 @@ TEST(EffectsCurrentGainMismatch, RippleAtTwoTimesThetaE) {
   };
   for (const Case& c : {Case{0.01, 0.0, 0.0, 10.0}, Case{0.0, -0.02, 0.0, 10.0}, Case{0.01, 0.01, -3.0, 8.0},
                         Case{0.02, -0.01, 5.0, 0.0}}) {
-    const CurrentGainMismatch gains{c.gain_a, c.gain_b};
+    const CurrentGainMismatchParams gains{{"gain_a", c.gain_a}, {"gain_b", c.gain_b}};
     const ForwardChain chain =
         forward_chain({{"current_gain_mismatch", "gain_a", c.gain_a}, {"current_gain_mismatch", "gain_b", c.gain_b}});
     const auto measured = [&](double theta_e) { return measured_currents(chain, c.i_d, c.i_q, theta_e); };
@@ -147,10 +147,10 @@ TEST(EffectsDeadTime, FifthAndSeventhGiveRippleAtSixTimesThetaE) {
   for (const auto& current : {std::pair{0.0, 10.0}, std::pair{-4.0, 6.0}, std::pair{5.0, 0.0}}) {
     const double i_d = current.first;  // [A] (locals, not a structured binding: lambdas capture them)
     const double i_q = current.second;
-    const DeadTime dead{2e-6};  // [s] -> k_dt = 0.02
-    const ForwardChain chain = forward_chain({{"dead_time", "t_d", dead.t_d}});
+    const DeadTimeParams dead{{"t_d", 2e-6}};  // [s] -> k_dt = 0.02
+    const ForwardChain chain = forward_chain({{"dead_time", "t_d", dead["t_d"]}});
     const double k = 2e-6 / 100e-6;
-    EXPECT_DOUBLE_EQ(dead.k_dt(), k);
+    EXPECT_DOUBLE_EQ(dead_time_k_dt(dead), k);
     const auto measured = [&](double theta_e) { return measured_currents(chain, i_d, i_q, theta_e); };
     // Header: delta i_d = 2 k i_q cos(6(theta_e + delta)), delta i_q = -2 k i_d cos(...).
     expect_only(dq_spectrum(measured), 6, {i_d, i_q}, {2.0 * k * std::abs(i_q), 2.0 * k * std::abs(i_d)});

@@ -52,7 +52,8 @@ TEST(EffectsSignatures, IdealChainHasNoError) {
 TEST(EffectsSignatures, AmplitudeImbalanceMatchesHanselmanEq5) {
   for (const double alpha : {-0.05, -0.01, 0.003, 0.01, 0.05}) {
     const ForwardChain chain = forward_chain({{"amplitude_imbalance", "alpha", alpha}});
-    const Residual r = residual(chain, [&](double theta) { return amplitude_imbalance_error({alpha}, theta); });
+    const Residual r =
+        residual(chain, [&](double theta) { return amplitude_imbalance_error({{"alpha", alpha}}, theta); });
     // Exact: tan(phi) = tan(theta)/(1+alpha) gives
     //   eps = -sum_k q^k/k sin(2k theta), q = -alpha/(2+alpha),
     // so eps - (alpha/2) sin 2theta is bounded by the change of the first term,
@@ -76,15 +77,15 @@ TEST(EffectsSignatures, QuadratureSignMatchesExactModel) {
   const ForwardChain chain = forward_chain({{"quadrature", "beta", beta}});
   const double theta = 0.5 * std::numbers::pi;
   EXPECT_NEAR(exact_error(chain, theta), -std::atan(std::sin(beta)), 1e-15);
-  EXPECT_NEAR(quadrature_error({beta}, theta), -beta, 1e-15);
+  EXPECT_NEAR(quadrature_error({{"beta", beta}}, theta), -beta, 1e-15);
   // atan(sin beta) = beta - beta^3/2 + ...: the signature is right to third order here.
-  EXPECT_NEAR(exact_error(chain, theta), quadrature_error({beta}, theta), beta * beta * beta);
+  EXPECT_NEAR(exact_error(chain, theta), quadrature_error({{"beta", beta}}, theta), beta * beta * beta);
 }
 
 TEST(EffectsSignatures, QuadratureMatchesHanselmanEq7) {
   for (const double beta : {-0.03, -0.004, 0.004, 0.01, 0.03}) {
     const ForwardChain chain = forward_chain({{"quadrature", "beta", beta}});
-    const Residual r = residual(chain, [&](double theta) { return quadrature_error({beta}, theta); });
+    const Residual r = residual(chain, [&](double theta) { return quadrature_error({{"beta", beta}}, theta); });
     // phi(beta) = atan2(sin theta, cos(theta + beta)); d phi/d beta = N/D with
     // N = sin theta sin(theta+beta), D = sin^2 theta + cos^2(theta+beta) = 1 - sin(2theta+beta) sin beta.
     // |N|, |N'|, |D'| <= 1, 1-|beta| <= D <= 1+|beta|, so |phi''| <= (2+|beta|)/(1-|beta|)^2 and the
@@ -102,7 +103,8 @@ TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
     const double o_s = offsets.first;  // (locals, not a structured binding: the lambda captures them)
     const double o_c = offsets.second;
     const ForwardChain chain = forward_chain({{"offsets", "o_s", o_s}, {"offsets", "o_c", o_c}});
-    const Residual r = residual(chain, [&](double theta) { return offsets_error({o_s, o_c}, theta); });
+    const Residual r =
+        residual(chain, [&](double theta) { return offsets_error({{"o_s", o_s}, {"o_c", o_c}}, theta); });
     const double bound = atan2_second_order_bound(std::hypot(o_s, o_c));
     EXPECT_LE(r.max_residual, bound) << o_s << "," << o_c;
     EXPECT_LT(bound, 0.05 * r.max_signature);
@@ -113,11 +115,7 @@ TEST(EffectsSignatures, OffsetsMatchFirstOrderAtan2) {
 TEST(EffectsSignatures, HarmonicsMatchHanselmanEq9) {
   const ForwardChain chain = forward_chain(
       {{"harmonics", "k0", 0.002}, {"harmonics", "k2", -0.001}, {"harmonics", "k3", 0.0015}, {"harmonics", "k7", 0.0005}});
-  Harmonics h;
-  h.k0 = 0.002;
-  h.k[2] = -0.001;
-  h.k[3] = 0.0015;
-  h.k[7] = 0.0005;
+  const HarmonicsParams h{{"k0", 0.002}, {"k2", -0.001}, {"k3", 0.0015}, {"k7", 0.0005}};
   const Residual r = residual(chain, [&](double theta) { return harmonics_error(h, theta); });
   // The harmonic part is an additive perturbation of length <= sqrt2 (|K_0| + sum |K_n|);
   // Hanselman eq. 9 is exactly its first-order atan2 term.
@@ -133,8 +131,8 @@ TEST(EffectsSignatures, OppositeSequenceHarmonicsLandOnNPlusOne) {
   for (const auto& [name, order] : {std::pair{"k3_opp", 3}, std::pair{"k2_opp", 2}}) {
     const double k = 0.002;
     const ForwardChain chain = forward_chain({{"harmonics", name, k}});
-    Harmonics h;
-    h.k_opp[static_cast<std::size_t>(order)] = k;
+    HarmonicsParams h;
+    h[harmonic_keys(order).opp] = k;
     const Residual r = residual(chain, [&](double theta) { return harmonics_error(h, theta); });
     EXPECT_LE(r.max_residual, atan2_second_order_bound(std::numbers::sqrt2 * k)) << name;
     // The grid's largest |sin((n + 1) theta)| is at least cos((n + 1) pi / kGrid): within 1e-5 relative.
@@ -146,11 +144,10 @@ TEST(EffectsSignatures, OppositeSequenceHarmonicsLandOnNPlusOne) {
 
 TEST(EffectsSignatures, K3LandsOnTwoThetaLikeAlpha) {
   // Hanselman eq. 8-9: K_3 and alpha both give a 2theta error; K_3 = -alpha/2 mimics alpha to first order.
-  Harmonics k3;
-  k3.k[3] = -0.002;
+  const HarmonicsParams k3{{"k3", -0.002}};
   for (int i = 0; i < 64; ++i) {
     const double theta = kTwoPi * i / 64.0;
-    EXPECT_NEAR(amplitude_imbalance_error({0.004}, theta), harmonics_error(k3, theta), 1e-15);
+    EXPECT_NEAR(amplitude_imbalance_error({{"alpha", 0.004}}, theta), harmonics_error(k3, theta), 1e-15);
   }
   // ...but the envelopes differ at first order: the effects are told apart there.
   const SinCos a = forward_chain({{"amplitude_imbalance", "alpha", 0.004}}).envelopes(0.3);
@@ -169,11 +166,12 @@ TEST(EffectsSignatures, EnvelopeDriftScalesTheRadiusAndNoAngle) {
         const double theta = kTwoPi * (i + 0.37) / 360.0;
         const SinCos sc = chain.envelopes(theta, t);
         ASSERT_NEAR(wrap_pi(theta - std::atan2(sc.s, sc.c)), 0.0, 1e-15) << "g=" << g << " t=" << t;
-        ASSERT_NEAR(std::hypot(sc.s, sc.c) - 1.0, envelope_drift_radius({g}, t), 1e-15) << "g=" << g << " t=" << t;
+        ASSERT_NEAR(std::hypot(sc.s, sc.c) - 1.0, envelope_drift_radius({{"g", g}}, t), 1e-15)
+            << "g=" << g << " t=" << t;
       }
     }
     // The radius moves by g t: at t = 3 s that is 3|g|, far above the rounding bound above.
-    EXPECT_NEAR(envelope_drift_radius({g}, 3.0), 3.0 * g, 1e-18);
+    EXPECT_NEAR(envelope_drift_radius({{"g", g}}, 3.0), 3.0 * g, 1e-18);
   }
   // Common to both channels: with an imbalance the angle error is the imbalance's alone
   // at every time (the drift scales s and (1 + alpha) c alike), and the gain multiplies
@@ -207,14 +205,12 @@ TEST(EffectsSignatures, ComposedChainSuperposesToFirstOrder) {
                                             {"offsets", "o_c", -0.0015},
                                             {"harmonics", "k0", 0.0005},
                                             {"harmonics", "k3", 0.0008}});
-  Harmonics h;
-  h.k0 = 0.0005;
-  h.k[3] = 0.0008;
+  const HarmonicsParams h{{"k0", 0.0005}, {"k3", 0.0008}};
   // The first-order error of the composed chain is the sum of the individual
   // effects' signatures (what the deleted small_signal_error summed).
   const auto first_order = [&](double theta) {
-    return amplitude_imbalance_error({0.003}, theta) + quadrature_error({0.002}, theta) +
-           offsets_error({0.001, -0.0015}, theta) + harmonics_error(h, theta);
+    return amplitude_imbalance_error({{"alpha", 0.003}}, theta) + quadrature_error({{"beta", 0.002}}, theta) +
+           offsets_error({{"o_s", 0.001}, {"o_c", -0.0015}}, theta) + harmonics_error(h, theta);
   };
   const Residual r = residual(chain, first_order);
   // Perturbation of the envelopes from the unit circle: d = d_lin + d_2 with

@@ -100,7 +100,7 @@ TEST(SimEffects, SamplingSkewReachesTheSampledAngleOnlyAndGrowsWithSpeed) {
     double peak = 0.0;
     for (const SimSample& s : run(c)) {
       const double eps_sc = wrap_pi(s.theta - std::atan2(s.sin_counts, s.cos_counts));
-      ASSERT_NEAR(eps_sc, sampling_skew_error({tau}, s.theta, omega), tol) << s.index;
+      ASSERT_NEAR(eps_sc, sampling_skew_error({{"tau", tau}}, s.theta, omega), tol) << s.index;
       // The R/D converter does not see the skew: half a 16-bit LSB.
       ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), 0.0, 0.5 * quantization_lsb(16) + 1e-12) << s.index;
       peak = std::max(peak, std::abs(eps_sc));
@@ -138,7 +138,7 @@ TEST(SimEffects, EnvelopeDriftScalesBothChannelsInTimeAndNoAngle) {
 TEST(SimEffects, EccentricityIsOneTimesMechanicalInBothAngles) {
   SimConfig c = quiet(200.0, 0.6);  // two mechanical turns
   c.chain.apply_spec("eccentricity:e=1e-3,phase=0.4");
-  const Eccentricity ecc{1e-3, 0.4};
+  const EccentricityParams ecc(c.chain.of(eccentricity_effect()));
   double peak = 0.0;
   for (const SimSample& s : run(c)) {
     const double expected = c.p_r * eccentricity_error(ecc, s.theta_m);
@@ -167,7 +167,7 @@ TEST(SimEffects, MountingOffsetGivesSteadyIdInTheReferenceFrameOnly) {
     // Drive frame: rounding plus |I| times half a 16-bit LSB of angle.
     const DqCurrents drive = sample_dq(s, s.rd_angle);
     ASSERT_NEAR(drive.d, 0.0, kDqRound + c.i_q_cmd * 0.5 * quantization_lsb(16)) << s.index;
-    ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), mounting_offset_error({0.2}, c.p_r, c.p),
+    ASSERT_NEAR(wrap_pi(s.theta - s.rd_angle), mounting_offset_error({{"theta_0", 0.2}}, c.p_r, c.p),
                 0.5 * quantization_lsb(16) + 1e-9);
   }
 }
@@ -198,15 +198,15 @@ TEST(SimEffects, CurrentEffectsRippleAtTheirOrders) {
     const ChainValues& v = c.chain;
     DqCurrents want{};
     if (k.order == 1) {
-      const CurrentOffsets off{v.get("current_offsets", "off_a"), v.get("current_offsets", "off_b")};
+      const CurrentOffsetsParams off(v.of(current_offsets_effect()));
       want = {current_offsets_ripple_1x(off), current_offsets_ripple_1x(off)};
     }
     if (k.order == 2) {
-      const CurrentGainMismatch g{v.get("current_gain_mismatch", "gain_a"), v.get("current_gain_mismatch", "gain_b")};
+      const CurrentGainMismatchParams g(v.of(current_gain_mismatch_effect()));
       const double a = current_gain_mismatch_ripple_2x(g, c.i_d_cmd, c.i_q_cmd);
       want = {a, a};
     }
-    if (k.order == 6) want = dead_time_ripple_6x(DeadTime{v.get("dead_time", "t_d")}, c.i_d_cmd, c.i_q_cmd);
+    if (k.order == 6) want = dead_time_ripple_6x(DeadTimeParams(v.of(dead_time_effect())), c.i_d_cmd, c.i_q_cmd);
     for (int h = 1; h < 8; ++h) {
       const auto i = static_cast<std::size_t>(h);
       const DqCurrents expect = h == k.order ? want : DqCurrents{};

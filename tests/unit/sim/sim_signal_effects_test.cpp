@@ -53,7 +53,8 @@ TEST(SimChannelDelay, RdAngleShowsQuadratureMinusOmegaTauUnlikeSamplingSkew) {
         // The converter sees the delayed cos too: the exact quadrature error, and
         // to first order (omega tau / 2)(1 - cos 2theta) (channel_delay.h).
         ASSERT_NEAR(eps_rd, test::exact_error(quad, s.theta), kHalfLsb + 1e-12) << s.index;
-        ASSERT_NEAR(eps_rd, quadrature_error({beta}, s.theta), kHalfLsb + quadrature_remainder_bound(beta)) << s.index;
+        ASSERT_NEAR(eps_rd, quadrature_error({{"beta", beta}}, s.theta), kHalfLsb + quadrature_remainder_bound(beta))
+            << s.index;
       } else {
         // The converter has its own analog front end: no error at all.
         ASSERT_NEAR(eps_rd, 0.0, kHalfLsb + 1e-12) << s.index;
