@@ -23,6 +23,7 @@ done
 # resolver-accuracy, their man pages and the Python package resolver_lcm.
 PROGRAM_PACKAGES=(
   build-essential cmake g++ pkg-config git
+  ca-certificates  # the build downloads uPlot over HTTPS (tools/model/web/fetch_locked_package.py)
   liblcm-dev liblcm-bin  # liblcm-bin: lcm-gen, run at build time (proto/, tools/python)
   libeigen3-dev libcli11-dev libtomlplusplus-dev libfmt-dev
   libmuparser-dev  # [[model.custom]] effects: expressions users write (daemon/core/model/custom_effect.h)
