@@ -1,0 +1,81 @@
+#!/usr/bin/python3
+"""The one error rule (issue 22 item 3, docs/ARCHITECTURE.md §9): each library error
+that used to come back as a value (a variant, an optional message, an out-parameter)
+is now a typed exception, and the program's one mapping gives it its documented exit
+code and one line "PROGRAM: WHERE: WHAT" (README: exit codes). Each case runs the
+real program:
+
+  BadDbc        a [layout] dbc with a syntax error: resolverd exits 2 naming the DBC
+                file and line (was parse_dbc's variant, mapped by hand in pipeline.cpp)
+
+  test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
+"""
+import argparse
+import os
+import subprocess
+import sys
+import unittest
+
+ARGS = None
+USAGE, IO = 2, 3  # README: 2 usage or configuration error, 3 I/O error
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, errors="replace", **kw)
+
+
+def work(name):
+    return os.path.join(ARGS.work, name)
+
+
+def write(name, text):
+    path = work(name)
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+_LOG = None
+
+
+def sim_log():
+    """A short resolver-sim candump log, made once."""
+    global _LOG
+    if _LOG is None:
+        _LOG = work("rule.log")
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", _LOG, "--duration", "0.5", "--seed", "5"])
+        if p.returncode != 0:
+            raise AssertionError(f"resolver-sim failed ({p.returncode}): {p.stderr}")
+    return _LOG
+
+
+def resolverd(*extra):
+    return run([f"{ARGS.bin}/resolverd", "--replay", sim_log(), "--once", "--fast", "--quiet", "--lcm", "memq://",
+                *extra])
+
+
+class BadDbc(unittest.TestCase):
+    def test_syntax_error_names_file_and_line(self):
+        dbc = write("broken.dbc", 'VERSION ""\n\nBO_ 256 RESOLVER_SAMPLE 8 RD\n')  # no ':' after the name
+        cfg = write("broken_dbc.toml", f'[layout]\ndbc = "{dbc}"\n')
+        p = resolverd("--config", cfg)
+        self.assertEqual(p.returncode, USAGE, p.stderr)
+        self.assertEqual(p.stderr.count("\n"), 1, p.stderr)
+        self.assertRegex(p.stderr, rf"^resolverd: {dbc}:3: expected ':'")
+
+    def test_control_the_bundled_dbc_copied_is_read(self):
+        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        with open(os.path.join(root, "proto", "resolver_bench.dbc")) as f:
+            dbc = write("copy.dbc", f.read())
+        cfg = write("copy_dbc.toml", f'[layout]\ndbc = "{dbc}"\n')
+        p = resolverd("--config", cfg)
+        self.assertEqual(p.returncode, 0, p.stderr)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--bin", required=True)
+    parser.add_argument("--work", required=True)
+    ARGS, rest = parser.parse_known_args()
+    os.makedirs(ARGS.work, exist_ok=True)
+    unittest.main(argv=[sys.argv[0]] + rest, verbosity=2)
