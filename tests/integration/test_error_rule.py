@@ -7,10 +7,17 @@ real program:
 
   BadDbc        a [layout] dbc with a syntax error: resolverd exits 2 naming the DBC
                 file and line (was parse_dbc's variant, mapped by hand in pipeline.cpp)
+  LockedStateDir  a --state-dir another process holds the lock of: resolverd exits 3
+                naming the directory and the holder's pid (was StateDirLock::acquire's
+                out-parameter, printed and mapped by hand in main)
+  Unreadable    a [layout] dbc that is not there: resolverd exits 3 naming the config
+                and the DBC (was exit_code::unreadable's optional message, mapped by
+                hand in every main)
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
 import argparse
+import fcntl
 import os
 import subprocess
 import sys
@@ -70,6 +77,36 @@ class BadDbc(unittest.TestCase):
         cfg = write("copy_dbc.toml", f'[layout]\ndbc = "{dbc}"\n')
         p = resolverd("--config", cfg)
         self.assertEqual(p.returncode, 0, p.stderr)
+
+
+class LockedStateDir(unittest.TestCase):
+    def test_a_held_lock_is_exit_3_naming_the_holder(self):
+        state = work("locked_state")
+        os.makedirs(state, exist_ok=True)
+        with open(os.path.join(state, "resolverd.lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)  # flock(2), as resolverd takes it
+            lock.write("4242\n")
+            lock.flush()
+            p = resolverd("--state-dir", state)
+        self.assertEqual(p.returncode, IO, p.stderr)
+        self.assertEqual(p.stderr.count("\n"), 1, p.stderr)
+        self.assertRegex(p.stderr, rf"^resolverd: cannot use --state-dir {state}: it is in use by another resolverd, "
+                                   r"pid 4242 ")
+
+    def test_control_the_released_lock_is_taken(self):
+        state = work("free_state")
+        os.makedirs(state, exist_ok=True)
+        p = resolverd("--state-dir", state)
+        self.assertEqual(p.returncode, 0, p.stderr)
+
+
+class Unreadable(unittest.TestCase):
+    def test_missing_dbc_names_the_config_and_the_file(self):
+        dbc = work("absent.dbc")
+        cfg = write("absent_dbc.toml", f'[layout]\ndbc = "{dbc}"\n')
+        p = resolverd("--config", cfg)
+        self.assertEqual(p.returncode, IO, p.stderr)
+        self.assertEqual(p.stderr, f"resolverd: {cfg}: cannot read [layout] dbc {dbc}: No such file or directory\n")
 
 
 if __name__ == "__main__":

@@ -116,18 +116,13 @@ void add_echo_options(CLI::App& app, EchoArguments& a) {
       ->needs(log_opt);
 }
 
-/// No input, or a --log that cannot be read: its exit code, after the message.
+/// No input: its exit code, after the message. A --log that cannot be read throws IoError.
 std::optional<int> check_input(const EchoArguments& a) {
   if (!a.list_types && a.log_path.empty() && a.lcm_url.empty()) {
     std::cerr << "resolver-echo: give --log FILE or --lcm URL (or --list-types); see --help\n";
     return exit_code::kUsage;
   }
-  if (!a.log_path.empty()) {
-    if (auto problem = exit_code::unreadable("--log", a.log_path)) {
-      std::cerr << "resolver-echo: " << *problem << '\n';
-      return exit_code::kIo;
-    }
-  }
+  if (!a.log_path.empty()) exit_code::require_readable("--log", a.log_path);  // IoError: exit 3
   return std::nullopt;
 }
 

@@ -309,7 +309,7 @@ int run(int argc, char** argv) {
   }
   std::vector<std::string> toml_effects;
   if (!o.config_file.empty()) {
-    if (auto problem = resolver::exit_code::unreadable("--config", o.config_file)) fail(*problem, resolver::exit_code::kIo);
+    resolver::exit_code::require_readable("--config", o.config_file);  // IoError: exit 3
     apply_toml(o.config_file, app, o, toml_effects);
   }
   if (o.out.empty()) fail("--out FILE is required (the candump log to write); see --help");
