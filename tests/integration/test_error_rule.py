@@ -13,6 +13,11 @@ real program:
   Unreadable    a [layout] dbc that is not there: resolverd exits 3 naming the config
                 and the DBC (was exit_code::unreadable's optional message, mapped by
                 hand in every main)
+  CsvColumns    a CSV export without a column [input.csv.columns] names: resolverd and
+                resolver-model exit 2 naming the file, its column-name line and the
+                option (was RowDecoder::bind's optional message)
+  CsvTime       a time column coarser than the rows: exit 2 naming the file and the
+                lines checked (was RowDecoder::check_time_resolution's optional message)
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -107,6 +112,59 @@ class Unreadable(unittest.TestCase):
         p = resolverd("--config", cfg)
         self.assertEqual(p.returncode, IO, p.stderr)
         self.assertEqual(p.stderr, f"resolverd: {cfg}: cannot read [layout] dbc {dbc}: No such file or directory\n")
+
+
+CSV_TOML = """[bench]
+p_r = 1
+p = 4
+[input.csv]
+delimiter = ","
+time_column = "t"
+time_unit = "s"
+[input.csv.columns]
+rd_angle = { column = "%s", unit = "deg" }
+"""
+
+
+def csv_export(name, time_format, rows=300, rate_hz=1000.0):
+    """A CSV export "t,rd" of a turning rotor, one row every 1/rate_hz s."""
+    lines = ["t,rd"] + [(time_format + ",%.3f") % (k / rate_hz, (k * 3.6) % 360) for k in range(rows)]
+    return write(name, "\n".join(lines) + "\n")
+
+
+def both_programs(log, cfg):
+    """resolverd --replay and resolver-model fit on `log` with `cfg`: their results."""
+    return (resolverd_on(log, "--config", cfg),
+            run([f"{ARGS.bin}/resolver-model", "fit", log, "--config", cfg]))
+
+
+def resolverd_on(log, *extra):
+    return run([f"{ARGS.bin}/resolverd", "--replay", log, "--once", "--fast", "--quiet", "--lcm", "memq://", *extra])
+
+
+class CsvColumns(unittest.TestCase):
+    def test_missing_column_names_file_line_and_option(self):
+        log = csv_export("columns.csv", "%.6f")
+        cfg = write("columns.toml", CSV_TOML % "Resolver")
+        for p in both_programs(log, cfg):
+            self.assertEqual(p.returncode, USAGE, p.stderr)
+            self.assertIn(f"{log}:1: [input.csv.columns]: rd_angle: no column named 'Resolver' "
+                          "(the columns are 't', 'rd')", p.stderr)
+
+    def test_control_the_right_name_is_read(self):
+        log = csv_export("columns_ok.csv", "%.6f")
+        cfg = write("columns_ok.toml", CSV_TOML % "rd")
+        p = resolverd_on(log, "--config", cfg)
+        self.assertEqual(p.returncode, 0, p.stderr)
+
+
+class CsvTime(unittest.TestCase):
+    def test_coarse_time_column_names_file_and_lines(self):
+        log = csv_export("coarse.csv", "%.2f")  # 0.01 s at 1 kHz: nine rows in ten repeat a time
+        cfg = write("coarse.toml", CSV_TOML % "rd")
+        for p in both_programs(log, cfg):
+            self.assertEqual(p.returncode, USAGE, p.stderr)
+            self.assertRegex(p.stderr, rf"{log}:2-\d+: column 't' \(time\): \d+ of the first \d+ rows repeat")
 
 
 if __name__ == "__main__":
