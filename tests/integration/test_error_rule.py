@@ -18,6 +18,9 @@ real program:
                 option (was RowDecoder::bind's optional message)
   CsvTime       a time column coarser than the rows: exit 2 naming the file and the
                 lines checked (was RowDecoder::check_time_resolution's optional message)
+  Unloggable    resolver-sim --iface with a blank: exit 2 naming the log and the line the
+                first frame would have taken (was check_loggable's optional message,
+                wrapped by hand in a std::invalid_argument)
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -165,6 +168,22 @@ class CsvTime(unittest.TestCase):
         for p in both_programs(log, cfg):
             self.assertEqual(p.returncode, USAGE, p.stderr)
             self.assertRegex(p.stderr, rf"{log}:2-\d+: column 't' \(time\): \d+ of the first \d+ rows repeat")
+
+
+class Unloggable(unittest.TestCase):
+    def test_interface_with_a_blank_names_the_log_and_line(self):
+        out = work("iface.log")
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", out, "--duration", "0.1", "--iface", "can 0"])
+        self.assertEqual(p.returncode, USAGE, p.stderr)
+        self.assertEqual(p.stderr, f"resolver-sim: {out}:1: cannot log this frame: interface name 'can 0' contains a "
+                                   "blank or control character\n")
+
+    def test_control_a_plain_interface_is_logged(self):
+        out = work("iface_ok.log")
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", out, "--duration", "0.1", "--iface", "vcan1"])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(out) as f:
+            self.assertIn(" vcan1 ", f.readline())
 
 
 if __name__ == "__main__":
