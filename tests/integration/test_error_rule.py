@@ -21,6 +21,8 @@ real program:
   Unloggable    resolver-sim --iface with a blank: exit 2 naming the log and the line the
                 first frame would have taken (was check_loggable's optional message,
                 wrapped by hand in a std::invalid_argument)
+  BadProfile    resolver-sim --profile with a bad segment: exit 2 naming the option and
+                the segment (was parse_speed_profile's optional message)
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -184,6 +186,22 @@ class Unloggable(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         with open(out) as f:
             self.assertIn(" vcan1 ", f.readline())
+
+
+class BadProfile(unittest.TestCase):
+    def test_bad_segment_names_option_and_segment(self):
+        out = work("profile.log")
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", out, "--profile", "200:0.1,abc:0.1"])
+        self.assertEqual(p.returncode, USAGE, p.stderr)
+        self.assertEqual(p.stderr.count("\n"), 1, p.stderr)
+        self.assertRegex(p.stderr, r"^resolver-sim: --profile: '200:0.1,abc:0.1': segment 'abc:0.1' has a bad start "
+                                   r"speed \[r/min\]; write rpm")
+        self.assertFalse(os.path.exists(out), "nothing is simulated with a bad profile")
+
+    def test_control_a_good_profile_is_simulated(self):
+        out = work("profile_ok.log")
+        p = run([f"{ARGS.bin}/resolver-sim", "--out", out, "--profile", "200:0.1,200-400:0.1"])
+        self.assertEqual(p.returncode, 0, p.stderr)
 
 
 if __name__ == "__main__":

@@ -175,7 +175,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
     fail("--duration applies to --rpm; with --profile each segment carries its own seconds (rpm:seconds)");
   }
   if (!o.profile_text.empty()) {
-    if (auto err = resolver::parse_speed_profile(o.profile_text, c.profile)) fail(*err);
+    c.profile = resolver::parse_speed_profile(o.profile_text);  // InputError: exit 2
   } else if (rpm_given) {
     c.profile = {{o.duration, o.rpm, o.rpm}};
   }
