@@ -23,6 +23,8 @@ real program:
                 wrapped by hand in a std::invalid_argument)
   BadProfile    resolver-sim --profile with a bad segment: exit 2 naming the option and
                 the segment (was parse_speed_profile's optional message)
+  LcmUrl        resolver-echo --lcm with a URL LCM cannot open: exit 3 naming the option
+                and the URL (was LiveEchoResult::error, printed by hand in main)
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -202,6 +204,18 @@ class BadProfile(unittest.TestCase):
         out = work("profile_ok.log")
         p = run([f"{ARGS.bin}/resolver-sim", "--out", out, "--profile", "200:0.1,200-400:0.1"])
         self.assertEqual(p.returncode, 0, p.stderr)
+
+
+class LcmUrl(unittest.TestCase):
+    def test_unknown_provider_is_exit_3_naming_the_url(self):
+        p = run([f"{ARGS.bin}/resolver-echo", "--lcm", "nosuch://x", "--count", "1", "--timeout", "1"], timeout=60)
+        self.assertEqual(p.returncode, IO, p.stderr)
+        self.assertIn("resolver-echo: --lcm nosuch://x: the LCM instance failed to initialize", p.stderr)
+
+    def test_control_memq_times_out_with_no_message(self):
+        p = run([f"{ARGS.bin}/resolver-echo", "--lcm", "memq://", "--count", "1", "--timeout", "0.2"], timeout=60)
+        self.assertEqual(p.returncode, 1, p.stderr)  # README: 1, the input had no usable data
+        self.assertIn("--timeout 0.2 s expired after 0 of --count 1 messages", p.stderr)
 
 
 if __name__ == "__main__":

@@ -194,11 +194,8 @@ int echo_live(const EchoArguments& a, const resolver::LcmJsonDecoder& decoder, c
     print_line(line);
     std::fflush(stdout);  // live output is watched or piped: do not sit in a buffer
   });
-  const auto result = live.run(a.count, timeout);
-  if (!result.error.empty()) {
-    std::cerr << "resolver-echo: --lcm " << a.lcm_url << ": " << result.error << '\n';
-    return exit_code::kIo;
-  }
+  // LCM or the output failing throws IoError "--lcm URL: ...": exit 3.
+  const auto result = live.run(a.count, timeout, resolver::Where::at_option("--lcm " + a.lcm_url));
   if (a.count && result.emitted < *a.count) {
     std::cerr << fmt::format("resolver-echo: --timeout {} s expired after {} of --count {} messages\n", *a.timeout_s,
                              result.emitted, *a.count);
