@@ -25,6 +25,9 @@ real program:
                 the segment (was parse_speed_profile's optional message)
   LcmUrl        resolver-echo --lcm with a URL LCM cannot open: exit 3 naming the option
                 and the URL (was LiveEchoResult::error, printed by hand in main)
+  EchoMapping   resolver-echo's errors its main caught and mapped by hand: a bad .lcm
+                in --types (exit 2, file and line), a bad --channel regex (exit 2),
+                --csv into a folder that cannot be made (exit 3, "--csv: cannot write")
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -216,6 +219,50 @@ class LcmUrl(unittest.TestCase):
         p = run([f"{ARGS.bin}/resolver-echo", "--lcm", "memq://", "--count", "1", "--timeout", "0.2"], timeout=60)
         self.assertEqual(p.returncode, 1, p.stderr)  # README: 1, the input had no usable data
         self.assertIn("--timeout 0.2 s expired after 0 of --count 1 messages", p.stderr)
+
+
+_LCMLOG = None
+
+
+def lcm_log():
+    """resolverd's LCM log of the short candump log (file:// URL), made once."""
+    global _LCMLOG
+    if _LCMLOG is None:
+        _LCMLOG = work("rule.lcmlog")
+        p = run([f"{ARGS.bin}/resolverd", "--replay", sim_log(), "--once", "--fast", "--quiet",
+                 "--lcm", f"file://{_LCMLOG}?mode=w"])
+        if p.returncode != 0:
+            raise AssertionError(f"resolverd writing {_LCMLOG} failed ({p.returncode}): {p.stderr}")
+    return _LCMLOG
+
+
+class EchoMapping(unittest.TestCase):
+    def test_bad_lcm_type_file_is_exit_2_naming_it(self):
+        types = work("types")
+        os.makedirs(types, exist_ok=True)
+        bad = write(os.path.join("types", "bad.lcm"), "package x;\nstruct broken {\n  int32_t ;\n}\n")
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--types", types, "--limit", "1"])
+        self.assertEqual(p.returncode, USAGE, p.stderr)
+        self.assertIn(f"resolver-echo: {bad}:3", p.stderr)
+
+    def test_bad_channel_regex_is_exit_2(self):
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--channel", "RESOLVER_(", "--limit", "1"])
+        self.assertEqual(p.returncode, USAGE, p.stderr)
+        self.assertEqual(p.stderr.count("\n"), 1, p.stderr)
+        self.assertIn("RESOLVER_(", p.stderr)
+
+    def test_csv_into_a_folder_that_cannot_be_made_is_exit_3(self):
+        blocker = write("csv_blocker", "a file where the folder's parent should be\n")
+        out = os.path.join(blocker, "tables")
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--csv", out])
+        self.assertEqual(p.returncode, IO, p.stderr)
+        self.assertRegex(p.stderr, rf"^resolver-echo: --csv: cannot write {out}: ")
+
+    def test_control_csv_tables_are_written(self):
+        out = work("tables")
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--csv", out])
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn("wrote ", p.stdout)
 
 
 if __name__ == "__main__":
