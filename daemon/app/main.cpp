@@ -394,7 +394,9 @@ static int run(int argc, char** argv) {
   // Held for the whole run (see state_dir_lock.h); taken before anything is read from the directory.
   std::optional<StateDirLock> state_lock;
   if (!o.state_dir.empty()) state_lock = StateDirLock::acquire(o.state_dir);  // IoError: exit 3
-  if (!config.dbc_path.empty()) exit_code::require_readable("[layout] dbc", config.dbc_path, Where::at_file(config_path));
+  if (!config.dbc_path.empty()) {
+    exit_code::require_readable("[layout] dbc", config.dbc_path, Where::at_file(config_path));  // IoError: exit 3
+  }
 
   // LCM that cannot start throws std::system_error (exit 3); a DBC or signal map that
   // does not fit, ConfigError or std::invalid_argument (exit 2).

@@ -42,7 +42,8 @@ StateDirLock StateDirLock::acquire(const std::string& dir) {
   // O_NONBLOCK: a FIFO put there must not hold the start up; it is refused below.
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NONBLOCK | O_NOFOLLOW, 0644);
   if (fd < 0) {
-    throw IoError("cannot use --state-dir " + dir + ": opening the lock file " + path + " failed: " + std::strerror(errno) +
+    throw IoError("cannot use --state-dir " + dir + ": opening the lock file " + path +
+                  " failed: " + std::strerror(errno) +
                   "; the state directory must exist and be writable by resolverd (the calibration is saved there)");
   }
   struct stat st {};

@@ -140,8 +140,8 @@ TEST(FrameDecoderUnits, MilliampsBecomeAmps) {
 }
 
 TEST(FrameDecoderUnits, TheBundledLayoutDescribesItself) {
-  FrameDecoder d(std::make_shared<const dbc::Database>(dbc::load_dbc_file(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc")),
-                 SignalMap::bench_default());
+  auto db = std::make_shared<const dbc::Database>(dbc::load_dbc_file(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc"));
+  FrameDecoder d(db, SignalMap::bench_default());
   EXPECT_EQ(d.describe_layout(),
             "RESOLVER_SAMPLE 0x100 (sin = sin, cos = cos, rd_angle = rd_angle), PHASE_CURRENTS 0x101 (i_a = i_a, "
             "i_b = i_b, i_c = i_c), REFERENCE_ANGLE 0x102 (ref_angle = ref_angle), counter 'counter'");
