@@ -96,7 +96,7 @@
 #include "daemon/core/estimation/sample_processor.h"
 #include "daemon/decode/row_decoder.h"
 #include "daemon/decode/signal_map.h"
-#include "daemon/service/program_errors.h"
+#include "daemon/core/errors.h"
 #include "drivers/csv/csv_format.h"
 
 namespace resolver {

@@ -1,6 +1,7 @@
 // The command-line side of the exit codes (daemon/service/program_errors.h has
 // the codes, their --help paragraph and the exception -> code rule): CLI11's
-// parse errors and unreadable files, checked before anything is read.
+// parse errors, and unreadable files checked before anything is read (IoError,
+// daemon/core/errors.h, which the one rule maps).
 //
 // CLI11's own codes (105 for a missing --config file, 106 for a missing
 // option, ...) never leave a program: parse_command_line() maps them.
@@ -33,18 +34,20 @@ namespace resolver::exit_code {
   return std::nullopt;
 }
 
-/// nullopt when `path` exists, may be read and is not a directory, else "cannot read
-/// <option> <path>: <strerror>" or "...: it is a directory, not a file" (a directory
-/// opens and reads as an empty file: a config would silently be all defaults).
-/// access(2) and stat(2), not open(2): opening a FIFO would briefly be its reader
-/// and let a waiting writer write into a pipe nobody reads.
-[[nodiscard]] inline std::optional<std::string> unreadable(const std::string& option, const std::string& path) {
-  if (::access(path.c_str(), R_OK) != 0) return "cannot read " + option + " " + path + ": " + std::strerror(errno);
+/// Returns when `path` exists, may be read and is not a directory; else throws IoError
+/// (exit 3) "[WHERE: ]cannot read <option> <path>: <strerror>" or "...: it is a
+/// directory, not a file" (a directory opens and reads as an empty file: a config would
+/// silently be all defaults). `where` names what named the path (the config file of a
+/// [layout] dbc). access(2) and stat(2), not open(2): opening a FIFO would briefly be
+/// its reader and let a waiting writer write into a pipe nobody reads.
+inline void require_readable(const std::string& option, const std::string& path, const Where& where = {}) {
+  if (::access(path.c_str(), R_OK) != 0) {
+    throw IoError("cannot read " + option + " " + path + ": " + std::strerror(errno), where);
+  }
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-    return "cannot read " + option + " " + path + ": it is a directory, not a file";
+    throw IoError("cannot read " + option + " " + path + ": it is a directory, not a file", where);
   }
-  return std::nullopt;
 }
 
 }  // namespace resolver::exit_code

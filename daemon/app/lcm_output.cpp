@@ -1,6 +1,6 @@
 #include "daemon/app/lcm_output.h"
 
-#include "daemon/service/program_errors.h"
+#include "daemon/core/errors.h"
 
 namespace resolver {
 

@@ -76,10 +76,7 @@ class CsvInput final : public ReaderInput<CsvReader> {
     // Read up to the first row so the column names are known and bound now:
     // a column the export lacks is a config error before anything runs.
     first_ = reader_.next(row_);
-    if (auto missing = decoder_.bind(reader_.column_names())) {
-      throw ConfigError(path + (reader_.names_line() > 0 ? ":" + std::to_string(reader_.names_line()) : std::string()) +
-                        ": [input.csv.columns] " + *missing);
-    }
+    decoder_.bind(reader_.column_names(), Where::at_file(path, reader_.names_line()));
     // The first row decides whether the columns line up at all: a first row
     // with more fields than the names (decimal commas split at a ',') would be
     // read, row after row, as other numbers. Refused before anything runs.
@@ -137,12 +134,9 @@ class CsvInput final : public ReaderInput<CsvReader> {
   double row_rate_hz_;
   CsvRow row_;
   std::optional<CsvReader::Status> first_;
-  /// A time column coarser than the rows (0.01 s at 1 kHz) times no row: refused.
+  /// A time column coarser than the rows (0.01 s at 1 kHz) times no row: refused (InputError).
   void check_time_resolution(bool at_end) {
-    if (auto why = decoder_.check_time_resolution(at_end)) {
-      throw ConfigError(path_ + ":" + std::to_string(first_line_) + "-" + std::to_string(reader_.line_number()) +
-                        ": " + *why);
-    }
+    decoder_.check_time_resolution(at_end, path_, first_line_, reader_.line_number());
   }
 
   std::uint64_t first_line_ = 0;             ///< line of the first data row

@@ -384,11 +384,7 @@ static int run(int argc, char** argv) {
     return exit_code::kUsage;
   }
   for (const auto& [option, path] : {std::pair{"--config", config_path}, std::pair{"--replay", o.replay_path}}) {
-    if (path.empty()) continue;
-    if (auto problem = exit_code::unreadable(option, path)) {
-      std::cerr << "resolverd: " << *problem << "\n";
-      return exit_code::kIo;
-    }
+    if (!path.empty()) exit_code::require_readable(option, path);  // IoError: exit 3
   }
 
   DaemonConfig config;
@@ -397,19 +393,9 @@ static int run(int argc, char** argv) {
   std::string config_crc = file_crc32(config_path);  // provenance of a saved calibration
   // Held for the whole run (see state_dir_lock.h); taken before anything is read from the directory.
   std::optional<StateDirLock> state_lock;
-  if (!o.state_dir.empty()) {
-    std::string problem;
-    state_lock = StateDirLock::acquire(o.state_dir, problem);
-    if (!state_lock) {
-      std::cerr << "resolverd: " << problem << "\n";
-      return exit_code::kIo;
-    }
-  }
+  if (!o.state_dir.empty()) state_lock = StateDirLock::acquire(o.state_dir);  // IoError: exit 3
   if (!config.dbc_path.empty()) {
-    if (auto problem = exit_code::unreadable("[layout] dbc", config.dbc_path)) {
-      std::cerr << "resolverd: " << config_path << ": " << *problem << "\n";
-      return exit_code::kIo;
-    }
+    exit_code::require_readable("[layout] dbc", config.dbc_path, Where::at_file(config_path));  // IoError: exit 3
   }
 
   // LCM that cannot start throws std::system_error (exit 3); a DBC or signal map that

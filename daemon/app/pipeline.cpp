@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <variant>
 
 #include <fmt/format.h>
 
@@ -15,9 +14,9 @@ namespace resolver {
 
 std::shared_ptr<const FrameDecoder> make_frame_decoder(const DaemonConfig& config) {
   const std::string path = config.dbc_path.empty() ? default_dbc_path() : config.dbc_path;
-  auto loaded = config.dbc_path.empty() ? dbc::parse_dbc(embedded_bench_dbc(), path) : dbc::load_dbc_file(path);
-  if (auto* err = std::get_if<dbc::DbcError>(&loaded)) throw ConfigError(err->what());
-  auto db = std::make_shared<const dbc::Database>(std::move(std::get<dbc::Database>(loaded)));
+  // A DBC that does not parse throws InputError (kUsage) naming its file and line.
+  auto db = std::make_shared<const dbc::Database>(config.dbc_path.empty() ? dbc::parse_dbc(embedded_bench_dbc(), path)
+                                                                          : dbc::load_dbc_file(path));
   try {
     return std::make_shared<const FrameDecoder>(db, config.signal_map);
   } catch (const std::invalid_argument& e) {

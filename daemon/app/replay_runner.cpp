@@ -11,7 +11,7 @@
 
 #include "daemon/app/log_input.h"
 #include "daemon/app/progress_meter.h"
-#include "daemon/service/program_errors.h"
+#include "daemon/core/errors.h"
 
 namespace resolver {
 

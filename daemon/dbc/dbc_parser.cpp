@@ -38,7 +38,7 @@ constexpr std::string_view kIgnoredStatements[] = {
     "SGTYPE_",    "SGTYPE_VAL_",  "EV_",              "ENVVAR_DATA_", "SIGTYPE_VALTYPE_", "CAT_DEF_",
     "CAT_",       "FILTER",       "BU_SG_REL_",       "BU_EV_REL_",  "BU_BO_REL_"};
 
-// Thrown inside the parser only; parse_dbc turns it into a DbcError.
+// Thrown inside the parser only; parse_dbc turns it into an InputError naming the source.
 struct ParseFailure {
   std::size_t line;
   std::string message;
@@ -572,35 +572,30 @@ class Parser {
 
 }  // namespace
 
-std::string DbcError::what() const {
-  if (line == 0) return source + ": " + message;
-  return source + ":" + std::to_string(line) + ": " + message;
-}
-
-std::variant<Database, DbcError> parse_dbc(std::string_view text, std::string_view source_name) {
+Database parse_dbc(std::string_view text, std::string_view source_name) {
   try {
     Parser parser(text, source_name);
     return parser.run();
   } catch (const ParseFailure& f) {
-    return DbcError{std::string(source_name), f.line, f.message};
+    throw InputError(Fault::kUsage, f.message, Where::at_file(std::string(source_name), f.line));
   } catch (const std::bad_alloc&) {
-    return DbcError{std::string(source_name), 0, "out of memory while parsing; is this really a DBC file?"};
+    // Not exit 4: a DBC is kilobytes, so a parse that runs out of memory was given something else.
+    throw InputError(Fault::kUsage, "out of memory while parsing; is this really a DBC file?",
+                     Where::at_file(std::string(source_name)));
   }
 }
 
-std::variant<Database, DbcError> load_dbc_file(const std::string& path) {
+Database load_dbc_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int err = errno;
-    return DbcError{path, 0,
-                    std::string("cannot open DBC file: ") + std::strerror(err) +
-                        "; check the path (a relative [layout] dbc is taken from the config file's folder)"};
+    throw IoError(std::string("cannot open DBC file: ") + std::strerror(err) +
+                      "; check the path (a relative [layout] dbc is taken from the config file's folder)",
+                  Where::at_file(path));
   }
   std::ostringstream content;
   content << in.rdbuf();
-  if (in.bad()) {
-    return DbcError{path, 0, "cannot read DBC file: I/O error; check the file and the disk"};
-  }
+  if (in.bad()) throw IoError("cannot read DBC file: I/O error; check the file and the disk", Where::at_file(path));
   return parse_dbc(content.str(), path);
 }
 

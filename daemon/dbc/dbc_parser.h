@@ -12,34 +12,27 @@
 // skipped to the end of its line and noted in Database::warnings. The last
 // line may end without a newline.
 //
-// Failure: parse_dbc never throws; a syntax error, a signal that does not fit
-// its message's DLC, a bad ID or length, two messages with one ID returns a
-// DbcError naming the source, the line and what was expected. References to unknown messages/signals in
-// CM_/VAL_/SIG_VALTYPE_ are not fatal (warnings), as real-world files have them.
+// Failure (the one error rule, daemon/core/errors.h): a syntax error, a signal
+// that does not fit its message's DLC, a bad ID or length, two messages with one ID
+// throw InputError (Fault::kUsage: a DBC is configuration, exit 2) whose where()
+// names the source and the line and whose message() says what was expected; a
+// file that cannot be opened or read throws IoError (exit 3). References to unknown
+// messages/signals in CM_/VAL_/SIG_VALTYPE_ are not fatal (warnings), as real-world
+// files have them.
 #pragma once
 
-#include <cstddef>
 #include <string>
 #include <string_view>
-#include <variant>
 
+#include "daemon/core/errors.h"
 #include "daemon/dbc/dbc_types.h"
 
 namespace resolver::dbc {
 
-struct DbcError {
-  std::string source;    ///< file path or the name given to parse_dbc
-  std::size_t line = 0;  ///< 1-based; 0 when the error is not about a line (cannot open)
-  std::string message;   ///< what went wrong and what to do
+/// Parses DBC text. `source_name` labels errors (InputError's where().file) and warnings.
+[[nodiscard]] Database parse_dbc(std::string_view text, std::string_view source_name);
 
-  /// "file.dbc:12: expected ':' after the message name, found '8'"
-  [[nodiscard]] std::string what() const;
-};
-
-/// Parses DBC text. `source_name` only labels errors and warnings.
-[[nodiscard]] std::variant<Database, DbcError> parse_dbc(std::string_view text, std::string_view source_name);
-
-/// Reads and parses a file; an unreadable file is a DbcError with line 0.
-[[nodiscard]] std::variant<Database, DbcError> load_dbc_file(const std::string& path);
+/// Reads and parses a file; one that cannot be opened or read is an IoError naming it.
+[[nodiscard]] Database load_dbc_file(const std::string& path);
 
 }  // namespace resolver::dbc

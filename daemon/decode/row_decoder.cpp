@@ -70,7 +70,7 @@ double csv_sincos_full_scale(const RowMap& map) {
   return std::min(s->full_scale, c->full_scale);
 }
 
-std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& names) {
+void RowDecoder::bind(const std::vector<std::string>& names, const Where& names_at) {
   std::string missing;
   auto resolve = [&](const ColumnRef& ref, const std::string& what) -> std::optional<Bound> {
     if (ref.name.empty()) return Bound{static_cast<std::size_t>(ref.index - 1)};
@@ -87,12 +87,16 @@ std::optional<std::string> RowDecoder::bind(const std::vector<std::string>& name
   std::vector<std::string_view> views(names.begin(), names.end());
   expected_fields_ = used_fields(views);
   fields_from_names_ = expected_fields_ > 0;
-  if (missing.empty()) return std::nullopt;
+  if (missing.empty()) return;
   std::string have;
   for (const std::string& n : names) have += (have.empty() ? "'" : ", '") + n + "'";
-  return missing + (names.empty() ? std::string(" (the export has no column-name line: set column_names = true, or name "
-                                                "columns by their 1-based index)")
-                                  : " (the columns are " + have + ")");
+  Where where = names_at;
+  where.option = "[input.csv.columns]";
+  throw InputError(Fault::kUsage,
+                   missing + (names.empty() ? std::string(" (the export has no column-name line: set column_names = "
+                                                          "true, or name columns by their 1-based index)")
+                                            : " (the columns are " + have + ")"),
+                   std::move(where));
 }
 
 std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, RowSample& out,
@@ -191,11 +195,12 @@ std::optional<TextProblem> RowDecoder::decode(const CsvRow& row, char decimal, R
   return std::nullopt;
 }
 
-std::optional<std::string> RowDecoder::check_time_resolution(bool at_end) {
-  if (time_checked_ || !map_.time) return std::nullopt;
-  if (time_steps_ < kTimeCheckSteps && !(at_end && time_steps_ >= 16)) return std::nullopt;
+void RowDecoder::check_time_resolution(bool at_end, const std::string& file, std::uint64_t first_line,
+                                       std::uint64_t last_line) {
+  if (time_checked_ || !map_.time) return;
+  if (time_steps_ < kTimeCheckSteps && !(at_end && time_steps_ >= 16)) return;
   time_checked_ = true;
-  if (static_cast<double>(repeated_times_) < kMaxRepeatedTimeShare * time_steps_) return std::nullopt;
+  if (static_cast<double>(repeated_times_) < kMaxRepeatedTimeShare * time_steps_) return;
   std::string rate;
   if (last_change_row_ > first_change_row_ && last_change_us_ > first_change_us_) {
     const double hz = static_cast<double>(last_change_row_ - first_change_row_) * 1e6 /
@@ -205,11 +210,16 @@ std::optional<std::string> RowDecoder::check_time_resolution(bool at_end) {
   const std::string resolution =
       min_time_step_us_ > 0 ? fmt::format("resolves only {:g} s", static_cast<double>(min_time_step_us_) / 1e6)
                             : std::string("never changes");
-  return fmt::format(
-      "{} (time): {} of the first {} rows repeat the previous row's time: the column {}, coarser than the rows "
-      "come{}; rows sharing a time have no time between them (the rotor would seem not to move). Export the time "
-      "with more digits, or, if the rows are evenly spaced, drop [input.csv] time_column and set row_rate_hz",
-      map_.time->describe(), repeated_times_, time_steps_ + 1, resolution, rate);
+  Where where = Where::at_file(file, first_line);
+  where.last_line = last_line;
+  throw InputError(
+      Fault::kUsage,
+      fmt::format(
+          "{} (time): {} of the first {} rows repeat the previous row's time: the column {}, coarser than the rows "
+          "come{}; rows sharing a time have no time between them (the rotor would seem not to move). Export the time "
+          "with more digits, or, if the rows are evenly spaced, drop [input.csv] time_column and set row_rate_hz",
+          map_.time->describe(), repeated_times_, time_steps_ + 1, resolution, rate),
+      std::move(where));
 }
 
 }  // namespace resolver

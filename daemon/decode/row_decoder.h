@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/errors.h"
 #include "daemon/decode/row_sample.h"
 #include "drivers/csv/csv_reader.h"
 #include "drivers/text/text_problem.h"
@@ -82,9 +83,10 @@ class RowDecoder {
   explicit RowDecoder(RowMap map) : map_(std::move(map)) {}
 
   /// Resolves column names against the export's column-name line (`names`,
-  /// empty when it has none). Returns a message naming every column that is
-  /// not there and the columns that are, or nullopt when all resolve.
-  [[nodiscard]] std::optional<std::string> bind(const std::vector<std::string>& names);
+  /// empty when it has none; `names_at` is the file and that line). When a column
+  /// is not there, throws InputError (Fault::kUsage: the config names it; option
+  /// "[input.csv.columns]") naming every missing column and the columns that are.
+  void bind(const std::vector<std::string>& names, const Where& names_at = {});
 
   /// Decodes one data row (after bind()). A problem names the column (reason
   /// bad_number, missing_column or absurd_value) or the field count
@@ -101,10 +103,12 @@ class RowDecoder {
   /// (the same time as the row before): 0.01 s at 1 kHz repeats 9 times in 10.
   static constexpr double kMaxRepeatedTimeShare = 0.25;
   /// Once kTimeCheckSteps rows with a time were decoded (or at the end, `at_end`,
-  /// after at least 16): a message when the time column repeats too often to
-  /// time the rows (naming the column, its resolution and the row rate the
-  /// rows between its changes suggest), else nullopt. Says it once.
-  [[nodiscard]] std::optional<std::string> check_time_resolution(bool at_end);
+  /// after at least 16): when the time column repeats too often to time the rows,
+  /// throws InputError (Fault::kUsage: the fix is in [input.csv]) whose where is
+  /// `file`, lines `first_line`-`last_line`, naming the column, its resolution and
+  /// the row rate the rows between its changes suggest. Checks once.
+  void check_time_resolution(bool at_end, const std::string& file = {}, std::uint64_t first_line = 0,
+                             std::uint64_t last_line = 0);
 
  private:
   struct Bound {

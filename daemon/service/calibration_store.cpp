@@ -1,5 +1,4 @@
 #include "daemon/service/calibration_store.h"
-#include "daemon/service/program_errors.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -13,6 +12,8 @@
 #include <cstring>
 #include <set>
 #include <string_view>
+
+#include "daemon/core/errors.h"
 
 namespace resolver {
 

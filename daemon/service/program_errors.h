@@ -11,7 +11,9 @@
 //   4  out of memory (std::bad_alloc: the input is larger than the memory the program may use)
 //   70 internal error (an unexpected exception: a bug, please report it; sysexits.h EX_SOFTWARE)
 //
-// Exceptions map to them in one place, exit_code_for():
+// The error types (InputError with its Fault and Where, IoError) live in
+// daemon/core/errors.h, the one header every layer may include; exceptions map to
+// the codes here, in one place, exit_code_for():
 //   InputError                 its fault(): kData -> 1, kUsage -> 2 (ConfigError is one, kUsage)
 //   std::invalid_argument      2: a library function refused an argument the caller passed on
 //                              from the command line or config (a program that hands the
@@ -24,14 +26,13 @@
 // so an exception that nothing else caught prints one line "NAME: ..." and exits with its code.
 #pragma once
 
-#include <cstdint>
 #include <exception>
 #include <iostream>
-#include <stdexcept>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <utility>
+
+#include "daemon/core/errors.h"
 
 namespace resolver {
 
@@ -50,63 +51,6 @@ inline constexpr const char* kHelpText =
     "3 I/O error (a file missing or unreadable, a write failed); 4 out of memory; 70 internal error (a bug).";
 
 }  // namespace exit_code
-
-/// Whose fault an InputError is: the data read, or how the program was called / configured.
-enum class Fault { kData, kUsage };
-
-/// Where the fault is; every part optional (empty / 0 = not known).
-struct Where {
-  std::string file;        ///< the file read (log, config, DBC, table)
-  std::uint64_t line = 0;  ///< 1-based line in `file`
-  std::string option;      ///< the command-line option or config key ("--effects", "[model] effects")
-  std::string signal;      ///< the CAN / DBC signal or CSV column concerned
-
-  [[nodiscard]] static Where at_file(std::string file, std::uint64_t line = 0) {
-    Where w;
-    w.file = std::move(file);
-    w.line = line;
-    return w;
-  }
-  [[nodiscard]] static Where at_option(std::string option) {
-    Where w;
-    w.option = std::move(option);
-    return w;
-  }
-};
-
-/// A fault of the input data (exit 1) or of the usage or configuration (exit 2).
-/// what() is "FILE:LINE: OPTION: signal 'SIGNAL': MESSAGE", with the parts known.
-class InputError : public std::runtime_error {
- public:
-  InputError(Fault fault, const std::string& message, Where where = {})
-      : std::runtime_error(compose(message, where)), fault_(fault), where_(std::move(where)) {}
-
-  [[nodiscard]] Fault fault() const noexcept { return fault_; }
-  [[nodiscard]] const Where& where() const noexcept { return where_; }
-
- private:
-  static std::string compose(const std::string& message, const Where& w) {
-    std::string out;
-    if (!w.file.empty()) out += w.file + (w.line > 0 ? ":" + std::to_string(w.line) : std::string()) + ": ";
-    if (!w.option.empty()) out += w.option + ": ";
-    if (!w.signal.empty()) out += "signal '" + w.signal + "': ";
-    return out + message;
-  }
-
-  Fault fault_;
-  Where where_;
-};
-
-/// An I/O failure with no errno to tell (a library such as LCM or matio said no):
-/// a std::system_error (exit 3) whose what() is `message` alone.
-class IoError : public std::system_error {
- public:
-  explicit IoError(const std::string& message) : std::system_error(std::make_error_code(std::errc::io_error)), message_(message) {}
-  [[nodiscard]] const char* what() const noexcept override { return message_.c_str(); }
-
- private:
-  std::string message_;
-};
 
 /// The exit code for `error` (the table above) and the one line to print after
 /// "PROGRAM: ". Never throws; allocates nothing for std::bad_alloc.

@@ -10,6 +10,8 @@
 #include <cstring>
 #include <string_view>
 
+#include "daemon/core/errors.h"
+
 namespace resolver {
 
 namespace {
@@ -35,27 +37,26 @@ std::string holder_pid(int fd) {
 
 }  // namespace
 
-std::optional<StateDirLock> StateDirLock::acquire(const std::string& dir, std::string& problem) {
+StateDirLock StateDirLock::acquire(const std::string& dir) {
   const std::string path = lock_path(dir);
   // O_NONBLOCK: a FIFO put there must not hold the start up; it is refused below.
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NONBLOCK | O_NOFOLLOW, 0644);
   if (fd < 0) {
-    problem = "cannot use --state-dir " + dir + ": opening the lock file " + path + " failed: " + std::strerror(errno) +
-              "; the state directory must exist and be writable by resolverd (the calibration is saved there)";
-    return std::nullopt;
+    throw IoError("cannot use --state-dir " + dir + ": opening the lock file " + path +
+                  " failed: " + std::strerror(errno) +
+                  "; the state directory must exist and be writable by resolverd (the calibration is saved there)");
   }
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     ::close(fd);
-    problem = "cannot use --state-dir " + dir + ": the lock file " + path + " is not a regular file; remove it";
-    return std::nullopt;
+    throw IoError("cannot use --state-dir " + dir + ": the lock file " + path + " is not a regular file; remove it");
   }
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
-    std::string who;
+    std::string problem;
     if (err == EWOULDBLOCK) {
       const std::string pid = holder_pid(fd);
-      who = pid.empty() ? "another resolverd (pid not known yet)" : "another resolverd, pid " + pid;
+      const std::string who = pid.empty() ? "another resolverd (pid not known yet)" : "another resolverd, pid " + pid;
       problem = "cannot use --state-dir " + dir + ": it is in use by " + who + " (it holds the lock " + path +
                 "); two daemons on one state dir would overwrite each other's calibration: stop that one or give "
                 "this one its own --state-dir";
@@ -63,7 +64,7 @@ std::optional<StateDirLock> StateDirLock::acquire(const std::string& dir, std::s
       problem = "cannot use --state-dir " + dir + ": locking " + path + " failed: " + std::strerror(err);
     }
     ::close(fd);
-    return std::nullopt;
+    throw IoError(problem);
   }
   const std::string pid = std::to_string(::getpid()) + "\n";
   // The pid is a courtesy for the message above: failing to write it is not fatal.

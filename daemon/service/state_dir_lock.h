@@ -12,7 +12,6 @@
 // rather than at the end of an eight-hour run when the calibration is saved.
 #pragma once
 
-#include <optional>
 #include <string>
 
 namespace resolver {
@@ -22,10 +21,10 @@ inline constexpr const char* kStateLockFileName = "resolverd.lock";
 
 class StateDirLock {
  public:
-  /// Takes the lock on `dir`. Returns the lock, or nullopt with `problem` naming the
-  /// lock file, the reason (errno text, or the pid of the resolverd that holds it) and
-  /// what to do. Never blocks (LOCK_NB; a FIFO in the lock file's place is refused).
-  static std::optional<StateDirLock> acquire(const std::string& dir, std::string& problem);
+  /// Takes the lock on `dir`, or throws IoError (exit 3, daemon/core/errors.h) naming
+  /// the lock file, the reason (errno text, or the pid of the resolverd that holds it)
+  /// and what to do. Never blocks (LOCK_NB; a FIFO in the lock file's place is refused).
+  [[nodiscard]] static StateDirLock acquire(const std::string& dir);
 
   StateDirLock(StateDirLock&& other) noexcept : fd_(other.fd_) { other.fd_ = -1; }
   StateDirLock& operator=(StateDirLock&& other) noexcept {

@@ -34,6 +34,7 @@
 #include <string>
 #include <string_view>
 
+#include "daemon/core/errors.h"
 #include "drivers/can_frame.h"
 
 namespace resolver {
@@ -87,17 +88,19 @@ struct LogLineProblem {
 /// std::bad_alloc while building a problem's message.
 [[nodiscard]] std::optional<LogLineProblem> parse_candump_line(std::string_view line, CanFrame& frame);
 
-/// Why `frame` cannot be written as a candump line that parse_candump_line
-/// (and canplayer) reads back identically; nullopt if it can. Checks: a
+/// Returns when `frame` can be written as a candump line that parse_candump_line
+/// (and canplayer) reads back identically; else throws InputError (Fault::kUsage:
+/// the frame came from the caller's options) "WHERE: cannot log this frame: WHY",
+/// `where` being the log and the line the frame would have taken. Checks: a
 /// timestamp >= 0, a non-empty interface name without blanks or control
 /// bytes, the id range (11/29 bits), len (<= 8 classic, a valid FD length),
 /// FD flags only BRS/ESI and only on FD frames, no RTR on FD or error frames.
-[[nodiscard]] std::optional<std::string> check_loggable(const CanFrame& frame);
+void check_loggable(const CanFrame& frame, const Where& where = {});
 
 /// Appends the frame exactly as `candump -l` logs it, including the trailing
 /// '\n': "(%010lu.%06lu) <iface> <frame>\n" with upper-case hex, e.g.
 /// "(1699999999.123456) can0 123#DEADBEEF\n".
-/// Precondition: check_loggable(frame) is nullopt; otherwise the output is
+/// Precondition: check_loggable(frame) does not throw; otherwise the output is
 /// clamped like candump's (len cut to 8/64, id masked, '-' for an empty
 /// interface) and may not read back the same. Does not allocate when `out`
 /// has 256 bytes of spare capacity.

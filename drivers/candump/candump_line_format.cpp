@@ -50,43 +50,45 @@ char* put_decimal(char* p, std::uint64_t value, int min_width) {
 
 }  // namespace
 
-std::optional<std::string> check_loggable(const CanFrame& frame) {
+void check_loggable(const CanFrame& frame, const Where& where) {
+  const auto refuse = [&](const std::string& why) {
+    throw InputError(Fault::kUsage, "cannot log this frame: " + why, where);
+  };
   if (frame.timestamp_us < 0) {
-    return fmt::format("timestamp {} us is negative; candump logs hold times since the epoch",
-                       frame.timestamp_us);
+    refuse(fmt::format("timestamp {} us is negative; candump logs hold times since the epoch",
+                       frame.timestamp_us));
   }
   const std::string_view iface = frame.iface_name();
-  if (iface.empty()) return std::string("interface name is empty; set it with set_iface(\"can0\")");
+  if (iface.empty()) refuse("interface name is empty; set it with set_iface(\"can0\")");
   for (const char c : iface) {
     if (!is_iface_char(c)) {
-      return fmt::format("interface name '{}' contains a blank or control character", iface);
+      refuse(fmt::format("interface name '{}' contains a blank or control character", iface));
     }
   }
   if (frame.error) {
-    if (frame.fd || frame.rtr) return std::string("error frames cannot be CAN FD or remote frames");
+    if (frame.fd || frame.rtr) refuse("error frames cannot be CAN FD or remote frames");
     if (frame.id > kCanEffMask) {
-      return fmt::format("error class bits 0x{:X} exceed 29 bits", frame.id);
+      refuse(fmt::format("error class bits 0x{:X} exceed 29 bits", frame.id));
     }
   } else if (frame.extended ? frame.id > kCanEffMask : frame.id > kCanSffMask) {
-    return fmt::format("{} CAN ID 0x{:X} exceeds 0x{:X}", frame.extended ? "29-bit" : "11-bit",
-                       frame.id, frame.extended ? kCanEffMask : kCanSffMask);
+    refuse(fmt::format("{} CAN ID 0x{:X} exceeds 0x{:X}", frame.extended ? "29-bit" : "11-bit",
+                       frame.id, frame.extended ? kCanEffMask : kCanSffMask));
   }
   if (frame.fd) {
-    if (frame.rtr) return std::string("CAN FD has no remote frames");
+    if (frame.rtr) refuse("CAN FD has no remote frames");
     if ((frame.fd_flags & ~kFdFlagsKnown) != 0U) {
-      return fmt::format("CAN FD flags 0x{:X} have bits other than BRS=1, ESI=2", frame.fd_flags);
+      refuse(fmt::format("CAN FD flags 0x{:X} have bits other than BRS=1, ESI=2", frame.fd_flags));
     }
     if (!is_fd_length(frame.len)) {
-      return fmt::format("CAN FD length {} is not one of 0..8, 12, 16, 20, 24, 32, 48, 64",
-                         frame.len);
+      refuse(fmt::format("CAN FD length {} is not one of 0..8, 12, 16, 20, 24, 32, 48, 64",
+                         frame.len));
     }
   } else if (frame.len > CanFrame::kMaxClassicLen) {
-    return fmt::format("classic CAN length {} exceeds 8 bytes", frame.len);
+    refuse(fmt::format("classic CAN length {} exceeds 8 bytes", frame.len));
   } else if (frame.fd_flags != 0U) {
     // candump has nowhere to put them on a classic line; they would be lost.
-    return fmt::format("CAN FD flags 0x{:X} set on a classic (non-FD) frame", frame.fd_flags);
+    refuse(fmt::format("CAN FD flags 0x{:X} set on a classic (non-FD) frame", frame.fd_flags));
   }
-  return std::nullopt;
 }
 
 void append_candump_line(const CanFrame& frame, std::string& out) {

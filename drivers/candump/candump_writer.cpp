@@ -22,7 +22,7 @@ constexpr std::size_t kLineHeadroom = 256;
 
 }  // namespace
 
-CandumpWriter::CandumpWriter(const std::string& path) : path_(path) {
+CandumpWriter::CandumpWriter(const std::string& path) : path_(path), line_at_(Where::at_file(path)) {
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
     throw std::system_error(errno, std::generic_category(), "cannot create " + path);
@@ -42,10 +42,8 @@ void CandumpWriter::write(const CanFrame& frame) {
   if (fd_ < 0) {
     throw std::runtime_error(fmt::format("write to {} after close()", path_));
   }
-  if (auto reason = check_loggable(frame)) {
-    throw std::invalid_argument(
-        fmt::format("cannot log frame {} to {}: {}", frames_written_ + 1, path_, *reason));
-  }
+  line_at_.line = frames_written_ + 1;  // one line a frame
+  check_loggable(frame, line_at_);
   append_candump_line(frame, buffer_);
   ++frames_written_;
   if (buffer_.size() >= kFlushBytes) flush();

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "daemon/core/errors.h"
 #include "drivers/can_frame.h"
 
 namespace resolver {
@@ -23,9 +24,9 @@ class CandumpWriter {
   CandumpWriter(const CandumpWriter&) = delete;
   CandumpWriter& operator=(const CandumpWriter&) = delete;
 
-  /// Appends one line. Throws std::invalid_argument if check_loggable()
-  /// rejects the frame (nothing is written), std::system_error on an I/O
-  /// error or after close().
+  /// Appends one line. Throws InputError (check_loggable(): "PATH:LINE: cannot log
+  /// this frame: WHY"; nothing is written), std::system_error on an I/O error or
+  /// after close().
   void write(const CanFrame& frame);
   /// Flushes and closes; throws std::system_error naming the path and strerror.
   /// A second call does nothing.
@@ -37,6 +38,7 @@ class CandumpWriter {
   void flush();
 
   std::string path_;
+  Where line_at_;  ///< path_ and the next line, for check_loggable (no allocation per frame)
   int fd_ = -1;
   std::string buffer_;
   std::uint64_t frames_written_ = 0;

@@ -10,10 +10,10 @@
 // is refused; warnings go to stderr.
 #include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <iostream>
 #include <sstream>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "daemon/dbc/dbc_codec.h"
@@ -42,12 +42,13 @@ int main(int argc, char** argv) {
     std::cerr << "usage: dbc_decode FILE.dbc < frames\n";
     return 2;
   }
-  auto loaded = resolver::dbc::load_dbc_file(argv[1]);
-  if (const auto* e = std::get_if<resolver::dbc::DbcError>(&loaded)) {
-    std::cerr << e->what() << "\n";
+  resolver::dbc::Database db;
+  try {
+    db = resolver::dbc::load_dbc_file(argv[1]);
+  } catch (const std::exception& e) {  // InputError (file:line: why) or IoError: the peer suite only needs "refused"
+    std::cerr << e.what() << "\n";
     return 2;
   }
-  const auto& db = std::get<resolver::dbc::Database>(loaded);
   for (const std::string& w : db.warnings) std::cerr << "warning: " << w << "\n";
   std::string line;
   while (std::getline(std::cin, line)) {

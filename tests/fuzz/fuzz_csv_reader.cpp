@@ -86,7 +86,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (status == resolver::CsvReader::Status::kEnd) break;
     if (!bound) {
       bound = true;
-      if (decoder.bind(reader.column_names())) break;  // a config error in resolverd: nothing more to read
+      try {
+        decoder.bind(reader.column_names());
+      } catch (const resolver::InputError& e) {  // a config error in resolverd: nothing more to read
+        FUZZ_CHECK(e.fault() == resolver::Fault::kUsage, "a missing column is not a usage error");
+        break;
+      }
     }
     if (status == resolver::CsvReader::Status::kBadLine) continue;
     FUZZ_CHECK(row.fields.size() == row.columns.size(), "fields and columns differ in number");

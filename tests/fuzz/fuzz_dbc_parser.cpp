@@ -14,7 +14,6 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
-#include <variant>
 #include <vector>
 
 #include "daemon/dbc/dbc_codec.h"
@@ -54,14 +53,16 @@ void check_signal(const dbc::Message& m, const dbc::Signal& s, std::uint64_t pat
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text = resolver::fuzz::as_text(data, size);
-  auto parsed = dbc::parse_dbc(text, "fuzz.dbc");
-  if (const auto* error = std::get_if<dbc::DbcError>(&parsed)) {
-    FUZZ_CHECK(error->line >= 1 && error->line <= count_lines(text) + 1, "DbcError line outside the text");
-    FUZZ_CHECK(!error->message.empty(), "DbcError without a message");
-    FUZZ_CHECK(!error->what().empty(), "DbcError::what() empty");
+  dbc::Database db;
+  try {
+    db = dbc::parse_dbc(text, "fuzz.dbc");
+  } catch (const resolver::InputError& error) {
+    const std::uint64_t line = error.where().line;
+    FUZZ_CHECK(line >= 1 && line <= count_lines(text) + 1, "refusal's line outside the text");
+    FUZZ_CHECK(!error.message().empty(), "refusal without a message");
+    FUZZ_CHECK(error.where().file == "fuzz.dbc", "refusal without the source name");
     return 0;
   }
-  const auto& db = std::get<dbc::Database>(parsed);
   // A pattern that differs between inputs, so insert/extract sees varied bits.
   std::uint64_t pattern = 0x9E3779B97F4A7C15ULL;
   for (std::size_t i = 0; i < size; ++i) pattern = (pattern ^ data[i]) * 0x100000001B3ULL;

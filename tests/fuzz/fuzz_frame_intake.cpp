@@ -20,7 +20,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <variant>
 
 #include "daemon/dbc/dbc_parser.h"
 #include "daemon/decode/crc8_j1850.h"

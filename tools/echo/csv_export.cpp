@@ -9,11 +9,11 @@
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <stdexcept>
 #include <unordered_map>
 
 #include <fmt/format.h>
 
+#include "daemon/core/errors.h"
 #include "tools/echo/lcm_eventlog_reader.h"
 
 namespace resolver {
@@ -115,7 +115,7 @@ CsvExportResult export_log_csv(const std::string& log_path, const LcmJsonDecoder
 
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
-  if (ec) throw std::runtime_error(fmt::format("cannot write {}: {}", dir, ec.message()));
+  if (ec) throw IoError(fmt::format("cannot write {}: {}", dir, ec.message()), Where::at_option("--csv"));
   std::vector<std::unique_ptr<std::FILE, FileCloser>> files;
   std::map<std::string, int> names_used;  // two channels that map to one file name get -2, -3 ...
   for (Channel& ch : channels) {
@@ -125,12 +125,14 @@ CsvExportResult export_log_csv(const std::string& log_path, const LcmJsonDecoder
     ch.file.columns = ch.columns.size() + 1;
     files.emplace_back(std::fopen(ch.file.path.c_str(), "wb"));
     ch.out = files.back().get();
-    if (ch.out == nullptr) throw std::runtime_error(fmt::format("cannot write {}: {}", ch.file.path, std::strerror(errno)));
+    if (ch.out == nullptr) {
+      throw IoError(fmt::format("cannot write {}: {}", ch.file.path, std::strerror(errno)), Where::at_option("--csv"));
+    }
     std::string header = "utime_s";
     for (const std::string& c : ch.columns) header += "," + c;
     header += '\n';
     if (std::fputs(header.c_str(), ch.out) == EOF) {
-      throw std::runtime_error(fmt::format("cannot write {}: {}", ch.file.path, std::strerror(errno)));
+      throw IoError(fmt::format("cannot write {}: {}", ch.file.path, std::strerror(errno)), Where::at_option("--csv"));
     }
   }
 
@@ -147,14 +149,15 @@ CsvExportResult export_log_csv(const std::string& log_path, const LcmJsonDecoder
     }
     line += '\n';
     if (std::fwrite(line.data(), 1, line.size(), ch.out) != line.size()) {
-      throw std::runtime_error(fmt::format("cannot write {}: {}", ch.file.path, std::strerror(errno)));
+      throw IoError(fmt::format("cannot write {}: {}", ch.file.path, std::strerror(errno)), Where::at_option("--csv"));
     }
     ++ch.file.rows;
   });
   for (std::size_t i = 0; i < channels.size(); ++i) {
     std::FILE* f = files[i].release();
     if (std::fclose(f) != 0) {
-      throw std::runtime_error(fmt::format("cannot write {}: {}", channels[i].file.path, std::strerror(errno)));
+      throw IoError(fmt::format("cannot write {}: {}", channels[i].file.path, std::strerror(errno)),
+                    Where::at_option("--csv"));
     }
     result.files.push_back(std::move(channels[i].file));
   }

@@ -44,7 +44,7 @@ struct CsvExportResult {
 /// Writes the channels of the log at `log_path` that `filter` accepts into `dir`
 /// (created when missing), stopping after `limit` messages when given.
 /// Throws EventLogError on a malformed log (before any file is written) and
-/// std::runtime_error "cannot write <path>: <reason>" when a file cannot be written.
+/// IoError "--csv: cannot write <path>: <reason>" (exit 3) when a file cannot be written.
 CsvExportResult export_log_csv(const std::string& log_path, const LcmJsonDecoder& decoder, const EchoFilter& filter,
                                std::optional<std::int64_t> limit, const std::string& dir);
 

@@ -116,32 +116,21 @@ void add_echo_options(CLI::App& app, EchoArguments& a) {
       ->needs(log_opt);
 }
 
-/// No input, or a --log that cannot be read: its exit code, after the message.
+/// No input: its exit code, after the message. A --log that cannot be read throws IoError.
 std::optional<int> check_input(const EchoArguments& a) {
   if (!a.list_types && a.log_path.empty() && a.lcm_url.empty()) {
     std::cerr << "resolver-echo: give --log FILE or --lcm URL (or --list-types); see --help\n";
     return exit_code::kUsage;
   }
-  if (!a.log_path.empty()) {
-    if (auto problem = exit_code::unreadable("--log", a.log_path)) {
-      std::cerr << "resolver-echo: " << *problem << '\n';
-      return exit_code::kIo;
-    }
-  }
+  if (!a.log_path.empty()) exit_code::require_readable("--log", a.log_path);  // IoError: exit 3
   return std::nullopt;
 }
 
-/// The --types directories into the registry: a bad .lcm file is a usage error (its exit
-/// code); what the registry could not resolve are warnings.
-std::optional<int> add_type_dirs(resolver::LcmTypeRegistry& registry, const std::vector<std::string>& type_dirs) {
-  try {
-    for (const auto& dir : type_dirs) registry.add_directory(dir);
-  } catch (const resolver::LcmParseError& e) {
-    std::cerr << "resolver-echo: " << e.what() << '\n';
-    return exit_code::kUsage;
-  }
+/// The --types directories into the registry: a bad .lcm file throws LcmParseError (an
+/// InputError, usage: exit 2); what the registry could not resolve are warnings.
+void add_type_dirs(resolver::LcmTypeRegistry& registry, const std::vector<std::string>& type_dirs) {
+  for (const auto& dir : type_dirs) registry.add_directory(dir);
   for (const auto& problem : registry.problems()) std::cerr << "resolver-echo: warning: " << problem << '\n';
-  return std::nullopt;
 }
 
 /// --list-types: one line per type, its fingerprint first.
@@ -164,15 +153,8 @@ bool type_known(const resolver::LcmTypeRegistry& registry, const std::string& ty
 /// --csv DIR: the log's channels as tables, one line per file on stdout.
 int write_csv_tables(const EchoArguments& a, const resolver::LcmJsonDecoder& decoder,
                      const resolver::EchoFilter& filter) {
-  resolver::CsvExportResult written;
-  try {
-    written = resolver::export_log_csv(a.log_path, decoder, filter, a.limit, a.csv_dir);
-  } catch (const resolver::EventLogError&) {
-    throw;
-  } catch (const std::runtime_error& e) {  // a file that cannot be written
-    std::cerr << "resolver-echo: --csv: " << e.what() << '\n';
-    return exit_code::kIo;
-  }
+  // A malformed log throws EventLogError (exit 1), a file that cannot be written IoError (exit 3).
+  const resolver::CsvExportResult written = resolver::export_log_csv(a.log_path, decoder, filter, a.limit, a.csv_dir);
   for (const auto& f : written.files) {
     std::cout << fmt::format("wrote {}: {} rows x {} columns ({} on channel {})\n", f.path, f.rows, f.columns,
                              fmt::join(f.types, ", "), f.channel);
@@ -199,11 +181,8 @@ int echo_live(const EchoArguments& a, const resolver::LcmJsonDecoder& decoder, c
     print_line(line);
     std::fflush(stdout);  // live output is watched or piped: do not sit in a buffer
   });
-  const auto result = live.run(a.count, timeout);
-  if (!result.error.empty()) {
-    std::cerr << "resolver-echo: --lcm " << a.lcm_url << ": " << result.error << '\n';
-    return exit_code::kIo;
-  }
+  // LCM or the output failing throws IoError "--lcm URL: ...": exit 3.
+  const auto result = live.run(a.count, timeout, resolver::Where::at_option("--lcm " + a.lcm_url));
   if (a.count && result.emitted < *a.count) {
     std::cerr << fmt::format("resolver-echo: --timeout {} s expired after {} of --count {} messages\n", *a.timeout_s,
                              result.emitted, *a.count);
@@ -215,7 +194,7 @@ int echo_live(const EchoArguments& a, const resolver::LcmJsonDecoder& decoder, c
 /// The types, then --list-types, or the filter and the log (as JSON lines or CSV) or the live bus.
 int echo(const EchoArguments& a) {
   resolver::LcmTypeRegistry registry = resolver::LcmTypeRegistry::with_embedded_types();
-  if (auto code = add_type_dirs(registry, a.type_dirs)) return *code;
+  add_type_dirs(registry, a.type_dirs);
   if (a.list_types) {
     print_types(registry);
     return 0;
@@ -225,13 +204,8 @@ int echo(const EchoArguments& a) {
                              a.type_name);
     return exit_code::kUsage;
   }
-  resolver::EchoFilter filter;
-  try {
-    filter = resolver::make_echo_filter(a.channel_regex, a.type_name);
-  } catch (const std::invalid_argument& e) {
-    std::cerr << "resolver-echo: " << e.what() << '\n';
-    return exit_code::kUsage;
-  }
+  // A bad --channel regex throws std::invalid_argument: exit 2.
+  const resolver::EchoFilter filter = resolver::make_echo_filter(a.channel_regex, a.type_name);
   const resolver::LcmJsonDecoder decoder(registry);
   if (!a.log_path.empty() && !a.csv_dir.empty()) return write_csv_tables(a, decoder, filter);
   if (!a.log_path.empty()) {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/service/program_errors.h"
+#include "daemon/core/errors.h"
 
 namespace resolver {
 

@@ -16,13 +16,16 @@
 #include <string_view>
 #include <vector>
 
+#include "daemon/core/errors.h"
 #include "tools/echo/lcm_type.h"
 
 namespace resolver {
 
-class LcmParseError : public std::runtime_error {
+/// A .lcm file (or --types directory) that cannot be used: the user's configuration,
+/// so the rule's InputError with Fault::kUsage (exit 2); what() is the message as given.
+class LcmParseError : public InputError {
  public:
-  using std::runtime_error::runtime_error;
+  explicit LcmParseError(const std::string& message) : InputError(Fault::kUsage, message) {}
 };
 
 /// Parses every struct in one .lcm file. `source_name` (usually the path) is

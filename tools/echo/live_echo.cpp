@@ -20,7 +20,7 @@ LiveEcho::~LiveEcho() {
 
 void LiveEcho::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel, LiveEcho* self) noexcept {
   LiveEchoResult& result = self->result_;
-  if (!result.error.empty() || (self->count_ && result.emitted >= *self->count_)) return;
+  if (!self->error_.empty() || (self->count_ && result.emitted >= *self->count_)) return;
   try {
     const std::span<const std::uint8_t> data(static_cast<const std::uint8_t*>(rbuf->data), rbuf->data_size);
     const auto line = format_message_json(self->decoder_, self->filter_, channel, rbuf->recv_utime, data);
@@ -28,22 +28,24 @@ void LiveEcho::on_message(const lcm::ReceiveBuffer* rbuf, const std::string& cha
     self->sink_(*line);
     ++result.emitted;
   } catch (const std::exception& e) {
-    result.error = fmt::format("channel '{}': cannot output the message: {}", channel, e.what());
+    self->error_ = fmt::format("channel '{}': cannot output the message: {}", channel, e.what());
   } catch (...) {
-    result.error = fmt::format("channel '{}': cannot output the message (unknown exception)", channel);
+    self->error_ = fmt::format("channel '{}': cannot output the message (unknown exception)", channel);
   }
 }
 
-LiveEchoResult LiveEcho::run(std::optional<std::int64_t> count, std::optional<std::chrono::milliseconds> timeout) {
+LiveEchoResult LiveEcho::run(std::optional<std::int64_t> count, std::optional<std::chrono::milliseconds> timeout,
+                             const Where& lcm_at) {
   result_ = {};
+  error_.clear();
   count_ = count;
   if (subscription_ == nullptr) {
-    result_.error = "the LCM instance failed to initialize; check the --lcm URL and the network (multicast route)";
-    return result_;
+    throw IoError("the LCM instance failed to initialize; check the --lcm URL and the network (multicast route)",
+                  lcm_at);
   }
   using Clock = std::chrono::steady_clock;
   const auto deadline = timeout ? std::optional(Clock::now() + *timeout) : std::nullopt;
-  while (result_.error.empty() && !(count_ && result_.emitted >= *count_)) {
+  while (error_.empty() && !(count_ && result_.emitted >= *count_)) {
     // Wake at least every 100 ms so the deadline is honoured.
     int wait_ms = 100;
     if (deadline) {
@@ -55,9 +57,10 @@ LiveEchoResult LiveEcho::run(std::optional<std::int64_t> count, std::optional<st
       wait_ms = static_cast<int>(std::min<long long>(left, wait_ms));
     }
     if (lcm_.handleTimeout(wait_ms) < 0) {
-      result_.error = "LCM reported an error while receiving; check the --lcm URL";
+      error_ = "LCM reported an error while receiving; check the --lcm URL";
     }
   }
+  if (!error_.empty()) throw IoError(error_, lcm_at);
   return result_;
 }
 

@@ -14,6 +14,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "daemon/core/errors.h"
 #include "tools/echo/echo_output.h"
 
 namespace resolver {
@@ -21,7 +22,6 @@ namespace resolver {
 struct LiveEchoResult {
   std::int64_t emitted = 0;  ///< lines passed to the sink
   bool timed_out = false;    ///< stopped by the timeout, not by the count
-  std::string error;         ///< non-empty when LCM or the sink failed; what happened
 };
 
 class LiveEcho {
@@ -33,10 +33,13 @@ class LiveEcho {
   LiveEcho& operator=(const LiveEcho&) = delete;
 
   /// Handles messages until `count` more lines were emitted (if given) or
-  /// `timeout` elapsed (if given; otherwise waits forever). Never throws:
+  /// `timeout` elapsed (if given; otherwise waits forever). When LCM or the sink
+  /// fails, throws IoError (exit 3) "LCM_AT: what happened" once LCM has returned:
   /// exceptions from the sink are caught inside the LCM callback (they must not
-  /// unwind through LCM's C code) and reported in LiveEchoResult::error.
-  LiveEchoResult run(std::optional<std::int64_t> count, std::optional<std::chrono::milliseconds> timeout);
+  /// unwind through LCM's C code) and thrown from here. `lcm_at` names the URL
+  /// (the option "--lcm URL").
+  LiveEchoResult run(std::optional<std::int64_t> count, std::optional<std::chrono::milliseconds> timeout,
+                     const Where& lcm_at = {});
 
  private:
   static void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel, LiveEcho* self) noexcept;
@@ -49,6 +52,7 @@ class LiveEcho {
   // State of the current run(), written by on_message.
   std::optional<std::int64_t> count_;
   LiveEchoResult result_;
+  std::string error_;  ///< what failed in on_message ("" = nothing)
 };
 
 }  // namespace resolver

@@ -13,7 +13,7 @@
 #include <system_error>
 
 #include "daemon/core/angles.h"
-#include "daemon/service/program_errors.h"
+#include "daemon/core/errors.h"
 #include "tools/model/report_data.h"
 #include "tools/model/row_prediction.h"
 

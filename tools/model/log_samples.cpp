@@ -10,7 +10,7 @@
 #include "daemon/app/pipeline.h"
 #include "daemon/app/signal_health_log.h"
 #include "daemon/decode/sample_stream.h"
-#include "daemon/service/program_errors.h"
+#include "daemon/core/errors.h"
 
 namespace resolver {
 

@@ -226,10 +226,7 @@ int run_fleet(const std::string& manifest, const std::string& out, const std::st
     std::cerr << "resolver-model fleet: give MANIFEST --out DIR, or --summarize DIR\n";
     return resolver::exit_code::kUsage;
   }
-  if (auto problem = resolver::exit_code::unreadable("MANIFEST", manifest)) {
-    std::cerr << "resolver-model: " << *problem << "\n";
-    return resolver::exit_code::kIo;
-  }
+  resolver::exit_code::require_readable("MANIFEST", manifest);  // IoError: exit 3
   resolver::FleetOptions options;
   if (!config_path.empty()) options.config = resolver::load_daemon_config(config_path);
   if (!effects.empty()) {
@@ -418,11 +415,7 @@ std::optional<int> check_arguments(const Arguments& a) {
     return resolver::exit_code::kUsage;
   }
   for (const auto& [option, path] : {std::pair{"LOG", a.log}, std::pair{"--config", a.config_path}}) {
-    if (path.empty()) continue;
-    if (auto problem = resolver::exit_code::unreadable(option, path)) {
-      std::cerr << "resolver-model: " << *problem << "\n";
-      return resolver::exit_code::kIo;
-    }
+    if (!path.empty()) resolver::exit_code::require_readable(option, path);  // IoError: exit 3
   }
   if (a.command == Command::kExportData && a.csv_out.empty() && a.mat_out.empty()) {
     std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";

@@ -179,7 +179,7 @@ SimConfig build_config(const CLI::App& app, const Options& o, const std::vector<
     fail("--duration applies to --rpm; with --profile each segment carries its own seconds (rpm:seconds)");
   }
   if (!o.profile_text.empty()) {
-    if (auto err = resolver::parse_speed_profile(o.profile_text, c.profile)) fail(*err);
+    c.profile = resolver::parse_speed_profile(o.profile_text);  // InputError: exit 2
   } else if (rpm_given) {
     c.profile = {{o.duration, o.rpm, o.rpm}};
   }
@@ -314,7 +314,7 @@ int run(int argc, char** argv) {
   }
   std::vector<std::string> toml_effects;
   if (!o.config_file.empty()) {
-    if (auto problem = resolver::exit_code::unreadable("--config", o.config_file)) fail(*problem, resolver::exit_code::kIo);
+    resolver::exit_code::require_readable("--config", o.config_file);  // IoError: exit 3
     apply_toml(o.config_file, app, o, toml_effects);
   }
   if (o.out.empty()) fail("--out FILE is required (the candump log to write); see --help");

@@ -67,38 +67,38 @@ bool parse_number(std::string_view text, double& value) {
 }
 }  // namespace
 
-std::optional<std::string> parse_speed_profile(std::string_view text, std::vector<SpeedSegment>& out) {
+std::vector<SpeedSegment> parse_speed_profile(std::string_view text) {
   std::vector<SpeedSegment> segments;
   std::string_view rest = text;
   const auto bad = [&](std::string_view item, std::string_view why) {
-    return fmt::format(
-        "--profile '{}': segment '{}' {}; write rpm[-rpm_end]:seconds segments separated by commas, "
-        "e.g. \"200:5,200-1000:3,1000:2\"",
-        text, item, why);
+    return InputError(Fault::kUsage,
+                      fmt::format("'{}': segment '{}' {}; write rpm[-rpm_end]:seconds segments separated by commas, "
+                                  "e.g. \"200:5,200-1000:3,1000:2\"",
+                                  text, item, why),
+                      Where::at_option("--profile"));
   };
-  if (rest.empty()) return bad("", "is empty");
+  if (rest.empty()) throw bad("", "is empty");
   while (!rest.empty()) {
     const std::size_t comma = rest.find(',');
     const std::string_view item = rest.substr(0, comma);
     rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
     const std::size_t colon = item.find(':');
-    if (colon == std::string_view::npos) return bad(item, "has no ':seconds'");
+    if (colon == std::string_view::npos) throw bad(item, "has no ':seconds'");
     const std::string_view speeds = item.substr(0, colon);
     // The range dash is the first '-' after the first character (which may be a sign).
     const std::size_t dash = speeds.size() > 1 ? speeds.find('-', 1) : std::string_view::npos;
     SpeedSegment s{};
-    if (!parse_number(speeds.substr(0, dash), s.rpm_start)) return bad(item, "has a bad start speed [r/min]");
+    if (!parse_number(speeds.substr(0, dash), s.rpm_start)) throw bad(item, "has a bad start speed [r/min]");
     s.rpm_end = s.rpm_start;
     if (dash != std::string_view::npos && !parse_number(speeds.substr(dash + 1), s.rpm_end)) {
-      return bad(item, "has a bad end speed [r/min]");
+      throw bad(item, "has a bad end speed [r/min]");
     }
     if (!parse_number(item.substr(colon + 1), s.duration_s) || !(s.duration_s > 0.0)) {
-      return bad(item, "needs a duration > 0 [s] after ':'");
+      throw bad(item, "needs a duration > 0 [s] after ':'");
     }
     segments.push_back(s);
   }
-  out = std::move(segments);
-  return std::nullopt;
+  return segments;
 }
 
 }  // namespace resolver

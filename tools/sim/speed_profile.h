@@ -3,12 +3,12 @@
 // Pure maths (no I/O); parse_speed_profile() reads the CLI's text form.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/errors.h"
 
 namespace resolver {
 
@@ -48,7 +48,8 @@ class SpeedProfile {
 
 /// Parses "200:5,200-1000:3,1000:2": comma-separated rpm[-rpm_end]:seconds
 /// segments (a leading '-' is a negative speed: "-200--100:1"). Returns the
-/// segments, or an error message that names the bad segment and shows the form.
-[[nodiscard]] std::optional<std::string> parse_speed_profile(std::string_view text, std::vector<SpeedSegment>& out);
+/// segments, or throws InputError (Fault::kUsage, option --profile) naming the
+/// bad segment and showing the form.
+[[nodiscard]] std::vector<SpeedSegment> parse_speed_profile(std::string_view text);
 
 }  // namespace resolver

@@ -153,7 +153,7 @@ TEST(PipelineBadInput, MissingLogIsAClearError) {
   EXPECT_THROW(run_replay(ro, pipeline, flags, diag), std::runtime_error);
 }
 
-TEST(PipelineBadInput, BadDbcInConfigIsAConfigError) {
+TEST(PipelineBadInput, BadDbcInConfigIsAUsageErrorNamingItsLine) {
   const std::string path = std::string(RESOLVER_BINARY_DIR) + "/pipeline_bad.dbc";
   std::ofstream(path) << "VERSION \"\"\nBO_ 256 RESOLVER_SAMPLE: 8 INVERTER\n SG_ counter : 0|8@1+ (1,0 [0|255] \"\" X\n";
   DaemonConfig config;
@@ -162,9 +162,12 @@ TEST(PipelineBadInput, BadDbcInConfigIsAConfigError) {
   std::ostringstream diag;
   try {
     Pipeline pipeline(config, sink, diag);
-    FAIL() << "expected ConfigError";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("pipeline_bad.dbc:3"), std::string::npos) << e.what();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {  // the parser's own, as it threw it: exit 2
+    EXPECT_EQ(e.fault(), Fault::kUsage);
+    EXPECT_EQ(e.where().file, path);
+    EXPECT_EQ(e.where().line, 3U);
+    EXPECT_NE(std::string(e.what()).find("pipeline_bad.dbc:3: "), std::string::npos) << e.what();
   }
 }
 

@@ -8,7 +8,6 @@
 #include <memory>
 #include <sstream>
 #include <string>
-#include <variant>
 
 #include "daemon/app/signal_health_log.h"
 #include "daemon/dbc/dbc_parser.h"
@@ -19,9 +18,7 @@ namespace {
 std::shared_ptr<const FrameDecoder> decoder_for(const std::string& sin_cos_signals) {
   const std::string text = "VERSION \"\"\nBU_: INV RD\nBO_ 256 FB: 8 INV\n SG_ counter : 0|8@1+ (1,0) [0|255] \"\" RD\n" +
                            sin_cos_signals + "\n";
-  auto loaded = dbc::parse_dbc(text, "test.dbc");
-  EXPECT_TRUE(std::holds_alternative<dbc::Database>(loaded));
-  auto db = std::make_shared<const dbc::Database>(std::get<dbc::Database>(std::move(loaded)));
+  auto db = std::make_shared<const dbc::Database>(dbc::parse_dbc(text, "test.dbc"));
   SignalMap m;
   m.roles[static_cast<std::size_t>(Role::kSin)] = SignalRef{"FB", "s"};
   m.roles[static_cast<std::size_t>(Role::kCos)] = SignalRef{"FB", "c"};

@@ -72,7 +72,13 @@ TEST(CandumpWriter, RejectsUnloggableFrameAndWritesNothing) {
   CanFrame bad;
   bad.set_iface("can0");
   bad.len = 9;  // classic frames hold at most 8 bytes
-  EXPECT_THROW(writer.write(bad), std::invalid_argument);
+  try {
+    writer.write(bad);
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {  // the caller's frame: a usage error (exit 2), at the line it would take
+    EXPECT_EQ(e.fault(), Fault::kUsage);
+    EXPECT_EQ(std::string(e.what()), tmp.str() + ":1: cannot log this frame: classic CAN length 9 exceeds 8 bytes");
+  }
   EXPECT_EQ(writer.frames_written(), 0U);
   writer.close();
   EXPECT_EQ(candump_test::read_text(tmp.str()), "");

@@ -17,21 +17,38 @@ namespace resolver::dbc {
 namespace {
 
 Database parse_ok(const std::string& text) {
-  auto r = parse_dbc(text, "test.dbc");
-  if (const auto* e = std::get_if<DbcError>(&r)) {
-    ADD_FAILURE() << "unexpected error: " << e->what();
+  try {
+    return parse_dbc(text, "test.dbc");
+  } catch (const InputError& e) {
+    ADD_FAILURE() << "unexpected error: " << e.what();
     return {};
   }
-  return std::get<Database>(std::move(r));
 }
 
-DbcError parse_bad(const std::string& text) {
-  auto r = parse_dbc(text, "bad.dbc");
-  if (std::holds_alternative<Database>(r)) {
-    ADD_FAILURE() << "expected an error for:\n" << text;
-    return {};
+/// What an InputError from the parser says, copied out for the checks below.
+struct Refusal {
+  std::size_t line = 0;
+  std::string message;
+  std::string text;  ///< what()
+  Fault fault = Fault::kData;
+  [[nodiscard]] const std::string& what() const { return text; }
+};
+
+Refusal refusal_of(const InputError& e) {
+  return Refusal{static_cast<std::size_t>(e.where().line), e.message(), e.what(), e.fault()};
+}
+
+Refusal parse_bad(const std::string& text) {
+  try {
+    (void)parse_dbc(text, "bad.dbc");
+  } catch (const InputError& e) {
+    const Refusal r = refusal_of(e);
+    EXPECT_EQ(e.where().file, "bad.dbc") << e.what();
+    EXPECT_EQ(r.fault, Fault::kUsage) << "a DBC is configuration: exit 2";
+    return r;
   }
-  return std::get<DbcError>(std::move(r));
+  ADD_FAILURE() << "expected an error for:\n" << text;
+  return {};
 }
 
 // Line 1 comment; the message starts on line 3, its first signal on line 4.
@@ -136,7 +153,7 @@ TEST(DbcParser, UnknownKeywordIsSkippedLineWiseWithAWarning) {
 }
 
 TEST(DbcParser, SignalAfterAnotherStatementIsNotAttachedToTheEarlierMessage) {
-  const DbcError e = parse_bad(kHeader + "CM_ BO_ 291 \"x\";\n SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n");
+  const Refusal e = parse_bad(kHeader + "CM_ BO_ 291 \"x\";\n SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n");
   EXPECT_EQ(e.line, 5U) << e.what();
   EXPECT_NE(e.message.find("not inside a message"), std::string::npos) << e.what();
 }
@@ -165,7 +182,7 @@ TEST(DbcParser, MultiplexedSignalsDecodeOnlyForTheirMuxValue) {
 }
 
 TEST(DbcParser, DuplicateMessageIdIsAnErrorNamingBothMessagesAndLines) {
-  const DbcError e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
+  const Refusal e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n"
                                          "BO_ 292 OTHER: 8 ECU\n"
                                          "BO_ 291 AGAIN: 8 ECU\n");
   EXPECT_EQ(e.line, 6U) << e.what();
@@ -253,7 +270,7 @@ TEST(DbcParser, LongNamesFromAttributesAreFoundBesideTheShortOnes) {
 }
 
 TEST(DbcParser, MultiplexedSignalWithoutMultiplexorIsAnError) {
-  const DbcError e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ b m3 : 8|8@1+ (1,0) [0|0] \"\" ECU\n");
+  const Refusal e = parse_bad(kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ b m3 : 8|8@1+ (1,0) [0|0] \"\" ECU\n");
   EXPECT_EQ(e.line, 5U) << e.what();
   EXPECT_NE(e.message.find("no multiplexor"), std::string::npos) << e.what();
 }
@@ -261,7 +278,7 @@ TEST(DbcParser, MultiplexedSignalWithoutMultiplexorIsAnError) {
 TEST(DbcParser, FloatSignalsFromSigValtype) {
   const Database db = parse_ok(kHeader + " SG_ f : 0|32@1- (1,0) [0|0] \"\" ECU\nSIG_VALTYPE_ 291 f : 1;\n");
   EXPECT_EQ(db.messages.at(0).signals.at(0).value_type, ValueType::kFloat32);
-  const DbcError e = parse_bad(kHeader + " SG_ f : 0|16@1- (1,0) [0|0] \"\" ECU\nSIG_VALTYPE_ 291 f : 2;\n");
+  const Refusal e = parse_bad(kHeader + " SG_ f : 0|16@1- (1,0) [0|0] \"\" ECU\nSIG_VALTYPE_ 291 f : 2;\n");
   EXPECT_EQ(e.line, 5U) << e.what();
   EXPECT_NE(e.message.find("needs 64"), std::string::npos) << e.what();
 }
@@ -300,7 +317,7 @@ TEST(DbcParser, SyntaxErrorsNameTheLineAndWhatWasExpected) {
       {"duplicate signal", kHeader + " SG_ a : 0|8@1+ (1,0) [0|0] \"\" ECU\n SG_ a : 8|8@1+ (1,0) [0|0] \"\" ECU\n", 5, "defined twice"},
   };
   for (const BadCase& c : cases) {
-    const DbcError e = parse_bad(c.text);
+    const Refusal e = parse_bad(c.text);
     EXPECT_EQ(e.line, c.line) << c.name << ": " << e.what();
     EXPECT_NE(e.message.find(c.expected_words), std::string::npos) << c.name << ": " << e.what();
     EXPECT_EQ(e.what().rfind("bad.dbc:" + std::to_string(c.line) + ": ", 0), 0U) << c.name << ": " << e.what();
@@ -308,11 +325,12 @@ TEST(DbcParser, SyntaxErrorsNameTheLineAndWhatWasExpected) {
 }
 
 TEST(DbcParser, MissingFileIsAnErrorNotACrash) {
-  const auto r = load_dbc_file("/nonexistent/dir/none.dbc");
-  ASSERT_TRUE(std::holds_alternative<DbcError>(r));
-  const DbcError& e = std::get<DbcError>(r);
-  EXPECT_EQ(e.line, 0U);
-  EXPECT_NE(e.what().find("/nonexistent/dir/none.dbc: cannot open"), std::string::npos) << e.what();
+  try {
+    (void)load_dbc_file("/nonexistent/dir/none.dbc");
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {  // a std::system_error: exit 3, like every file that cannot be read
+    EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/dir/none.dbc: cannot open DBC file: ", 0), 0U) << e.what();
+  }
 }
 
 TEST(DbcParser, EmptyAndWhitespaceInputsGiveEmptyDatabases) {
@@ -343,12 +361,13 @@ TEST(DbcParserRobustness, TruncatedAndDamagedFilesNeverCrash) {
   ss << in.rdbuf();
   const std::string full = ss.str();
   const auto check = [](const std::string& text, const std::string& what) {
-    const auto r = parse_dbc(text, "damaged.dbc");
-    if (const auto* e = std::get_if<DbcError>(&r)) {
+    try {
+      (void)parse_dbc(text, "damaged.dbc");
+    } catch (const InputError& e) {
       const auto lines = static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1U;
-      EXPECT_GE(e->line, 1U) << what << ": " << e->what();
-      EXPECT_LE(e->line, lines) << what << ": " << e->what();
-      EXPECT_FALSE(e->message.empty()) << what;
+      EXPECT_GE(e.where().line, 1U) << what << ": " << e.what();
+      EXPECT_LE(e.where().line, lines) << what << ": " << e.what();
+      EXPECT_FALSE(e.message().empty()) << what;
     }
   };
   for (std::size_t n = 0; n <= full.size(); n += 7) check(full.substr(0, n), "prefix " + std::to_string(n));

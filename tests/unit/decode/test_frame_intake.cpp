@@ -7,7 +7,6 @@
 #include <memory>
 #include <string>
 #include <utility>
-#include <variant>
 #include <vector>
 
 #include "daemon/dbc/dbc_parser.h"
@@ -18,9 +17,7 @@ namespace resolver {
 namespace {
 
 std::shared_ptr<const FrameDecoder> bench_decoder() {
-  auto loaded = dbc::load_dbc_file(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc");
-  EXPECT_TRUE(std::holds_alternative<dbc::Database>(loaded));
-  auto db = std::make_shared<const dbc::Database>(std::get<dbc::Database>(std::move(loaded)));
+  auto db = std::make_shared<const dbc::Database>(dbc::load_dbc_file(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc"));
   return std::make_shared<const FrameDecoder>(db, SignalMap::bench_default());
 }
 
@@ -342,9 +339,7 @@ TEST(FrameIntake, FramesWithoutAnInterfaceNameAreAlwaysRead) {
 }
 
 TEST(FrameDecoder, SignalMapErrorsNameTheProblem) {
-  auto loaded = dbc::load_dbc_file(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc");
-  ASSERT_TRUE(std::holds_alternative<dbc::Database>(loaded));
-  auto db = std::make_shared<const dbc::Database>(std::get<dbc::Database>(std::move(loaded)));
+  auto db = std::make_shared<const dbc::Database>(dbc::load_dbc_file(RESOLVER_SOURCE_DIR "/proto/resolver_bench.dbc"));
   SignalMap map = SignalMap::bench_default();
   map.roles[static_cast<std::size_t>(Role::kSin)] = SignalRef{"RESOLVER_SAMPLE", "sine"};
   map.roles[static_cast<std::size_t>(Role::kIA)] = SignalRef{"CURRENTS", "i_a"};

@@ -9,7 +9,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "daemon/dbc/dbc_parser.h"
@@ -29,12 +28,12 @@ const std::string kMuxDbc =
     " SG_ rd : 48|16@1+ (0.0001,0) [0|6.3] \"rad\" RD\n";
 
 std::shared_ptr<const dbc::Database> parse(const std::string& text) {
-  auto loaded = dbc::parse_dbc(text, "test.dbc");
-  if (auto* err = std::get_if<dbc::DbcError>(&loaded)) {
-    ADD_FAILURE() << err->what();
+  try {
+    return std::make_shared<const dbc::Database>(dbc::parse_dbc(text, "test.dbc"));
+  } catch (const InputError& e) {
+    ADD_FAILURE() << e.what();
     return std::make_shared<const dbc::Database>();
   }
-  return std::make_shared<const dbc::Database>(std::get<dbc::Database>(std::move(loaded)));
 }
 
 SignalMap map(bool with_rd) {

@@ -8,7 +8,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <variant>
 
 #include "daemon/dbc/dbc_parser.h"
 #include "daemon/decode/frame_decoder.h"
@@ -19,12 +18,12 @@ namespace {
 std::shared_ptr<const dbc::Database> parse(const std::string& signals) {
   const std::string text = "VERSION \"\"\nBU_: INV RD\nBO_ 256 FB: 8 INV\n SG_ counter : 0|8@1+ (1,0) [0|255] \"\" RD\n" +
                            signals + "\n";
-  auto loaded = dbc::parse_dbc(text, "test.dbc");
-  if (auto* err = std::get_if<dbc::DbcError>(&loaded)) {
-    ADD_FAILURE() << err->what();
+  try {
+    return std::make_shared<const dbc::Database>(dbc::parse_dbc(text, "test.dbc"));
+  } catch (const InputError& e) {
+    ADD_FAILURE() << e.what();
     return nullptr;
   }
-  return std::make_shared<const dbc::Database>(std::get<dbc::Database>(std::move(loaded)));
 }
 
 SignalMap sincos_map() {

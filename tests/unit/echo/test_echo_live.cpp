@@ -40,7 +40,6 @@ TEST_F(EchoLive, StopsAfterCount) {
   LiveEcho live(lcm_, decoder_, EchoFilter{}, sink_);
   publish(3);
   const auto r = live.run(2, 5s);
-  EXPECT_EQ(r.error, "");
   EXPECT_FALSE(r.timed_out);
   EXPECT_EQ(r.emitted, 2);
   ASSERT_EQ(lines_.size(), 2u);
@@ -62,15 +61,19 @@ TEST_F(EchoLive, StopsAtTimeoutWithWhatArrived) {
   EXPECT_EQ(lines_.size(), 1u);
 }
 
-TEST_F(EchoLive, SinkExceptionIsReportedNotPropagated) {
+TEST_F(EchoLive, SinkExceptionIsThrownAsIoErrorOnceLcmHasReturned) {
   const JsonLineSink throwing = [](const std::string&) { throw std::runtime_error("disk full"); };
   LiveEcho live(lcm_, decoder_, EchoFilter{}, throwing);
   publish(2);
-  LiveEchoResult r;
-  EXPECT_NO_THROW(r = live.run(2, 2s));
-  EXPECT_EQ(r.emitted, 0);
-  EXPECT_NE(r.error.find("disk full"), std::string::npos) << r.error;
-  EXPECT_NE(r.error.find("RESOLVER_ANGLE"), std::string::npos) << r.error;
+  try {
+    (void)live.run(2, 2s, Where::at_option("--lcm memq://"));
+    ADD_FAILURE() << "expected IoError";
+  } catch (const IoError& e) {  // exit 3
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("--lcm memq://: channel '", 0), 0U) << what;
+    EXPECT_NE(what.find("disk full"), std::string::npos) << what;
+    EXPECT_NE(what.find("RESOLVER_ANGLE"), std::string::npos) << what;
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -387,27 +388,24 @@ TEST(CalibrationStore, SetAsideKeepsTheFileUnderANewName) {
 
 TEST(StateDirLock, SecondHolderIsRefusedNamingThePid) {
   TempDir dir;
-  std::string problem;
-  auto first = StateDirLock::acquire(dir.path(), problem);
-  ASSERT_TRUE(first) << problem;
+  std::optional<StateDirLock> first;
+  ASSERT_NO_THROW(first = StateDirLock::acquire(dir.path()));
   // flock locks belong to the open file description: a second open in this process
   // conflicts just as another process would.
-  auto second = StateDirLock::acquire(dir.path(), problem);
-  EXPECT_FALSE(second);
+  const std::string problem = thrown<IoError>([&] { (void)StateDirLock::acquire(dir.path()); });
   EXPECT_NE(problem.find("in use by another resolverd, pid " + std::to_string(::getpid())), std::string::npos)
       << problem;
   EXPECT_NE(problem.find(dir.path() + "/resolverd.lock"), std::string::npos) << problem;
   first.reset();  // released: the next one gets it
-  EXPECT_TRUE(StateDirLock::acquire(dir.path(), problem)) << problem;
+  EXPECT_NO_THROW((void)StateDirLock::acquire(dir.path()));
 }
 
 TEST(StateDirLock, MissingDirectoryAndFifoAreRefusedWithoutBlocking) {
   TempDir dir;
-  std::string problem;
-  EXPECT_FALSE(StateDirLock::acquire(dir.path() + "/nope", problem));
+  std::string problem = thrown<IoError>([&] { (void)StateDirLock::acquire(dir.path() + "/nope"); });
   EXPECT_NE(problem.find("No such file or directory"), std::string::npos) << problem;
   ASSERT_EQ(::mkfifo((dir.path() + "/resolverd.lock").c_str(), 0644), 0);
-  EXPECT_FALSE(StateDirLock::acquire(dir.path(), problem));
+  problem = thrown<IoError>([&] { (void)StateDirLock::acquire(dir.path()); });
   EXPECT_NE(problem.find("not a regular file"), std::string::npos) << problem;
 }
 

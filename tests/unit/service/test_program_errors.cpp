@@ -32,6 +32,20 @@ TEST(ProgramErrors, InputErrorSaysWhoseFaultAndWhere) {
   EXPECT_EQ(mapped(InputError(Fault::kUsage, "no where")).second, "no where");
 }
 
+TEST(ProgramErrors, WhereSpansLinesAndTheMessageStandsAlone) {
+  Where rows = Where::at_file("scope.csv", 2);
+  rows.last_line = 202;
+  const InputError e(Fault::kUsage, "time column too coarse", rows);
+  EXPECT_STREQ(e.what(), "scope.csv:2-202: time column too coarse");
+  EXPECT_EQ(e.message(), "time column too coarse");
+  EXPECT_EQ(e.where().last_line, 202U);
+  rows.last_line = 2;  // one line: no range
+  EXPECT_STREQ(InputError(Fault::kUsage, "x", rows).what(), "scope.csv:2: x");
+  const auto [code, message] = mapped(IoError("cannot read [layout] dbc a.dbc: gone", Where::at_file("b.toml")));
+  EXPECT_EQ(code, exit_code::kIo);
+  EXPECT_EQ(message, "b.toml: cannot read [layout] dbc a.dbc: gone");
+}
+
 TEST(ProgramErrors, LibraryArgumentCheckIsUsage) {
   EXPECT_EQ(mapped(std::invalid_argument("'x' is not an effect")),
             std::make_pair(exit_code::kUsage, std::string("'x' is not an effect")));

@@ -43,8 +43,7 @@ TEST(SimSpeedProfile, RejectsBadSegments) {
 }
 
 TEST(SimSpeedProfile, ParsesTheCliForm) {
-  std::vector<SpeedSegment> s;
-  ASSERT_FALSE(parse_speed_profile("200:5,200-1000:3,1000:2,-200--100:1.5", s));
+  const std::vector<SpeedSegment> s = parse_speed_profile("200:5,200-1000:3,1000:2,-200--100:1.5");
   ASSERT_EQ(s.size(), 4U);
   EXPECT_DOUBLE_EQ(s[0].rpm_start, 200.0);
   EXPECT_DOUBLE_EQ(s[0].rpm_end, 200.0);
@@ -55,11 +54,14 @@ TEST(SimSpeedProfile, ParsesTheCliForm) {
   EXPECT_DOUBLE_EQ(s[3].rpm_end, -100.0);
   EXPECT_DOUBLE_EQ(s[3].duration_s, 1.5);
   for (const char* bad : {"", "200", "200:0", "abc:1", "200-x:1", "200:1,,300:1", "200:-1"}) {
-    std::vector<SpeedSegment> unchanged{{1.0, 1.0, 1.0}};
-    const auto err = parse_speed_profile(bad, unchanged);
-    ASSERT_TRUE(err.has_value()) << bad;
-    EXPECT_NE(err->find("--profile"), std::string::npos) << *err;
-    EXPECT_EQ(unchanged.size(), 1U);
+    try {
+      (void)parse_speed_profile(bad);
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.fault(), Fault::kUsage);
+      EXPECT_EQ(e.where().option, "--profile");
+      EXPECT_EQ(std::string(e.what()).rfind("--profile: '" + std::string(bad) + "': segment ", 0), 0U) << e.what();
+    }
   }
 }
 
