@@ -294,7 +294,9 @@ std::string format_model_html(const DiscoveryRun& run, const LogSamples& log, st
   o += fmt::format(
       "<p class=\"meta\">log <code>{}</code> · {} samples from {} frames · p<sub>r</sub> = {}, p = {}{} · "
       "position error against {} · signals fitted: {}</p>\n",
-      escape(log_path), run.log->samples_in, log.frames, run.log->p_r, run.log->p,
+      // The prepared log's count (a pooled run's LogSamples has no samples of its own).
+      escape(log_path), run.log ? run.log->samples_in : static_cast<std::int64_t>(log.input.samples.size()), log.frames,
+      run.log ? run.log->p_r : log.input.p_r, run.log ? run.log->p : log.input.p,
       log.bench_info ? " (BENCH_INFO)" : " (assumed)",
       f.reference ? "the reference encoder" : "the speed-smoothed ideal angle",
       escape(fmt::format("{}", fmt::join(signals, ", "))));
