@@ -14,6 +14,7 @@
 #include <toml++/toml.h>
 
 #include "daemon/app/exit_codes.h"
+#include "daemon/core/errors.h"
 #include "daemon/core/effects/chain_values.h"
 #include "daemon/core/effects/quantization.h"
 #include "drivers/candump/candump_writer.h"
@@ -76,9 +77,12 @@ struct Options {
   bool effects_markdown = false;
 };
 
+/// A refused option or config (exit 2), or a file that cannot be written (exit 3):
+/// thrown, so run_program prints it and maps it by the one rule (no std::exit past
+/// the destructors of a half-written log).
 [[noreturn]] void fail(const std::string& message, int code = resolver::exit_code::kUsage) {
-  fmt::print(stderr, "resolver-sim: {}\n", message);
-  std::exit(code);
+  if (code == resolver::exit_code::kIo) throw resolver::IoError(message);
+  throw resolver::InputError(resolver::Fault::kUsage, message);
 }
 
 /// [rad per sample] the resolver electrical angle's travel per sample at which it
