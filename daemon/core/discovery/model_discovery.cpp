@@ -203,7 +203,16 @@ Eigen::MatrixXd parameter_covariance(const StepSolution& s, const ResidualPass& 
     for (Eigen::Index b = 0; b < k; ++b) m_inv(a, b) = s.inverse(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]);
   }
   const double correction = static_cast<double>(pass.blocks) / (pass.blocks - 1.0);
-  const Eigen::MatrixXd robust = m_inv * pass.score_outer * m_inv * correction;
+  // robust = M^-1 S M^-1 with S = sum over blocks of g g' (positive semidefinite), formed
+  // as F F' with F = M^-1 P' L sqrt(D) from S's LDLT: each variance is then a sum of
+  // squares. Multiplied out, rounding lost a nonlinear parameter's variance: the
+  // tracking loop's z = 1/omega_n^2 ~ 1e-7 beside alpha ~ 1e-2 gave a variance below
+  // zero, printed as a standard error of 0 (tracking_loop.omega_n = 3047 +- 0).
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(pass.score_outer);
+  const Eigen::VectorXd root_d = ldlt.vectorD().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::MatrixXd l_root = Eigen::MatrixXd(ldlt.matrixL()) * root_d.asDiagonal();
+  const Eigen::MatrixXd factor = m_inv * (ldlt.transpositionsP().transpose() * l_root);
+  const Eigen::MatrixXd robust = factor * factor.transpose() * correction;
   for (Eigen::Index a = 0; a < k; ++a) {
     for (Eigen::Index b = 0; b < k; ++b) {
       cov(cols[static_cast<std::size_t>(a)], cols[static_cast<std::size_t>(b)]) = robust(a, b);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace resolver {
@@ -186,9 +187,20 @@ bool Design::pushed_past_bound(int col, double dz) const {
     const ParamInfo& info = t.effect->params()[p];
     if (info.polar != Polar::kNone) return false;
     const double z = to_internal(info, t.values[p]);
-    const double lo = to_internal(info, info.min), hi = to_internal(info, info.max);
-    const double zmin = std::min(lo, hi), zmax = std::max(lo, hi);
-    const double tol = 1e-12 * std::max(1.0, zmax - zmin);
+    double zmin = 0.0, zmax = 0.0;
+    if (info.scale == FitScale::kInverseSquare) {
+      // z = 1/value^2 with value 0 the neutral (an ideal converter, infinitely fast): z runs
+      // from 0 (ideal; the range's top, 1e6 rad/s, is z = 1e-12) up to 1/min^2, unbounded
+      // for min = 0. Taken as [z(min), z(max)] = [0, 1e-12], every fitted loop sat "at the
+      // top bound", and a step to a slower loop was held: omega_n only ever rose (3047 for
+      // a 3000 rad/s loop) and its standard error printed 0 (its column left the solution).
+      zmin = 0.0;
+      zmax = info.min > 0.0 ? to_internal(info, info.min) : std::numeric_limits<double>::infinity();
+    } else {
+      zmin = std::min(info.min, info.max);
+      zmax = std::max(info.min, info.max);
+    }
+    const double tol = 1e-12 * (std::isfinite(zmax) ? std::max(1.0, zmax - zmin) : 1.0);
     return (z <= zmin + tol && dz < 0.0) || (z >= zmax - tol && dz > 0.0);
   }
   return false;
