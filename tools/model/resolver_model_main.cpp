@@ -46,6 +46,7 @@
 #include "tools/model/log_samples.h"
 #include "tools/model/model_report.h"
 #include "tools/model/pooled_run.h"
+#include "tools/model/stats_run.h"
 #include "daemon/service/program_version.h"
 
 namespace {
@@ -201,6 +202,23 @@ A unit fails, and the others go on, when a log is missing,
 unreadable or has no usable data, is listed twice, or has another p_r than the fleet.
 Exit 0 when every unit is done, 1 when some unit failed (fleet.json says which and why).)";
 
+constexpr const char* kStatsExamples = R"(Examples:
+  # one run's statistics (the model fitted to it, then one pass with every candidate's columns)
+  resolver-model stats mon.log --effects amplitude_imbalance,quadrature,tracking_loop --out mon.stats
+  # the second half of a long log only
+  resolver-model stats endurance.log --from 1800 --out endurance_2.stats
+Writes self-describing JSON (format, version, tool, layout, bench, model, columns, each
+signal group's normal equations per validation fold, noise floors, counts) that merge reads.)";
+
+constexpr const char* kMergeExamples = R"(Examples:
+  # a week of runs of one motor fitted together from their statistics (no logs needed)
+  resolver-model merge mon.stats tue.stats wed.stats
+  # another model from the same statistics (its effects must be each file's model or candidates)
+  resolver-model merge mon.stats tue.stats --effects amplitude_imbalance,quadrature --json
+Each run keeps its own reference zero, amplitude and operating point, as in fit A.log B.log;
+linear parameters merge exactly, nonlinear ones to second order in how far the runs' own
+fits lie apart (a note says how far). Files of another version or layout are refused (exit 2).)";
+
 /// A subcommand's footer: its examples, then the exit codes every --help ends with.
 std::string sub_footer(const char* examples) {
   return std::string(examples) + "\n\n" + resolver::exit_code::kHelpText;
@@ -252,7 +270,7 @@ int run_fleet(const std::string& manifest, const std::string& out, const std::st
 }
 
 /// The subcommands; several share an argument (LOG, --effects, --config, ...).
-enum class Command { kFit, kExplain, kReport, kExportData, kExport, kFleet };
+enum class Command { kFit, kExplain, kReport, kExportData, kExport, kFleet, kStats, kMerge };
 
 /// Every value the command line sets, one field per option whatever subcommand gives it.
 struct Arguments {
@@ -275,6 +293,8 @@ struct Arguments {
   std::string export_format = "csv", export_out;  // export
   int export_points = 1024;  // export and fleet
   std::string manifest, fleet_out, summarize_dir;  // fleet
+  std::string stats_out;                // stats
+  std::vector<std::string> stats_files;  // merge
 };
 
 /// fit and explain: the log, the model (with the fittable effects listed) and --json.
@@ -332,8 +352,12 @@ struct Subcommands {
   CLI::App* export_data = nullptr;
   CLI::App* exporter = nullptr;
   CLI::App* fleet = nullptr;
+  CLI::App* stats = nullptr;
+  CLI::App* merge = nullptr;
 
   [[nodiscard]] Command parsed() const {
+    if (stats->parsed()) return Command::kStats;
+    if (merge->parsed()) return Command::kMerge;
     if (explain->parsed()) return Command::kExplain;
     if (report->parsed()) return Command::kReport;
     if (export_data->parsed()) return Command::kExportData;
@@ -379,6 +403,27 @@ void add_discovery_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
   }
 }
 
+/// stats and merge: statistics that merge (issue 24).
+void add_statistics_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
+  CLI::App* stats = subs.stats = app.add_subcommand(
+      "stats", "fit the model to one log and write its statistics (normal equations of the model and every "
+               "candidate, floors, counts) for merge");
+  stats->footer(sub_footer(kStatsExamples));
+  stats->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
+  stats->add_option("--effects", a.effects_args, "the model, as for fit (default amplitude_imbalance)");
+  stats->add_option("--out", a.stats_out, "statistics file to write (JSON)")->required();
+  add_config_options(stats, a);
+  add_slicing_options(stats, a);
+  CLI::App* merge = subs.merge = app.add_subcommand(
+      "merge", "fit several runs of one bench from their statistics files (resolver-model stats), without the logs");
+  merge->footer(sub_footer(kMergeExamples));
+  merge->add_option("STATS", a.stats_files, "statistics files written by resolver-model stats")->required();
+  merge->add_option("--effects", a.effects_args,
+                    "the model (default: the first file's); each parameter must be a column of every file");
+  merge->add_flag("--json", a.json, "print one JSON object instead of the text report");
+  merge->add_option("--config", a.config_path, "resolverd config (TOML): its [[model.custom]] effects");
+}
+
 /// export and fleet, after the others.
 void add_calibration_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
   CLI::App* exporter = subs.exporter = app.add_subcommand(
@@ -406,6 +451,7 @@ void add_calibration_subcommands(CLI::App& app, Arguments& a, Subcommands& subs)
   fleet->add_option("--points", a.export_points, "calibration table points per mechanical revolution (default 1024)")
       ->check(CLI::Range(8, 1 << 20));
   fleet->add_option("--config", a.config_path, "resolverd config (TOML), as for explain");
+  add_statistics_subcommands(app, a, subs);
 }
 
 /// A usage error or an unreadable input, said before anything is read: its exit code.
@@ -566,6 +612,10 @@ int run_on_log(const Arguments& a) {
   if (a.command == Command::kReport || a.command == Command::kExport || a.command == Command::kExportData) {
     return write_outputs(a, samples, model.effects, options, shown);
   }
+  if (a.command == Command::kStats) {
+    resolver::write_stats_file(resolver::make_stats_file(samples, a.log, model.effects, options, model.config), a.stats_out);
+    return 0;
+  }
   const bool do_explain = a.command == Command::kExplain;
   const resolver::Explanation ex = fit_or_explain(samples, a.log, model.effects, options, do_explain, shown);
   const std::vector<std::string> notes = report_notes(samples);
@@ -591,6 +641,11 @@ int run(int argc, char** argv) {
   if (a.command == Command::kFleet) {
     return run_fleet(a.manifest, a.fleet_out, a.summarize_dir, split_effects(a.effects_args), a.config_path,
                      a.export_points);
+  }
+  if (a.command == Command::kMerge) {
+    for (const std::string& f : a.stats_files) resolver::exit_code::require_readable("STATS", f);  // IoError: exit 3
+    const Model model = load_model(a);
+    return resolver::run_merge(a.stats_files, split_effects(a.effects_args), a.json, discovery_options(a, model.config));
   }
   if (auto code = check_arguments(a)) return *code;
   return run_on_log(a);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 #include "daemon/core/discovery/coverage.h"
@@ -82,6 +83,23 @@ void check_model_against_log(const ModelSpec& spec, const PreparedLog& log) {
   }
   const CoverageCheck c = check_coverage(log.rows, needed_orders(spec));
   if (!c.ok) throw std::invalid_argument(c.missing);
+}
+
+/// Cross-validated rms of group g: fitted on one fold, evaluated on the other.
+double held_back_rms(const PassStatistics& stats, const GroupFloors& floors, std::span<const int> cols, Group g) {
+  const auto i = static_cast<std::size_t>(g);
+  const NormalEquations b = stats.fold_b(g);
+  const NormalEquations& a = stats.fold_a[i];
+  if (a.n() == 0 || b.n() == 0) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<NormalEquations> only_a(kGroups), only_b(kGroups);
+  for (int k = 0; k < kGroups; ++k) {
+    only_a[static_cast<std::size_t>(k)] = stats.fold_a[static_cast<std::size_t>(k)];
+    only_b[static_cast<std::size_t>(k)] = stats.fold_b(static_cast<Group>(k));
+  }
+  const StepSolution fa = solve_step(only_a, floors, cols);
+  const StepSolution fb = solve_step(only_b, floors, cols);
+  if (!fa.ok || !fb.ok) return std::numeric_limits<double>::quiet_NaN();
+  return rms(b.rss(fa.dz) + a.rss(fb.dz), a.n() + b.n());
 }
 
 std::string num(double v, const char* format) {

@@ -2,6 +2,7 @@
 // the columns of a design's model, residual rms per signal, the verdict test.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,11 @@ inline constexpr std::string_view kNeedsAlignedReference =
 /// Checks the model's needs against the log (reference, currents, coverage).
 /// Throws std::invalid_argument naming the effect and what the log lacks.
 void check_model_against_log(const ModelSpec& spec, const PreparedLog& log);
+
+/// Cross-validated rms of group g: each fold fitted on `cols` and evaluated on the
+/// other (NaN without two folds).
+[[nodiscard]] double held_back_rms(const PassStatistics& stats, const GroupFloors& floors, std::span<const int> cols,
+                                   Group g);
 
 /// "%.3g" formatting for messages.
 [[nodiscard]] std::string num(double v, const char* format = "%.3g");

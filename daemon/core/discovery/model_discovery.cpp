@@ -46,23 +46,6 @@ SampleAccount account_of(const PreparedLog& log) {
   return a;
 }
 
-/// Cross-validated rms of group g: fitted on one fold, evaluated on the other.
-double held_back_rms(const PassStatistics& stats, const GroupFloors& floors, std::span<const int> cols, Group g) {
-  const auto i = static_cast<std::size_t>(g);
-  const NormalEquations b = stats.fold_b(g);
-  const NormalEquations& a = stats.fold_a[i];
-  if (a.n() == 0 || b.n() == 0) return kNaN;
-  std::vector<NormalEquations> only_a(kGroups), only_b(kGroups);
-  for (int k = 0; k < kGroups; ++k) {
-    only_a[static_cast<std::size_t>(k)] = stats.fold_a[static_cast<std::size_t>(k)];
-    only_b[static_cast<std::size_t>(k)] = stats.fold_b(static_cast<Group>(k));
-  }
-  const StepSolution fa = solve_step(only_a, floors, cols);
-  const StepSolution fb = solve_step(only_b, floors, cols);
-  if (!fa.ok || !fb.ok) return kNaN;
-  return rms(b.rss(fa.dz) + a.rss(fb.dz), a.n() + b.n());
-}
-
 /// Standard errors in value coordinates from an internal covariance.
 void fill_params(ModelFit& f, const Design& d, const Eigen::MatrixXd& cov) {
   std::vector<double> ses;

@@ -7,6 +7,9 @@
 
 #include <fmt/format.h>
 
+#include "daemon/core/angles.h"
+#include "daemon/core/effects/registry.h"
+
 namespace resolver {
 
 namespace {
@@ -60,32 +63,15 @@ FloorEstimate pool_floor(const std::vector<const FloorEstimate*>& f, const std::
   return out;
 }
 
-/// Each log's floors weighted by its rows: the pool's (one weight per group for all its rows).
+/// Each log's floors weighted by its rows: the pool's.
 FloorReport pool_floors(const std::vector<PreparedLog>& logs) {
-  std::vector<double> weight;
-  std::vector<const FloorEstimate*> rd, sc, cur;
+  std::vector<const FloorReport*> floors;
+  std::vector<double> rows;
   for (const PreparedLog& l : logs) {
-    weight.push_back(static_cast<double>(l.fitted_rows()));
-    rd.push_back(&l.floors.rd);
-    sc.push_back(&l.floors.sc);
-    cur.push_back(&l.floors.cur);
+    floors.push_back(&l.floors);
+    rows.push_back(static_cast<double>(l.fitted_rows()));
   }
-  return {pool_floor(rd, weight), pool_floor(sc, weight), pool_floor(cur, weight)};
-}
-
-void add_motion(MotionSummary& into, const MotionSummary& m, bool first) {
-  into.samples += m.samples;
-  into.moving += m.moving;
-  into.standstill += m.standstill;
-  into.forward += m.forward;
-  into.backward += m.backward;
-  into.reversals += m.reversals;
-  into.standstills += m.standstills;
-  into.travelled += m.travelled;
-  into.span_s += m.span_s;
-  into.omega_min = first ? m.omega_min : std::min(into.omega_min, m.omega_min);
-  into.omega_max = first ? m.omega_max : std::max(into.omega_max, m.omega_max);
-  into.angle_noise = std::max(into.angle_noise, m.angle_noise);
+  return pool_floor_reports(floors, rows);
 }
 
 void add_outliers(std::vector<OutlierSignal>& into, const std::vector<OutlierSignal>& add) {
@@ -99,6 +85,15 @@ void add_outliers(std::vector<OutlierSignal>& into, const std::vector<OutlierSig
     same->largest = std::max(same->largest, o.largest);
     same->scale = std::max(same->scale, o.scale);
   }
+}
+
+/// True when `name` ("effect.param") is the phase of a polar pair (effect.h Polar).
+bool is_phase(const std::string& name) {
+  const std::size_t dot = name.find('.');
+  const Effect* e = dot == std::string::npos ? nullptr : find_effect(name.substr(0, dot));
+  if (e == nullptr) return false;
+  const int p = find_param(*e, name.substr(dot + 1));
+  return p >= 0 && e->params()[static_cast<std::size_t>(p)].polar == Polar::kPhase;
 }
 
 /// The logs' rows one after the other: part index, time running on, blocks numbered on.
@@ -222,7 +217,9 @@ std::vector<PoolDisagreement> compare_with_pool(const ModelFit& pooled, const st
     for (std::size_t i = 0; i < n; ++i) {
       for (const ModelParameter& p : alone[i].params) {
         if (p.name != q.name || !std::isfinite(p.value) || !(p.std_error > 0.0)) continue;
-        x[i] = p.value;
+        // A phase (eccentricity's, a polar harmonic's) is compared on the circle: 3.1
+        // and -3.1 rad are 0.08 apart, not 6.2.
+        x[i] = is_phase(p.name) ? q.value + wrap_pi(p.value - q.value) : p.value;
         w[i] = 1.0 / (p.std_error * p.std_error);
         in[i] = true;
       }
@@ -314,6 +311,31 @@ PooledExplanation explain_pooled(const std::vector<const DiscoveryInput*>& input
   out.logs = compare_logs(pooled, names, out.pooled.fit, effects, options);
   for (std::string& n : disagreement_notes(out.logs.comparisons)) out.pooled.fit.notes.push_back(std::move(n));
   return out;
+}
+
+FloorReport pool_floor_reports(const std::vector<const FloorReport*>& floors, const std::vector<double>& rows) {
+  std::vector<const FloorEstimate*> rd, sc, cur;
+  for (const FloorReport* f : floors) {
+    rd.push_back(&f->rd);
+    sc.push_back(&f->sc);
+    cur.push_back(&f->cur);
+  }
+  return {pool_floor(rd, rows), pool_floor(sc, rows), pool_floor(cur, rows)};
+}
+
+void add_motion(MotionSummary& into, const MotionSummary& m, bool first) {
+  into.samples += m.samples;
+  into.moving += m.moving;
+  into.standstill += m.standstill;
+  into.forward += m.forward;
+  into.backward += m.backward;
+  into.reversals += m.reversals;
+  into.standstills += m.standstills;
+  into.travelled += m.travelled;
+  into.span_s += m.span_s;
+  into.omega_min = first ? m.omega_min : std::min(into.omega_min, m.omega_min);
+  into.omega_max = first ? m.omega_max : std::max(into.omega_max, m.omega_max);
+  into.angle_noise = std::max(into.angle_noise, m.angle_noise);
 }
 
 }  // namespace resolver

@@ -25,6 +25,14 @@ namespace resolver {
 /// layout), or when fewer than two logs or more than 65535 are given.
 [[nodiscard]] PreparedLog pool_logs(std::vector<PreparedLog> logs, const std::vector<std::string>& names);
 
+/// Each log's floors weighted by its rows (one weight per group for all its rows):
+/// the rows-weighted pooled variance.
+[[nodiscard]] FloorReport pool_floor_reports(const std::vector<const FloorReport*>& floors,
+                                             const std::vector<double>& rows);
+
+/// Adds one log's motion to a pool's (`first`: the pool's first log).
+void add_motion(MotionSummary& into, const MotionSummary& m, bool first);
+
 /// One parameter of one log against the other logs.
 struct PoolDisagreement {
   std::string log;

@@ -51,33 +51,6 @@ bool in_model(const ModelSpec& spec, const Effect& e, int param) {
   return t != nullptr && std::find(t->params.begin(), t->params.end(), param) != t->params.end();
 }
 
-/// What the log's motion (or signals) lacks for `e` to be identifiable, as advice
-/// ("" = nothing). One speed: the moving speeds span less than 10 % of the fastest (a
-/// bench's speed ripple is a few percent; a step or ramp is far more). `sincos`: the
-/// fit has the envelopes' rows beside the R/D angle's.
-std::string motion_missing(const Effect& e, const MotionSummary& m, bool sincos) {
-  const bool reversal = m.reversals > 0;
-  const double fastest = std::max(std::abs(m.omega_min), std::abs(m.omega_max));
-  const bool speed_change = m.omega_max - m.omega_min > 0.1 * fastest;
-  switch (e.identifiable_with()) {
-    case Effect::Needs::kNothing: return "";
-    case Effect::Needs::kSpeedChangeOrReversal:
-      return speed_change || reversal ? ""
-                                      : "at one speed in one direction it is a constant turn of the angle; record "
-                                        "a speed step, a ramp or an out-and-back";
-    case Effect::Needs::kSpeedChangeOrSinCos:
-      // A 3 % gain error at 600 r/min with a 3000 rad/s loop leaves 6e-5 rad at 2 theta
-      // in the R/D angle alone (2x its floor): with sin/cos the fit finds omega_n to 0.1 %.
-      return speed_change || sincos ? ""
-                                    : "at one speed, with the R/D angle alone, it only turns and scales each error "
-                                      "harmonic by a constant; record a ramp or speed steps, or log the sin/cos "
-                                      "envelopes (the loop filters only the R/D angle)";
-    case Effect::Needs::kReversal:
-      return reversal ? "" : "in one direction a play is a constant; record an out-and-back (a reversal)";
-  }
-  return "";
-}
-
 /// A family (CandidateParams::family) of one effect: every group's parameters not
 /// yet in the model, ascending, or empty when fewer than kFamilyFrom groups are left.
 ModelTerm family_term(const Effect& e, const ModelSpec& spec, const std::vector<std::vector<std::string>>& groups) {
@@ -183,6 +156,35 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
   return out;
 }
 
+}  // namespace
+
+/// What the log's motion (or signals) lacks for `e` to be identifiable, as advice
+/// ("" = nothing). One speed: the moving speeds span less than 10 % of the fastest (a
+/// bench's speed ripple is a few percent; a step or ramp is far more). `sincos`: the
+/// fit has the envelopes' rows beside the R/D angle's.
+std::string motion_missing(const Effect& e, const MotionSummary& m, bool sincos) {
+  const bool reversal = m.reversals > 0;
+  const double fastest = std::max(std::abs(m.omega_min), std::abs(m.omega_max));
+  const bool speed_change = m.omega_max - m.omega_min > 0.1 * fastest;
+  switch (e.identifiable_with()) {
+    case Effect::Needs::kNothing: return "";
+    case Effect::Needs::kSpeedChangeOrReversal:
+      return speed_change || reversal ? ""
+                                      : "at one speed in one direction it is a constant turn of the angle; record "
+                                        "a speed step, a ramp or an out-and-back";
+    case Effect::Needs::kSpeedChangeOrSinCos:
+      // A 3 % gain error at 600 r/min with a 3000 rad/s loop leaves 6e-5 rad at 2 theta
+      // in the R/D angle alone (2x its floor): with sin/cos the fit finds omega_n to 0.1 %.
+      return speed_change || sincos ? ""
+                                    : "at one speed, with the R/D angle alone, it only turns and scales each error "
+                                      "harmonic by a constant; record a ramp or speed steps, or log the sin/cos "
+                                      "envelopes (the loop filters only the R/D angle)";
+    case Effect::Needs::kReversal:
+      return reversal ? "" : "in one direction a play is a constant; record an out-and-back (a reversal)";
+  }
+  return "";
+}
+
 std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params) {
   std::string vals;
   const std::string prefix = std::string(t.effect->name()) + ".";
@@ -193,6 +195,8 @@ std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& par
   return std::string(t.effect->physics()) + " (fit: " + vals + ").";
 }
 
+namespace {
+
 /// Standard error of one parameter in value coordinates from a solution's inverse
 /// (column `col`, internal coordinate `z` for the inverse-square scale).
 double value_std_error(const ParamInfo& info, const StepSolution& s, int col, double z) {
@@ -202,32 +206,30 @@ double value_std_error(const ParamInfo& info, const StepSolution& s, int col, do
   return se;
 }
 
-/// The parameters of `design`'s term in value coordinates with standard errors from `s`.
-/// `step` moves the term by the solution first (a linearised candidate taken from its
-/// neutral point); without it the design is already at the solution (a converged refit).
+}  // namespace
+
 std::vector<ModelParameter> term_params(const Design& design, std::size_t term, const StepSolution& s, bool step) {
   Design moved = design;
   DesignTerm& dt = moved.terms()[term];
   dt.candidate = false;  // let step() move it
+  const Eigen::VectorXd z_at = moved.z();  // where the step starts (a candidate: neutral)
   if (step) moved.step(s.dz);
   std::vector<ModelParameter> out;
   for (std::size_t k = 0; k < dt.params.size(); ++k) {
     const auto p = static_cast<std::size_t>(dt.params[k]);
     const ParamInfo& info = dt.effect->params()[p];
     const int col = design.term_column(term) + static_cast<int>(k);
-    const double z = step ? s.dz[col] : to_internal(info, dt.values[p]);
+    const double z = z_at[col] + (step ? s.dz[col] : 0.0);
     out.push_back({std::string(dt.effect->name()) + "." + std::string(info.name), dt.values[p],
                    value_std_error(info, s, col, z), std::string(info.unit)});
   }
   return out;
 }
 
-/// What a candidate's step leaves: residuals, BIC against the model's, the share of
-/// the model's excess it explains, and whether it is proposed and reaches the floor.
-void score_candidate(Candidate& c, const StepSolution& s, const PreparedLog& log, const StepSolution& base,
-                     const GroupFloors& floors, const DiscoveryOptions& options) {
+void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSolution& base, const GroupFloors& floors,
+                     const DiscoveryOptions& options) {
   const double base_bic = bic_of(base);
-  c.residual_after_rad = rms(log.rd ? s.rss[0] : s.rss[1], log.rd ? s.n[0] : s.n[1]);
+  c.residual_after_rad = rms(rd ? s.rss[0] : s.rss[1], rd ? s.n[0] : s.n[1]);
   c.sincos_residual_after = rms(s.rss[1], s.n[1]);
   c.dq_residual_after = rms(s.rss[2], s.n[2]);
   c.weighted_rss = s.rss_w;
@@ -237,6 +239,8 @@ void score_candidate(Candidate& c, const StepSolution& s, const PreparedLog& log
   c.proposed = c.bic_drop > options.proposal_bic_drop;
   c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
 }
+
+namespace {
 
 /// The linearised step of candidate `term` (design `d`) on the model's columns.
 /// Part of a multi-parameter candidate may be the model's already (a 2 theta_m
@@ -289,7 +293,7 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     const FitResult fr = fit_design(dm, log.rows, floors);
     out.passes += fr.passes;
     if (!fr.ok) continue;
-    score_candidate(c, fr.last, log, base, floors, options);
+    score_candidate(c, fr.last, log.rd, base, floors, options);
     c.params = term_params(dm, dm.terms().size() - 1, fr.last, false);
     c.reason = reason_of(term, c.params);
   }
@@ -381,7 +385,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     Candidate c;
     c.effect = terms[i].reference();
     c.family = terms[i].params.size() >= 2 * static_cast<std::size_t>(kFamilyFrom);
-    score_candidate(c, s, log, base, floors, options);
+    score_candidate(c, s, log.rd, base, floors, options);
     c.params = term_params(d, term, s, true);
     std::erase_if(c.params, [&](const ModelParameter& pv) {
       for (int p : terms[i].params) {

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/model/design.h"
+#include "daemon/core/model/least_squares.h"
 
 namespace resolver {
 
@@ -22,6 +24,25 @@ struct Ranking {
   std::vector<std::string> not_evaluated;
   int passes = 0;
 };
+
+/// What the log's motion (or signals) lacks for `e` to be identifiable, as advice
+/// ("" = nothing): a speed change, a reversal, or sin/cos beside the R/D angle (`sincos`).
+[[nodiscard]] std::string motion_missing(const Effect& e, const MotionSummary& m, bool sincos);
+
+/// One sentence of the term's physics with its fitted values.
+[[nodiscard]] std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params);
+
+/// The parameters of `design`'s term in value coordinates with standard errors from `s`.
+/// `step` moves the term by the solution first (a linearised candidate taken from its
+/// neutral point); without it the design is already at the solution (a converged refit).
+[[nodiscard]] std::vector<ModelParameter> term_params(const Design& design, std::size_t term, const StepSolution& s,
+                                                      bool step);
+
+/// What a candidate's step `s` leaves against the model's `base`: residuals (`rd`: the
+/// position error is the R/D angle's), BIC drop, the share of the model's weighted
+/// residual it removes, whether it is proposed and reaches the floor.
+void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSolution& base, const GroupFloors& floors,
+                     const DiscoveryOptions& options);
 
 /// Ranks the candidates for the fitted model `fit` on `log`.
 [[nodiscard]] Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options);

@@ -50,6 +50,19 @@ TEST(PoolComparison, LogsThatAgreeWithinTheirErrorsAreNotNamed) {
   EXPECT_EQ(d.size(), 3U);
 }
 
+TEST(PoolComparison, APhaseIsComparedOnTheCircle) {
+  // Eccentricity's phase near +-pi: 3.13 and -3.13 rad are 0.023 rad apart (z ~ 1.6),
+  // not 6.26 (z ~ 440, a false "changed between runs").
+  const auto phase = [](double v) {
+    ModelFit f;
+    f.params.push_back({"eccentricity.phase", v, 0.01, "[rad]"});
+    return f;
+  };
+  const auto d = compare_with_pool(phase(3.14), {phase(3.13), phase(-3.13), phase(3.135)}, {"a", "b", "c"});
+  EXPECT_TRUE(flagged(d).empty());
+  for (const PoolDisagreement& x : d) EXPECT_LT(std::abs(x.z), 2.0) << x.log;
+}
+
 TEST(PoolComparison, ALogWhoseOwnFitFailedIsLeftOut) {
   const auto d = compare_with_pool(fit_with(1.0, 0.005), {fit_with(1.0, 0.01), ModelFit{}, fit_with(1.0, 0.01)},
                                    {"a", "failed", "c"});

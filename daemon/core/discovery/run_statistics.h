@@ -1,0 +1,101 @@
+// Statistics that merge (issue 24): a run's fit kept as the quadratic it leaves,
+// so runs fitted apart (other processes, other machines) combine into the pooled fit
+// without their samples.
+//
+// A run's statistics are the normal equations of one pass (least_squares.h) at the
+// run's own converged fit, over its nuisance columns, the model's parameters and the
+// candidate effects' columns (each at its neutral value), per signal group and per
+// validation fold. In the parameter step delta = z - z_r about that point the pass
+// leaves the residual
+//     RSS(delta) = yy - 2 delta'b + delta'M delta.
+// Moved to another point z0 (d = z_r - z0, so delta = delta0 - d) the same quadratic is
+//     yy + 2 d'b + d'M d - 2 delta0'(b + M d) + delta0'M delta0,
+// so runs linearised at their own solutions add exactly once moved to one point. Each
+// run keeps its own nuisance columns (design.h "Parts": its reference zero, amplitude,
+// operating point), as a pooled fit of the logs does. For parameters the prediction is
+// linear in the merge is the pooled fit; for nonlinear ones (a tracking loop, envelope
+// effects at large magnitude) it is the pooled Gauss-Newton step from the runs' own
+// solutions, exact to second order in how far those lie apart.
+//
+// Pure; the file format is tools/model/stats_file.h.
+#pragma once
+
+#include <Eigen/Dense>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "daemon/core/discovery/model_discovery.h"
+#include "daemon/core/discovery/pool.h"
+#include "daemon/core/discovery/prepare.h"
+#include "daemon/core/model/least_squares.h"
+
+namespace resolver {
+
+struct RunStatistics {
+  // What the statistics are of: a merge needs the same in every run.
+  int p_r = 0, p = 0;
+  bool reference = false, reference_aligned = false, rd = false, sincos = false, currents = false;
+  std::vector<std::string> effects;  ///< the model fitted to the run (references, e.g. "harmonics(k3)")
+  /// The run's own fit of that model (standard errors robust where it has the revolutions):
+  /// what a merge compares each run with the others by.
+  std::vector<ModelParameter> params;
+  /// Every column's name: the run's nuisances ("nuisance.sr_gain"), then the model's
+  /// parameters, then the candidates' ("quadrature.beta").
+  std::vector<std::string> columns;
+  int nuisance_columns = 0;  ///< the first columns are the run's own constants
+  int model_columns = 0;     ///< then the model's parameters; the rest are candidates
+  /// Internal coordinate (design.h) of every column at the linearisation point: the
+  /// run's fit for the model's, 0 for nuisances and candidates (neutral).
+  Eigen::VectorXd point;
+  /// Every model term's parameter values (all of its parameters, in effect order).
+  std::vector<std::vector<double>> values;
+  double frame_shift = 0.0;  ///< [rad] the run's sensor zero in its fit's frame
+  PassStatistics stats;      ///< at `point`, columns as above
+  FloorReport floors;        ///< the run's own noise floors
+  std::int64_t fitted_rows = 0;
+  std::int64_t samples = 0;
+  double span_s = 0.0;
+  double electrical_revolutions = 0.0;
+  MotionSummary motion;  ///< what a candidate needs of the motion is judged on the runs' together
+  std::vector<std::string> notes;  ///< the run's fit's notes
+  /// Signal faults that held for a large part of the run (DiscoveryOptions::untrusted_input):
+  /// a merge with any is never "explained".
+  std::vector<std::string> untrusted;
+};
+
+/// Fits `effects` to the prepared run to convergence and takes one more pass there
+/// with every candidate the run's layout allows (a fittable catalog effect not in the
+/// model, default parameters; one that needs a reference, an aligned reference or
+/// currents the run lacks is left out). Throws std::invalid_argument as fit_prepared.
+[[nodiscard]] RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string> effects,
+                                           const DiscoveryOptions& options);
+
+/// A merged fit of several runs.
+struct MergedFit {
+  std::vector<std::string> effects;
+  std::vector<ModelParameter> params;    ///< value and formal standard error
+  std::vector<ModelParameter> nuisance;  ///< each run's constants, named "...[run]"
+  std::vector<SignalResidual> signals;   ///< rms (linearised), floor (pooled), held back, rows
+  std::vector<Candidate> candidates;     ///< the common candidates not in the model, best BIC first
+  std::vector<std::string> not_evaluated;
+  /// Each run's own fit against the other runs' (compare_with_pool), largest |z| first.
+  std::vector<PoolDisagreement> comparisons;
+  FloorReport floors;                    ///< rows-weighted over the runs
+  std::int64_t rows = 0;
+  int runs = 0;
+  bool explained = false;  ///< every signal within explained_ratio x its floor, held back too
+  std::vector<std::string> notes;
+};
+
+/// Merges `runs` (named `names`, e.g. their files) and fits `effects` (empty: the
+/// runs' model) from them: the parameters' columns must be in every run (a model
+/// effect or a candidate of each). Throws std::invalid_argument naming the run that
+/// differs (pole pairs, signals, model, a missing column) or when fewer than one run
+/// or the columns are not separable. The result does not depend on the runs' order
+/// (beyond rounding): they are moved to the point of the run with the most rows.
+[[nodiscard]] MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names,
+                                   std::span<const std::string> effects, const DiscoveryOptions& options);
+
+}  // namespace resolver

@@ -1,0 +1,128 @@
+#include "tools/model/merge_report.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "tools/model/json_text.h"
+
+namespace resolver {
+
+namespace {
+
+std::string unit_of(const SignalResidual& s) {
+  return s.signal == "position_error" ? " rad" : s.signal == "i_dq" ? " A" : " of the amplitude";
+}
+
+std::string json_params(const std::vector<ModelParameter>& ps) {
+  std::string o = "{";
+  for (std::size_t i = 0; i < ps.size(); ++i) {
+    o += fmt::format("{}{}:{{\"value\":{},\"stderr\":{},\"unit\":{}}}", i > 0 ? "," : "", json::str(ps[i].name),
+                     json::num(ps[i].value), json::num(ps[i].std_error), json::str(ps[i].unit));
+  }
+  return o + "}";
+}
+
+std::string json_strings(const std::vector<std::string>& v) {
+  std::string o = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) o += (i > 0 ? "," : "") + json::str(v[i]);
+  return o + "]";
+}
+
+}  // namespace
+
+MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
+  const std::string ratio = fmt::format("{:.3g}", explained_ratio);
+  if (m.explained) {
+    return {"explained", "every signal's residual is within " + ratio +
+                             "x its pooled noise floor, on held-back samples too (linearised, from the statistics)"};
+  }
+  const Candidate* best = m.candidates.empty() || !m.candidates.front().proposed ? nullptr : &m.candidates.front();
+  if (best != nullptr && best->reaches_floor) {
+    return {"missing_effect", "adding " + best->effect + " brings every signal to within " + ratio +
+                                  "x its floor: " + best->reason + " Its value is one step linearised from zero: "
+                                  "make the statistics again with it in --effects (or fit the logs) for the exact fit."};
+  }
+  return {"unexplained", best == nullptr ? "no candidate in the statistics lowers the residual enough to be proposed"
+                                         : "the best candidate, " + best->effect +
+                                               ", does not reach the floor: run resolver-model explain on the logs"};
+}
+
+std::string format_merge_text(const MergedFit& m, const std::vector<std::string>& runs,
+                              const std::vector<RunStatistics>& stats, double explained_ratio) {
+  std::string o = fmt::format("merged {} run{} ({} fitted samples)\n", m.runs, m.runs == 1 ? "" : "s", m.rows);
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    o += fmt::format("  {}: {} fitted samples over {:.3g} s, {:.3g} electrical revolutions; its model {}\n", runs[r],
+                     stats[r].fitted_rows, stats[r].span_s, stats[r].electrical_revolutions,
+                     fmt::join(stats[r].effects, ", "));
+  }
+  o += fmt::format("model: {}\n", m.effects.empty() ? std::string("(none)") : fmt::format("{}", fmt::join(m.effects, ", ")));
+  for (const std::string& n : m.notes) o += "note: " + n + "\n";
+  o += "\nparameters (value +- standard error):\n";
+  for (const ModelParameter& p : m.params) {
+    o += fmt::format("  {:<36} {:>12.7g} +- {:.2g} {}\n", p.name, p.value, p.std_error, p.unit);
+  }
+  if (!m.comparisons.empty()) o += "\neach run's own fit against the others' (* = disagrees: |z| > 4):\n";
+  for (const PoolDisagreement& d : m.comparisons) {
+    o += fmt::format("  {} {:<20} {:<30} {:>12.6g} +- {:.2g} against {:.6g} +- {:.2g} (z = {:.1f})\n",
+                     std::abs(d.z) > kPoolDisagreementZ ? '*' : ' ', d.log, d.parameter, d.value, d.std_error,
+                     d.others, d.others_std_error, d.z);
+  }
+  o += "\neach run's constants:\n";
+  for (const ModelParameter& p : m.nuisance) o += fmt::format("  {:<36} {:>12.5g}\n", p.name, p.value);
+  o += "\nresidual rms vs the pooled noise floor (held back: fitted on one fold, evaluated on the other):\n";
+  for (const SignalResidual& s : m.signals) {
+    o += fmt::format("  {:<15} {:.3g}{} (before: {:.3g}), floor {:.3g} -> {:.2f}x floor; held back {}\n", s.signal,
+                     s.rms, unit_of(s), s.raw_rms, s.floor, s.rms / s.floor,
+                     std::isfinite(s.held_back_rms) ? fmt::format("{:.2f}x", s.held_back_rms / s.floor) : "n/a");
+  }
+  o += m.candidates.empty() ? "\ncandidates: none in every run's statistics\n"
+                            : "\ncandidates (lowest BIC first; * = proposed; ERR = share of the residual it removes):\n";
+  for (const Candidate& c : m.candidates) {
+    o += fmt::format("  {} {:<26} BIC drop {:.1f} ERR {:.3f}{}\n      {}\n", c.proposed ? '*' : ' ', c.effect,
+                     c.bic_drop, c.err, c.reaches_floor ? "  reaches the floor" : "", c.reason);
+  }
+  for (const std::string& n : m.not_evaluated) o += "    not evaluated: " + n + "\n";
+  const MergeVerdict v = merge_verdict(m, explained_ratio);
+  return o + fmt::format("\nverdict: {}\n{}\n", v.word, v.summary);
+}
+
+std::string format_merge_json(const MergedFit& m, const std::vector<std::string>& runs,
+                              const std::vector<RunStatistics>& stats, double explained_ratio) {
+  std::string o = "{\"runs\":[";
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    o += fmt::format("{}{{\"file\":{},\"fitted_samples\":{},\"span_s\":{},\"effects\":{}}}", r > 0 ? "," : "",
+                     json::str(runs[r]), stats[r].fitted_rows, json::num(stats[r].span_s), json_strings(stats[r].effects));
+  }
+  o += "],\"effects\":" + json_strings(m.effects) + ",\"params\":" + json_params(m.params) +
+       ",\"nuisance\":" + json_params(m.nuisance) + ",\"signals\":[";
+  for (std::size_t i = 0; i < m.signals.size(); ++i) {
+    const SignalResidual& s = m.signals[i];
+    o += fmt::format("{}{{\"signal\":{},\"rms\":{},\"raw_rms\":{},\"floor\":{},\"held_back_rms\":{},\"rows\":{}}}",
+                     i > 0 ? "," : "", json::str(s.signal), json::num(s.rms), json::num(s.raw_rms), json::num(s.floor),
+                     json::num(s.held_back_rms), s.rows);
+  }
+  o += "],\"candidates\":[";
+  for (std::size_t i = 0; i < m.candidates.size(); ++i) {
+    const Candidate& c = m.candidates[i];
+    o += fmt::format("{}{{\"effect\":{},\"bic_drop\":{},\"err\":{},\"proposed\":{},\"reaches_floor\":{},\"params\":{}}}",
+                     i > 0 ? "," : "", json::str(c.effect), json::num(c.bic_drop), json::num(c.err), c.proposed,
+                     c.reaches_floor, json_params(c.params));
+  }
+  o += "],\"comparisons\":[";
+  for (std::size_t i = 0; i < m.comparisons.size(); ++i) {
+    const PoolDisagreement& d = m.comparisons[i];
+    o += fmt::format("{}{{\"run\":{},\"parameter\":{},\"value\":{},\"std_error\":{},\"others\":{},"
+                     "\"others_std_error\":{},\"z\":{},\"disagrees\":{}}}",
+                     i > 0 ? "," : "", json::str(d.log), json::str(d.parameter), json::num(d.value),
+                     json::num(d.std_error), json::num(d.others), json::num(d.others_std_error), json::num(d.z),
+                     std::abs(d.z) > kPoolDisagreementZ);
+  }
+  const MergeVerdict v = merge_verdict(m, explained_ratio);
+  o += "],\"not_evaluated\":" + json_strings(m.not_evaluated) + ",\"notes\":" + json_strings(m.notes) +
+       ",\"verdict\":" + json::str(v.word) + ",\"summary\":" + json::str(v.summary) + "}\n";
+  return o;
+}
+
+}  // namespace resolver

@@ -1,0 +1,48 @@
+// The statistics file of `resolver-model stats` (issue 24): one run's statistics
+// (daemon/core/discovery/run_statistics.h) as self-describing JSON that `merge`
+// reads back exactly (every double with 17 significant digits).
+//
+//   {"format": "resolver-model stats", "version": 1, "tool": "resolver-model ...",
+//    "log": ..., "layout": {"id", "description"}, "bench": {"p_r", "p"},
+//    "signals": {...}, "effects": [...], "values": [[...]], "frame_shift": ...,
+//    "columns": [...], "nuisance_columns": n, "model_columns": m, "point": [...],
+//    "floors": {"rd": {...}, "sc": {...}, "cur": {...}}, "counts": {...}, "notes": [...],
+//    "groups": {"rd": {"all": {"n", "yy", "b", "m"}, "fold_a": {...}}, "sc": ..., "cur": ...}}
+//
+// A file of another format or version, or one that does not parse, is refused naming
+// the file (InputError, usage: exit 2); so are files of different layouts in one merge.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "daemon/core/discovery/run_statistics.h"
+
+namespace resolver {
+
+inline constexpr int kStatsFileVersion = 1;
+
+/// A statistics file's content: the run and where it came from.
+struct StatsFile {
+  RunStatistics run;
+  std::string log;                 ///< the log it was made from, as given
+  std::string layout_id;           ///< the layout's identity (pipeline.h layout_identity)
+  std::string layout_description;  ///< in words, for messages
+  std::string tool;                ///< the version line of the program that wrote it
+};
+
+/// The file's text.
+[[nodiscard]] std::string format_stats_file(const StatsFile& file);
+
+/// Parses `text` read from `path`. Throws InputError (usage, naming `path`) when it is
+/// not a statistics file of this version or a member is missing or malformed.
+[[nodiscard]] StatsFile parse_stats_file(const std::string& text, const std::string& path);
+
+/// Reads and parses `path` (IoError when it cannot be read).
+[[nodiscard]] StatsFile read_stats_file(const std::string& path);
+
+/// Throws InputError (usage) naming both files when `files` were made with different
+/// layouts (the signals mean other things).
+void check_same_layout(const std::vector<StatsFile>& files, const std::vector<std::string>& paths);
+
+}  // namespace resolver
