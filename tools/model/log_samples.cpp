@@ -1,5 +1,6 @@
 #include "tools/model/log_samples.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -58,11 +59,47 @@ RecordsRead feed_records(LogInput& reader, SampleStream& stream, const std::stri
     if (progress && ++since_progress >= 4096) {  // a std::function call per 4096 records: not measurable
       since_progress = 0;
       progress(LogReadProgress{reader.bytes_read(), reader.total_bytes(),
-                               static_cast<std::int64_t>(out.input.samples.size()), false});
+                               static_cast<std::int64_t>(out.input.samples.size()) + out.chunked_samples, false});
     }
   }
   return read;
 }
+
+/// Cuts the samples into chunks of `chunk_s` of sample time and hands each on one
+/// chunk late, so that a short last piece can join the chunk before it.
+class SampleChunker {
+ public:
+  SampleChunker(double chunk_s, std::function<void(DiscoveryInput&&)> emit) : chunk_s_(chunk_s), emit_(std::move(emit)) {}
+
+  void add(const Sample& s, int p_r, int p) {
+    // Time as the clock runs: a step back (a re-anchored clock) adds nothing.
+    if (!current_.samples.empty()) span_ += std::max(0.0, s.t - current_.samples.back().t);
+    if (span_ >= chunk_s_) {
+      if (!pending_.samples.empty()) emit_(std::move(pending_));
+      pending_ = std::move(current_);
+      current_ = DiscoveryInput{};
+      span_ = 0.0;
+    }
+    current_.p_r = p_r;
+    current_.p = p;
+    current_.samples.push_back(s);
+  }
+
+  void finish() {
+    if (!pending_.samples.empty() && !current_.samples.empty() && span_ < 0.5 * chunk_s_) {
+      pending_.samples.insert(pending_.samples.end(), current_.samples.begin(), current_.samples.end());
+      current_ = DiscoveryInput{};
+    }
+    if (!pending_.samples.empty()) emit_(std::move(pending_));
+    if (!current_.samples.empty()) emit_(std::move(current_));
+  }
+
+ private:
+  double chunk_s_;
+  std::function<void(DiscoveryInput&&)> emit_;
+  DiscoveryInput pending_, current_;
+  double span_ = 0.0;
+};
 
 /// A regular file read to its end has given exactly the bytes it had when opened.
 /// Fewer: it was truncated or replaced while read, and the samples may mix two logs
@@ -127,7 +164,7 @@ void add_read_notes(LogSamples& out, const DaemonConfig& config, const SampleSli
   }
   if (slice.limited()) {
     out.notes.push_back(fmt::format("slice {} s .. {} s: {} samples used, {} outside", slice.from_s, slice.to_s,
-                                    out.input.samples.size(), out.outside_slice));
+                                    out.input.samples.size() + static_cast<std::size_t>(out.chunked_samples), out.outside_slice));
   }
 }
 
@@ -146,10 +183,17 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
   if (format == LogFormat::kCsv && !config.health_full_scale_set) {
     health.set_full_scale(csv_sincos_full_scale(config.csv.map), 0.0);  // as resolverd's Pipeline::feed_row
   }
+  std::optional<SampleChunker> chunker;
+  if (options.chunk_s > 0.0 && options.on_chunk) chunker.emplace(options.chunk_s, options.on_chunk);
   SampleStream stream(decoder, sample_stream_config(config, options.slice),
                       SampleStream::Callbacks{
                           [&](const Sample& s, std::uint8_t) {
-                            out.input.samples.push_back(s);
+                            if (chunker) {
+                              chunker->add(s, out.input.p_r, out.input.p);
+                              ++out.chunked_samples;
+                            } else {
+                              out.input.samples.push_back(s);
+                            }
                             health.add(s);
                           },
                           [&](const BenchInfo& i) {
@@ -168,6 +212,7 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
   const RecordsRead read = feed_records(*reader, stream, path, progress, out);
   check_size_while_read(*reader, read.at_end, path, out);
   stream.flush();
+  if (chunker) chunker->finish();
   health.finish();
   out.faults = health.faults();
   out.health_samples = health.samples();
@@ -175,9 +220,9 @@ LogSamples read_log_samples(const std::string& path, const std::function<void(co
   if (std::string note = stream.intake().interface_note(); !note.empty()) out.notes.push_back(std::move(note));
   if (progress) {
     progress(LogReadProgress{reader->bytes_read(), reader->total_bytes(),
-                             static_cast<std::int64_t>(out.input.samples.size()), true});
+                             static_cast<std::int64_t>(out.input.samples.size()) + out.chunked_samples, true});
   }
-  if (out.input.samples.empty()) {
+  if (out.input.samples.empty() && out.chunked_samples == 0) {
     throw_no_samples(path, format, config, *decoder, options.slice, out, stream.clock().last_t());
   }
   add_read_notes(out, config, options.slice, problem_counts, read.bad_line_reasons);

@@ -35,6 +35,7 @@ struct LogSamples {
   /// the DBC's or the CSV column's full scale): what each fault held for.
   std::array<SignalFaultState, kSignalFaultCount> faults{};
   std::int64_t health_samples = 0;
+  std::int64_t chunked_samples = 0;  ///< samples handed to LogReadOptions::on_chunk
 };
 
 /// Samples each fault held for (lasting_faults(), signal_health.h, words them).
@@ -51,6 +52,12 @@ struct LogReadProgress {
 struct LogReadOptions {
   std::optional<LogFormat> format;  ///< --format; nullopt: [input] format, else the extension
   SampleSlice slice;                ///< --from/--to [s]
+  /// [s] > 0: the samples are handed to on_chunk in chunks of this much sample time
+  /// instead of being kept (LogSamples::input stays empty): a log of any length in the
+  /// memory of two chunks. A last piece shorter than half a chunk joins the chunk
+  /// before it; none is dropped.
+  double chunk_s = 0.0;
+  std::function<void(DiscoveryInput&& chunk)> on_chunk;
 };
 
 /// Reads `path`. progress(how far) is called every 4096 records and at the end

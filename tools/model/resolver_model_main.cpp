@@ -23,6 +23,7 @@
 #include <string_view>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <optional>
 #include <stdexcept>
@@ -294,6 +295,7 @@ struct Arguments {
   int export_points = 1024;  // export and fleet
   std::string manifest, fleet_out, summarize_dir;  // fleet
   std::string stats_out;                // stats
+  double chunk_s = 0.0;                 // stats: one run per chunk of this many seconds
   std::vector<std::string> stats_files;  // merge
 };
 
@@ -412,6 +414,11 @@ void add_statistics_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) 
   stats->add_option("LOG", a.log, "log: candump -l, Vector ASC or CSV (default bench layout unless --config)")->required();
   stats->add_option("--effects", a.effects_args, "the model, as for fit (default amplitude_imbalance)");
   stats->add_option("--out", a.stats_out, "statistics file to write (JSON)")->required();
+  stats->add_option("--chunk", a.chunk_s,
+                    "read the log in chunks of this many seconds, each a run of its own (its own reference zero, "
+                    "amplitude and operating point): a log of any length in the memory of two chunks; a last piece "
+                    "shorter than half a chunk joins the one before")
+      ->check(CLI::PositiveNumber);
   add_config_options(stats, a);
   add_slicing_options(stats, a);
   CLI::App* merge = subs.merge = app.add_subcommand(
@@ -495,14 +502,20 @@ Model load_model(const Arguments& a) {
 }
 
 /// The log's samples, with a progress bar while it is read.
+/// `on_chunk` (stats --chunk): the samples go there chunk by chunk instead of into the result.
 resolver::LogSamples read_samples(const Arguments& a, const resolver::DaemonConfig& config,
-                                  const resolver::ProgressMeter::Options& shown) {
+                                  const resolver::ProgressMeter::Options& shown,
+                                  const std::function<void(resolver::DiscoveryInput&&)>& on_chunk = {}) {
   resolver::LogSamples samples;
   {
     resolver::ProgressMeter bar(stderr, "reading " + a.log, shown);
     resolver::LogReadOptions read_options;
     read_options.format = resolver::log_format_from_name(a.format_name);
     read_options.slice = a.slice;
+    if (on_chunk) {
+      read_options.chunk_s = a.chunk_s;
+      read_options.on_chunk = on_chunk;
+    }
     samples = resolver::read_log_samples(
         a.log, [&](const resolver::LogReadProgress& p) { bar.bytes(p.bytes_read, p.total_bytes, p.samples, p.done); },
         config, read_options);
@@ -601,20 +614,42 @@ int run_on_logs(const Arguments& a, const Model& model, const resolver::Progress
   return resolver::run_pooled(run);
 }
 
+/// stats: the log's statistics, whole or one run per chunk (--chunk S).
+int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
+  resolver::DiscoveryOptions options = discovery_options(a, model.config);
+  resolver::StatsFile file = resolver::stats_file_header(a.log, model.config);
+  std::function<void(resolver::DiscoveryInput&&)> on_chunk;
+  if (a.chunk_s > 0.0) {
+    on_chunk = [&](resolver::DiscoveryInput&& chunk) { resolver::add_chunk(file, chunk, model.effects, options); };
+  }
+  resolver::LogSamples samples = read_samples(a, model.config, shown, on_chunk);
+  weigh_signal_faults(samples, options);
+  try {
+    if (!on_chunk) resolver::add_run(file, a.log, samples.input, model.effects, options);
+  } catch (const std::invalid_argument& e) {
+    throw resolver::InputError(resolver::Fault::kData, e.what(), resolver::Where::at_file(a.log));
+  }
+  if (file.runs.empty()) {
+    throw resolver::InputError(resolver::Fault::kData,
+                               fmt::format("no chunk of the log could be fitted: {}", fmt::join(file.left_out, "; ")),
+                               resolver::Where::at_file(a.log));
+  }
+  resolver::mark_untrusted(file, options.untrusted_input);
+  resolver::write_stats_file(file, a.stats_out);
+  return 0;
+}
+
 /// Every subcommand but fleet: read the log, then fit, explain or write.
 int run_on_log(const Arguments& a) {
   const Model model = load_model(a);
   const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(a.progress);
+  if (a.command == Command::kStats) return run_stats(a, model, shown);
   if (a.logs.size() > 1) return run_on_logs(a, model, shown);
   resolver::LogSamples samples = read_samples(a, model.config, shown);
   resolver::DiscoveryOptions options = discovery_options(a, model.config);
   weigh_signal_faults(samples, options);
   if (a.command == Command::kReport || a.command == Command::kExport || a.command == Command::kExportData) {
     return write_outputs(a, samples, model.effects, options, shown);
-  }
-  if (a.command == Command::kStats) {
-    resolver::write_stats_file(resolver::make_stats_file(samples, a.log, model.effects, options, model.config), a.stats_out);
-    return 0;
   }
   const bool do_explain = a.command == Command::kExplain;
   const resolver::Explanation ex = fit_or_explain(samples, a.log, model.effects, options, do_explain, shown);

@@ -176,8 +176,7 @@ class Reader {
   std::string path_;
 };
 
-void read_run(const Reader& r, RunStatistics& run) {
-  const json::Json& root = r.root();
+void read_run(const Reader& r, const json::Json& root, RunStatistics& run) {
   run.p_r = static_cast<int>(r.integer(r.at(root, "bench"), "p_r"));
   run.p = static_cast<int>(r.integer(r.at(root, "bench"), "p"));
   const json::Json& sig = r.at(root, "signals");
@@ -217,10 +216,8 @@ void read_run(const Reader& r, RunStatistics& run) {
   }
 }
 
-}  // namespace
-
-std::string format_stats_file(const StatsFile& file) {
-  const RunStatistics& run = file.run;
+/// One run's object of the file.
+std::string format_run(const std::string& name, const RunStatistics& run) {
   std::string values = "[";
   for (std::size_t i = 0; i < run.values.size(); ++i) values += (i > 0 ? "," : "") + json::array(run.values[i], kExact);
   values += "]";
@@ -231,21 +228,31 @@ std::string format_stats_file(const StatsFile& file) {
   }
   groups += "}";
   return fmt::format(
-      "{{\"format\":{},\"version\":{},\"tool\":{},\"log\":{},\n"
-      "\"layout\":{{\"id\":{},\"description\":{}}},\n"
-      "\"bench\":{{\"p_r\":{},\"p\":{}}},\n"
+      "{{\"name\":{},\"bench\":{{\"p_r\":{},\"p\":{}}},\n"
       "\"signals\":{{\"reference\":{},\"reference_aligned\":{},\"rd\":{},\"sincos\":{},\"currents\":{}}},\n"
       "\"effects\":{},\"params\":{},\n\"values\":{},\"frame_shift\":{},\n"
       "\"columns\":{},\"nuisance_columns\":{},\"model_columns\":{},\n\"point\":{},\n"
       "\"floors\":{{\"rd\":{},\"sc\":{},\"cur\":{}}},\n"
       "\"counts\":{{\"fitted_rows\":{},\"samples\":{},\"span_s\":{},\"electrical_revolutions\":{}}},\n"
-      "\"motion\":{},\n\"notes\":{},\"untrusted\":{},\n\"groups\":{}}}\n",
-      json::str(kFormat), kStatsFileVersion, json::str(file.tool), json::str(file.log), json::str(file.layout_id),
-      json::str(file.layout_description), run.p_r, run.p, run.reference, run.reference_aligned, run.rd, run.sincos,
+      "\"motion\":{},\n\"notes\":{},\"untrusted\":{},\n\"groups\":{}}}",
+      json::str(name), run.p_r, run.p, run.reference, run.reference_aligned, run.rd, run.sincos,
       run.currents, strings(run.effects), params_of(run.params), values, num(run.frame_shift), strings(run.columns), run.nuisance_columns,
       run.model_columns, vector_of(run.point), floor_estimate(run.floors.rd), floor_estimate(run.floors.sc),
       floor_estimate(run.floors.cur), run.fitted_rows, run.samples, num(run.span_s), num(run.electrical_revolutions),
       motion_of(run.motion), strings(run.notes), strings(run.untrusted), groups);
+}
+
+}  // namespace
+
+std::string format_stats_file(const StatsFile& file) {
+  std::string runs;
+  for (std::size_t i = 0; i < file.runs.size(); ++i) {
+    runs += (i > 0 ? ",\n" : "\n") + format_run(file.runs[i].name, file.runs[i].run);
+  }
+  return fmt::format("{{\"format\":{},\"version\":{},\"tool\":{},\"log\":{},\n"
+                     "\"layout\":{{\"id\":{},\"description\":{}}},\n\"left_out\":{},\n\"runs\":[{}]}}\n",
+                     json::str(kFormat), kStatsFileVersion, json::str(file.tool), json::str(file.log),
+                     json::str(file.layout_id), json::str(file.layout_description), strings(file.left_out), runs);
 }
 
 StatsFile parse_stats_file(const std::string& text, const std::string& path) {
@@ -271,7 +278,14 @@ StatsFile parse_stats_file(const std::string& text, const std::string& path) {
   out.log = r.text(root, "log");
   out.layout_id = r.text(r.at(root, "layout"), "id");
   out.layout_description = r.text(r.at(root, "layout"), "description");
-  read_run(r, out.run);
+  out.left_out = r.strings(root, "left_out");
+  for (const json::Json& j : r.items(root, "runs")) {
+    NamedRun run;
+    run.name = r.text(j, "name");
+    read_run(r, j, run.run);
+    out.runs.push_back(std::move(run));
+  }
+  if (out.runs.empty()) r.fail("the statistics file holds no run");
   return out;
 }
 

@@ -3,11 +3,15 @@
 // reads back exactly (every double with 17 significant digits).
 //
 //   {"format": "resolver-model stats", "version": 1, "tool": "resolver-model ...",
-//    "log": ..., "layout": {"id", "description"}, "bench": {"p_r", "p"},
-//    "signals": {...}, "effects": [...], "values": [[...]], "frame_shift": ...,
-//    "columns": [...], "nuisance_columns": n, "model_columns": m, "point": [...],
-//    "floors": {"rd": {...}, "sc": {...}, "cur": {...}}, "counts": {...}, "notes": [...],
-//    "groups": {"rd": {"all": {"n", "yy", "b", "m"}, "fold_a": {...}}, "sc": ..., "cur": ...}}
+//    "log": ..., "layout": {"id", "description"},
+//    "runs": [{"name": ..., "bench": {"p_r", "p"}, "signals": {...}, "effects": [...],
+//              "params": [...], "values": [[...]], "frame_shift": ..., "columns": [...],
+//              "nuisance_columns": n, "model_columns": m, "point": [...],
+//              "floors": {"rd": {...}, "sc": {...}, "cur": {...}}, "counts": {...},
+//              "motion": {...}, "notes": [...], "untrusted": [...],
+//              "groups": {"rd": {"all": {"n", "yy", "b", "m_upper"}, "fold_a": {...}}, "sc": ..., "cur": ...}}]}
+// One run per log, or one per chunk of a long log (stats --chunk): each chunk is a run
+// with its own constants, so a log of any length is read in bounded memory.
 //
 // A file of another format or version, or one that does not parse, is refused naming
 // the file (InputError, usage: exit 2); so are files of different layouts in one merge.
@@ -22,13 +26,21 @@ namespace resolver {
 
 inline constexpr int kStatsFileVersion = 1;
 
-/// A statistics file's content: the run and where it came from.
-struct StatsFile {
+/// One run of a file: its name (the log, or "LOG [t0-t1 s]" for a chunk) and statistics.
+struct NamedRun {
+  std::string name;
   RunStatistics run;
+};
+
+/// A statistics file's content: its runs and where they came from.
+struct StatsFile {
+  std::vector<NamedRun> runs;
   std::string log;                 ///< the log it was made from, as given
   std::string layout_id;           ///< the layout's identity (pipeline.h layout_identity)
   std::string layout_description;  ///< in words, for messages
   std::string tool;                ///< the version line of the program that wrote it
+  /// Chunks of the log no fit could be made of, each with its time span and reason.
+  std::vector<std::string> left_out;
 };
 
 /// The file's text.

@@ -14,15 +14,8 @@
 
 namespace resolver {
 
-StatsFile make_stats_file(const LogSamples& samples, const std::string& log, std::span<const std::string> effects,
-                          const DiscoveryOptions& options, const DaemonConfig& config) {
+StatsFile stats_file_header(const std::string& log, const DaemonConfig& config) {
   StatsFile file;
-  try {
-    const PreparedLog prepared = prepare_log(samples.input, options.prepare);
-    file.run = run_statistics(prepared, effects, options);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(Fault::kData, e.what(), Where::at_file(log));
-  }
   const LayoutIdentity layout = layout_identity(config);
   file.log = log;
   file.layout_id = layout.id;
@@ -31,32 +24,66 @@ StatsFile make_stats_file(const LogSamples& samples, const std::string& log, std
   return file;
 }
 
+void add_run(StatsFile& file, const std::string& name, const DiscoveryInput& input, std::span<const std::string> effects,
+             const DiscoveryOptions& options) {
+  const PreparedLog prepared = prepare_log(input, options.prepare);
+  file.runs.push_back({name, run_statistics(prepared, effects, options)});
+}
+
+void add_chunk(StatsFile& file, const DiscoveryInput& chunk, std::span<const std::string> effects,
+               const DiscoveryOptions& options) {
+  const double t0 = chunk.samples.front().t, t1 = chunk.samples.back().t;
+  const std::string name = fmt::format("{} [{:.6g}-{:.6g} s]", file.log, t0, t1);
+  try {
+    add_run(file, name, chunk, effects, options);
+  } catch (const std::invalid_argument& e) {
+    file.left_out.push_back(fmt::format("{}: {} samples left out: {}", name, chunk.samples.size(), e.what()));
+  }
+}
+
+void mark_untrusted(StatsFile& file, const std::vector<std::string>& untrusted) {
+  for (NamedRun& r : file.runs) r.run.untrusted = untrusted;
+}
+
 void write_stats_file(const StatsFile& file, const std::string& out) {
   const std::string text = format_stats_file(file);
   write_text_file(out, text);  // throws std::system_error: exit 3
-  const RunStatistics& r = file.run;
-  std::cout << fmt::format("wrote {} ({} KiB): {} fitted samples of {}, model {}, {} columns ({} the candidates')\n",
-                           out, (text.size() + 512) / 1024, r.fitted_rows, file.log, fmt::join(r.effects, ","),
-                           r.columns.size(), r.columns.size() - static_cast<std::size_t>(r.nuisance_columns + r.model_columns));
+  std::int64_t rows = 0;
+  for (const NamedRun& r : file.runs) rows += r.run.fitted_rows;
+  const RunStatistics& r = file.runs.front().run;
+  std::cout << fmt::format("wrote {} ({} KiB): {} fitted samples of {} in {} run{}, model {}, {} columns ({} the "
+                           "candidates')\n",
+                           out, (text.size() + 512) / 1024, rows, file.log, file.runs.size(),
+                           file.runs.size() == 1 ? "" : "s", fmt::join(r.effects, ","), r.columns.size(),
+                           r.columns.size() - static_cast<std::size_t>(r.nuisance_columns + r.model_columns));
+  for (const std::string& l : file.left_out) std::cout << "left out: " << l << "\n";
 }
 
 int run_merge(const std::vector<std::string>& paths, std::span<const std::string> effects, bool json,
               const DiscoveryOptions& options) {
   std::vector<StatsFile> files;
   std::vector<RunStatistics> runs;
+  std::vector<std::string> names;
   for (const std::string& p : paths) {
     files.push_back(read_stats_file(p));
-    runs.push_back(files.back().run);
+    // A file of one run is named by its path; a chunked log's runs by path and span.
+    for (const NamedRun& r : files.back().runs) {
+      names.push_back(files.back().runs.size() == 1 ? p : p + ": " + r.name.substr(r.name.rfind(" [") + 1));
+      runs.push_back(r.run);
+    }
   }
   check_same_layout(files, paths);
   MergedFit merged;
   try {
-    merged = merge_runs(runs, paths, effects, options);
+    merged = merge_runs(runs, names, effects, options);
   } catch (const std::invalid_argument& e) {
     throw InputError(Fault::kData, e.what());
   }
-  std::cout << (json ? format_merge_json(merged, paths, runs, options.explained_ratio)
-                     : format_merge_text(merged, paths, runs, options.explained_ratio));
+  for (const StatsFile& f : files) {
+    for (const std::string& l : f.left_out) merged.notes.push_back("left out when the statistics were made: " + l);
+  }
+  std::cout << (json ? format_merge_json(merged, names, runs, options.explained_ratio)
+                     : format_merge_text(merged, names, runs, options.explained_ratio));
   return 0;
 }
 

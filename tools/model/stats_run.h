@@ -13,12 +13,22 @@
 
 namespace resolver {
 
-/// Prepares the log's samples, fits `effects` and takes the statistics pass
-/// (run_statistics.h) with the layout of `config` recorded. Throws InputError (data,
-/// naming `log`) when the fit refuses the samples.
-[[nodiscard]] StatsFile make_stats_file(const LogSamples& samples, const std::string& log,
-                                        std::span<const std::string> effects, const DiscoveryOptions& options,
-                                        const DaemonConfig& config);
+/// A file without runs yet: the log, the layout of `config`, this program's version.
+[[nodiscard]] StatsFile stats_file_header(const std::string& log, const DaemonConfig& config);
+
+/// Prepares `input`, fits `effects` and takes the statistics pass (run_statistics.h)
+/// into `file` as a run named `name`. Throws std::invalid_argument when the fit
+/// refuses the samples (too few, the rotor hardly moves, ...).
+void add_run(StatsFile& file, const std::string& name, const DiscoveryInput& input, std::span<const std::string> effects,
+             const DiscoveryOptions& options);
+
+/// add_run for one chunk of a long log (LogReadOptions::on_chunk), named "LOG [t0-t1 s]";
+/// a chunk the fit refuses is counted in file.left_out with its span and reason.
+void add_chunk(StatsFile& file, const DiscoveryInput& chunk, std::span<const std::string> effects,
+               const DiscoveryOptions& options);
+
+/// Marks every run with the log's lasting signal faults (a merge is then never "explained").
+void mark_untrusted(StatsFile& file, const std::vector<std::string>& untrusted);
 
 /// Writes `file` to `out` (IoError: exit 3) and says what it holds on stdout.
 void write_stats_file(const StatsFile& file, const std::string& out);
