@@ -23,6 +23,7 @@
 // The envelopes carry the delay but not the loop: env_sin(k) = sin(k (theta - omega d)).
 #pragma once
 
+#include <complex>
 #include <cstddef>
 #include <limits>
 #include <span>
@@ -138,6 +139,11 @@ class AngleBasis {
   /// sin / cos (n theta_m') of the mechanical angle the envelopes carry.
   [[nodiscard]] double env_mech_sin(int n) const;
   [[nodiscard]] double env_mech_cos(int n) const;
+  /// H(j k omega) of the R/D loop for order k of the resolver angle (1 without a loop):
+  /// rd_sin(k) = Re(H) env_sin(k) + Im(H) env_cos(k); rd_cos(k) = Re(H) env_cos(k) - Im(H) env_sin(k).
+  [[nodiscard]] std::complex<double> rd_response(int k) const {
+    return transform_.omega_n > 0.0 && k != 0 ? loop_response(k * row_.omega) : std::complex<double>(1.0, 0.0);
+  }
   /// False when no tracking loop filters the R/D angle: rd_sin(k) == env_sin(k) then,
   /// and a caller summing both may compute one.
   [[nodiscard]] bool rd_filtered() const { return transform_.omega_n > 0.0; }
@@ -176,6 +182,8 @@ class AngleBasis {
   };
   /// g sin(k a + phi) or g cos(k a + phi) with g e^{j phi} = H(j k w).
   [[nodiscard]] double filtered(const Series& series, int k, double w, bool sine) const;
+  /// The R/D loop's closed-loop response H(j w) (transform_.omega_n > 0).
+  [[nodiscard]] std::complex<double> loop_response(double w) const;
 
   SignatureRow row_;
   BasisTransform transform_;

@@ -382,7 +382,7 @@ void Design::evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, 
     ++col;
   }
   col = nuisance_columns();
-  AngleBasis shifted;  // numeric derivatives move the basis; `basis` stays at the model's
+  AngleBasis& shifted = shifted_;  // numeric derivatives move the basis; `basis` stays at the model's
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const auto ps = t.effect->params();

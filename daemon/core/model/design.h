@@ -162,6 +162,9 @@ class Design {
   int columns_ = 0;
   std::vector<double> frame_shifts_ = std::vector<double>(1, 0.0);  ///< per part
   mutable std::vector<SignalValues> scratch_;
+  /// The basis of a numeric derivative's moved prediction: a member, not a local, so its
+  /// series keep their storage from row to row (an allocation per row was a tenth of a fit).
+  mutable AngleBasis shifted_;
   mutable EnvelopeCache envelope_;
 };
 

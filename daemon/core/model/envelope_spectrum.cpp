@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <complex>
 #include <numbers>
 
 #include "daemon/core/angles.h"
@@ -84,7 +85,12 @@ SignalValues EnvelopeSeries::at(const AngleBasis& basis) const {
     const int n = k[i];
     const double c = basis.env_cos(n), s = basis.env_sin(n);
     out.sa += e_cos[i] * c + e_sin[i] * s;
-    if (filtered) out.rd += e_cos[i] * basis.rd_cos(n) + e_sin[i] * basis.rd_sin(n);
+    if (filtered) {
+      // e_cos rd_cos(n) + e_sin rd_sin(n) with rd_cos = Re(h) c - Im(h) s and
+      // rd_sin = Re(h) s + Im(h) c (signature.h): one loop response per order.
+      const std::complex<double> h = basis.rd_response(n);
+      out.rd += h.real() * (e_cos[i] * c + e_sin[i] * s) + h.imag() * (e_sin[i] * c - e_cos[i] * s);
+    }
     out.sr += r_cos[i] * c + r_sin[i] * s;
   }
   // Without a loop the R/D angle sees the envelopes' error term for term (the same sums).
