@@ -13,8 +13,14 @@ Prints two tables (medians of --repeats runs, each under /usr/bin/time -v):
      to measure a change side by side), and log2asc on the same log; ratios are the
      median of the per-repetition ratios, so a noisy neighbour slows both sides alike.
 
+  3. with --stats-chunk S (issue 23): resolver-model stats LOG --chunk S (one run per chunk,
+     the samples of two chunks in memory) against the same log's resolverd --replay --fast
+     with the model fit off, per --minutes length: peak RSS, wall and their ratio, and
+     merge of the file's runs.
+
 Examples:
   /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin
+  /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin --skip-replay --skip-explain --stats-chunk 30 --minutes 1 5 60
   /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin --minutes 1 10 --baseline-bin ../old/build/bin
 """
 import argparse
@@ -39,7 +45,11 @@ def parse_args():
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--max-rss-gb", type=float, default=16.0, help="do not run explain beyond this projected RSS")
     p.add_argument("--work", type=pathlib.Path, default=pathlib.Path("/tmp/resolver-scale-bench"))
-    p.add_argument("--skip-replay", action="store_true", help="only the explain table")
+    p.add_argument("--skip-replay", action="store_true", help="no replay table")
+    p.add_argument("--skip-explain", action="store_true", help="no explain table")
+    p.add_argument("--stats-chunk", type=float, default=0.0,
+                   help="[s] also the table of resolver-model stats --chunk S against the replay with the fit off")
+    p.add_argument("--effects", default="amplitude_imbalance", help="the model for stats (default the seed's)")
     return p.parse_args()
 
 
@@ -74,6 +84,30 @@ def explain_table(args):
         print(f"| {minutes:g} min | {samples:.3g} | {wall:.1f} | {rss_mb:.0f} | {per_sample:.0f} |", flush=True)
 
 
+def stats_table(args):
+    print(f"\nresolver-model stats --chunk {args.stats_chunk:g} --effects {args.effects} against resolverd --replay "
+          f"--fast with the model fit off, 10 kHz bench (median of {args.repeats})")
+    print("| log | samples | stats wall [s] | stats peak RSS [MB] | replay (fit off) wall [s] | stats / replay | "
+          "merge wall [s] | merge peak RSS [MB] |")
+    print("|---|---|---|---|---|---|---|---|", flush=True)
+    out = args.work / "chunked.stats"
+    for minutes in sorted(args.minutes):
+        log = make_log(args, minutes)
+        frames = rb.count_lines(log)
+        rb.warm_cache(log)
+        stats, replay, merge = [], [], []
+        for _ in range(args.repeats):
+            stats.append(rb.timed([str(args.bin / "resolver-model"), "stats", str(log), "--chunk", f"{args.stats_chunk:g}",
+                                   "--effects", args.effects, "--out", str(out)]))
+            replay.append(rb.run_resolverd_pipeline(argparse.Namespace(bin=args.bin, work=args.work), log, frames))
+            merge.append(rb.timed([str(args.bin / "resolver-model"), "merge", str(out)]))
+        ratio = statistics.median(s[0] / r["wall"] for s, r in zip(stats, replay))
+        print(f"| {minutes:g} min | {SAMPLE_RATE * minutes * 60:.3g} | {statistics.median(s[0] for s in stats):.1f} | "
+              f"{statistics.median(s[1] for s in stats) / 1024:.0f} | {statistics.median(r['wall'] for r in replay):.1f} | "
+              f"{ratio:.2f} | {statistics.median(m[0] for m in merge):.2f} | "
+              f"{statistics.median(m[1] for m in merge) / 1024:.0f} |", flush=True)
+
+
 def replay_table(args):
     log = make_log(args, args.replay_minutes)
     frames = rb.count_lines(log)
@@ -105,7 +139,10 @@ def main():
     args.work.mkdir(parents=True, exist_ok=True)
     if not args.skip_replay:
         replay_table(args)
-    explain_table(args)
+    if not args.skip_explain:
+        explain_table(args)
+    if args.stats_chunk > 0:
+        stats_table(args)
 
 
 if __name__ == "__main__":
