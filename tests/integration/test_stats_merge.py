@@ -181,6 +181,17 @@ def main():
         d = abs(merged_chunks["params"][name]["value"] - p["value"]) / p["stderr"]
         c.check(d < 1.0, f"chunks of 2 s merged against the whole log on {name}: {d:.3f} se apart")
 
+    # fit|explain --chunk: the same in one command, for every log given.
+    r = run([model, "fit", a, b, "--chunk", 2, "--effects", MODEL, "--json"])
+    both = json.loads(r.stdout) if r.returncode == 0 else {"runs": []}
+    c.check(len(both["runs"]) == 6 and {x["file"].split(":")[0] for x in both["runs"]} == {str(a), str(b)},
+            f"fit a.log b.log --chunk 2: 6 runs, 3 of each log ({r.returncode}: {r.stderr.strip()[:200]})")
+    r = run([model, "explain", a, "--chunk", 2, "--effects", MODEL, "--json"])
+    one = json.loads(r.stdout) if r.returncode == 0 else {"params": {}}
+    c.check(all(abs(one["params"].get(n, {"value": 1e9})["value"] - v["value"]) <= 1e-12 + 1e-8 * abs(v["value"])
+                for n, v in merged_chunks["params"].items()),
+            "explain --chunk 2 = stats --chunk 2 then merge, in one command")
+
     # 6. bad input
     text = sa.read_text()
     bad = {"v2.stats": text.replace('"version":1', '"version":2', 1), "cut.stats": text[: len(text) // 2],

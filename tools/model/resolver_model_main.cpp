@@ -377,6 +377,13 @@ void add_discovery_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) {
   subs.explain = app.add_subcommand("explain", "fit, say where it fails and rank the missing catalog effects");
   add_model_options(subs.fit, a, fittable);
   add_model_options(subs.explain, a, fittable);
+  for (CLI::App* sub : {subs.fit, subs.explain}) {
+    sub->add_option("--chunk", a.chunk_s,
+                    "one log of any length in the memory of two chunks: each chunk of this many seconds is fitted "
+                    "as a run and the runs merged (as stats --chunk then merge; the report is merge's: no "
+                    "breakdowns by harmonic or speed)")
+        ->check(CLI::PositiveNumber);
+  }
   subs.fit->footer(sub_footer(kFitExamples));
   subs.explain->footer(sub_footer(kExplainExamples));
   CLI::App* report = subs.report = app.add_subcommand(
@@ -614,8 +621,8 @@ int run_on_logs(const Arguments& a, const Model& model, const resolver::Progress
   return resolver::run_pooled(run);
 }
 
-/// stats: the log's statistics, whole or one run per chunk (--chunk S).
-int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
+/// The log's statistics, whole or one run per chunk (--chunk S).
+resolver::StatsFile statistics_of_log(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
   resolver::DiscoveryOptions options = discovery_options(a, model.config);
   resolver::StatsFile file = resolver::stats_file_header(a.log, model.config);
   std::function<void(resolver::DiscoveryInput&&)> on_chunk;
@@ -635,15 +642,31 @@ int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMe
                                resolver::Where::at_file(a.log));
   }
   resolver::mark_untrusted(file, options.untrusted_input);
-  resolver::write_stats_file(file, a.stats_out);
-  return 0;
+  return file;
+}
+
+/// stats: the file; fit or explain --chunk: its runs merged at once (a long log in the
+/// memory of two chunks, reported as merge reports).
+int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
+  if (a.command == Command::kStats) {
+    resolver::write_stats_file(statistics_of_log(a, model, shown), a.stats_out);
+    return 0;
+  }
+  std::vector<resolver::StatsFile> files;
+  const std::vector<std::string> logs = a.logs.empty() ? std::vector<std::string>{a.log} : a.logs;
+  for (const std::string& log : logs) {
+    Arguments one = a;
+    one.log = log;
+    files.push_back(statistics_of_log(one, model, shown));
+  }
+  return resolver::print_merge(files, logs, {}, a.json, discovery_options(a, model.config));
 }
 
 /// Every subcommand but fleet: read the log, then fit, explain or write.
 int run_on_log(const Arguments& a) {
   const Model model = load_model(a);
   const resolver::ProgressMeter::Options shown = resolver::ProgressMeter::for_stderr(a.progress);
-  if (a.command == Command::kStats) return run_stats(a, model, shown);
+  if (a.command == Command::kStats || a.chunk_s > 0.0) return run_stats(a, model, shown);
   if (a.logs.size() > 1) return run_on_logs(a, model, shown);
   resolver::LogSamples samples = read_samples(a, model.config, shown);
   resolver::DiscoveryOptions options = discovery_options(a, model.config);

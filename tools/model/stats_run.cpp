@@ -62,17 +62,23 @@ void write_stats_file(const StatsFile& file, const std::string& out) {
 int run_merge(const std::vector<std::string>& paths, std::span<const std::string> effects, bool json,
               const DiscoveryOptions& options) {
   std::vector<StatsFile> files;
+  for (const std::string& p : paths) files.push_back(read_stats_file(p));
+  check_same_layout(files, paths);
+  return print_merge(files, paths, effects, json, options);
+}
+
+int print_merge(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+                std::span<const std::string> effects, bool json, const DiscoveryOptions& options) {
   std::vector<RunStatistics> runs;
   std::vector<std::string> names;
-  for (const std::string& p : paths) {
-    files.push_back(read_stats_file(p));
+  for (std::size_t i = 0; i < files.size(); ++i) {
     // A file of one run is named by its path; a chunked log's runs by path and span.
-    for (const NamedRun& r : files.back().runs) {
-      names.push_back(files.back().runs.size() == 1 ? p : p + ": " + r.name.substr(r.name.rfind(" [") + 1));
+    for (const NamedRun& r : files[i].runs) {
+      names.push_back(files[i].runs.size() == 1 ? paths[i]
+                                                : paths[i] + ": " + r.name.substr(r.name.rfind(" [") + 1));
       runs.push_back(r.run);
     }
   }
-  check_same_layout(files, paths);
   MergedFit merged;
   try {
     merged = merge_runs(runs, names, effects, options);

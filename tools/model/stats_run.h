@@ -33,6 +33,11 @@ void mark_untrusted(StatsFile& file, const std::vector<std::string>& untrusted);
 /// Writes `file` to `out` (IoError: exit 3) and says what it holds on stdout.
 void write_stats_file(const StatsFile& file, const std::string& out);
 
+/// Merges the runs of `files` (named by `paths`, a chunk by its span too) with `effects`
+/// and prints text or JSON on stdout; returns 0. InputError (data) when they do not merge.
+int print_merge(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+                std::span<const std::string> effects, bool json, const DiscoveryOptions& options);
+
 /// Reads the statistics files, checks they are of one layout and merges them with
 /// `effects` (empty: the first run's model); prints text or JSON on stdout; returns 0.
 int run_merge(const std::vector<std::string>& paths, std::span<const std::string> effects, bool json,
