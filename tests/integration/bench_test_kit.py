@@ -9,6 +9,7 @@
 Standard library only.
 """
 import subprocess
+import sys
 
 
 def run(cmd, timeout=300, **kwargs):
@@ -35,3 +36,13 @@ class Checks:
             return 1
         print(passed_message)
         return 0
+
+
+def simulate_run(sim, out, rpm, seed, alpha, beta, theta_0, extra=(), duration=6):
+    """One run of one sensor with resolver-sim: amplitude imbalance alpha, quadrature beta and the
+    reference's zero theta_0 (mounting_offset), at rpm with the noise seed; exits on failure."""
+    r = run([sim, "--out", out, "--rpm", rpm, "--duration", duration, "--seed", seed, "--effect",
+             f"amplitude_imbalance:alpha={alpha}", "--effect", f"quadrature:beta={beta}", "--effect",
+             f"mounting_offset:theta_0={theta_0}", *extra])
+    if r.returncode != 0:
+        sys.exit(f"resolver-sim failed: {r.stderr}")

@@ -19,9 +19,11 @@ Standard library only.
 import argparse
 import json
 import math
-import subprocess
 import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_test_kit import Checks, run, simulate_run  # noqa: E402
 
 MODEL = "amplitude_imbalance,quadrature,tracking_loop"
 ALPHA, BETA = 0.03, 0.01
@@ -33,25 +35,12 @@ TOL = 1e-5
 # below the 1.5 rad the two runs' zeros differ by.
 TOL_ZERO = 1e-4
 
-failures = []
-
-
-def check(ok, what):
-    print(("ok   " if ok else "FAIL ") + what)
-    if not ok:
-        failures.append(what)
-
-
-def run(cmd):
-    return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=300)
+checks = Checks()
+check = checks.check
 
 
 def simulate(sim, out, rpm, seed, alpha, theta_0, extra=()):
-    r = run([sim, "--out", out, "--rpm", rpm, "--duration", 6, "--seed", seed, "--effect",
-             f"amplitude_imbalance:alpha={alpha}", "--effect", f"quadrature:beta={BETA}", "--effect",
-             f"mounting_offset:theta_0={theta_0}", *extra])
-    if r.returncode != 0:
-        sys.exit(f"resolver-sim failed: {r.stderr}")
+    simulate_run(sim, out, rpm, seed, alpha, BETA, theta_0, extra)
 
 
 def fit_json(model, logs, effects=MODEL, jobs=1):
@@ -138,11 +127,7 @@ def main():
     single, _ = fit_json(model, [a])
     check("pool" not in single, "one log: no pool in the JSON")
 
-    if failures:
-        print(f"{len(failures)} check(s) failed")
-        return 1
-    print("all pooled-fit checks passed")
-    return 0
+    return checks.finish("all pooled-fit checks passed")
 
 
 if __name__ == "__main__":

@@ -25,7 +25,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_test_kit import Checks, run  # noqa: E402
+from bench_test_kit import Checks, run, simulate_run  # noqa: E402
 
 MODEL = "amplitude_imbalance,quadrature,tracking_loop"
 ALPHA, BETA = 0.03, 0.01
@@ -44,11 +44,7 @@ c = Checks()
 
 
 def simulate(sim, out, rpm, seed, alpha, theta_0, extra=()):
-    r = run([sim, "--out", out, "--rpm", rpm, "--duration", 6, "--seed", seed, "--effect",
-             f"amplitude_imbalance:alpha={alpha}", "--effect", f"quadrature:beta={BETA}", "--effect",
-             f"mounting_offset:theta_0={theta_0}", *extra])
-    if r.returncode != 0:
-        sys.exit(f"resolver-sim failed: {r.stderr}")
+    simulate_run(sim, out, rpm, seed, alpha, BETA, theta_0, extra)
 
 
 def stats(model, log, out, effects=MODEL, extra=()):

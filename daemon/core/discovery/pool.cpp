@@ -18,28 +18,6 @@ namespace {
 /// whiteness lag or history gap test (three row spacings), so nothing reaches across.
 constexpr double kGapBetweenLogs = 10.0;
 
-/// The signals a pooled fit shares must be the same in every log.
-void check_same_layout(const PreparedLog& first, const PreparedLog& other, const std::string& first_name,
-                       const std::string& name) {
-  if (other.p_r != first.p_r || other.p != first.p) {
-    throw std::invalid_argument(fmt::format("{}: pole pairs p_r = {}, p = {} differ from {}'s p_r = {}, p = {}: a "
-                                            "pooled fit is of one bench",
-                                            name, other.p_r, other.p, first_name, first.p_r, first.p));
-  }
-  const auto differs = [&](bool a, bool b, const char* what) {
-    if (a == b) return;
-    throw std::invalid_argument(fmt::format(
-        "{} {} {} but {} {}: a pooled fit needs the same signals in every log (fit them apart, or pool the logs "
-        "that share a layout)",
-        name, b ? "has" : "lacks", what, first_name, a ? "has it" : "does not"));
-  };
-  differs(first.reference, other.reference, "a reference angle");
-  differs(first.reference_aligned, other.reference_aligned, "an aligned reference ([bench] reference_aligned)");
-  differs(first.rd, other.rd, "an R/D angle");
-  differs(first.sincos, other.sincos, "sin/cos envelopes");
-  differs(first.currents, other.currents, "phase currents");
-}
-
 /// Rows-weighted pooled variance of one group's floors.
 FloorEstimate pool_floor(const std::vector<const FloorEstimate*>& f, const std::vector<double>& weight) {
   FloorEstimate out;
@@ -137,7 +115,9 @@ PreparedLog pool_logs(std::vector<PreparedLog> logs, const std::vector<std::stri
     throw std::invalid_argument(fmt::format("{} logs: a pooled fit takes at most 65535", logs.size()));
   }
   const PreparedLog& first = logs.front();
-  for (std::size_t i = 1; i < logs.size(); ++i) check_same_layout(first, logs[i], names.front(), names[i]);
+  for (std::size_t i = 1; i < logs.size(); ++i) {
+    check_same_layout(pool_layout(first), pool_layout(logs[i]), names.front(), names[i]);
+  }
   PreparedLog pool;
   pool.p_r = first.p_r;
   pool.p = first.p;
@@ -336,6 +316,31 @@ void add_motion(MotionSummary& into, const MotionSummary& m, bool first) {
   into.omega_min = first ? m.omega_min : std::min(into.omega_min, m.omega_min);
   into.omega_max = first ? m.omega_max : std::max(into.omega_max, m.omega_max);
   into.angle_noise = std::max(into.angle_noise, m.angle_noise);
+}
+
+PoolLayout pool_layout(const PreparedLog& log) {
+  return {log.p_r, log.p, log.reference, log.reference_aligned, log.rd, log.sincos, log.currents};
+}
+
+void check_same_layout(const PoolLayout& first, const PoolLayout& other, const std::string& first_name,
+                       const std::string& name) {
+  if (other.p_r != first.p_r || other.p != first.p) {
+    throw std::invalid_argument(fmt::format("{}: pole pairs p_r = {}, p = {} differ from {}'s p_r = {}, p = {}: "
+                                            "pooled or merged runs are of one bench",
+                                            name, other.p_r, other.p, first_name, first.p_r, first.p));
+  }
+  const auto differs = [&](bool a, bool b, const char* what) {
+    if (a == b) return;
+    throw std::invalid_argument(fmt::format(
+        "{} {} {} but {} {}: pooled or merged runs need the same signals in every log (fit them apart, or pool "
+        "the logs that share a layout)",
+        name, b ? "has" : "lacks", what, first_name, a ? "has it" : "does not"));
+  };
+  differs(first.reference, other.reference, "a reference angle");
+  differs(first.reference_aligned, other.reference_aligned, "an aligned reference ([bench] reference_aligned)");
+  differs(first.rd, other.rd, "an R/D angle");
+  differs(first.sincos, other.sincos, "sin/cos envelopes");
+  differs(first.currents, other.currents, "phase currents");
 }
 
 }  // namespace resolver

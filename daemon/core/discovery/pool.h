@@ -25,6 +25,18 @@ namespace resolver {
 /// layout), or when fewer than two logs or more than 65535 are given.
 [[nodiscard]] PreparedLog pool_logs(std::vector<PreparedLog> logs, const std::vector<std::string>& names);
 
+/// What runs fitted together must share: the bench and the signals.
+struct PoolLayout {
+  int p_r = 0, p = 0;
+  bool reference = false, reference_aligned = false, rd = false, sincos = false, currents = false;
+};
+[[nodiscard]] PoolLayout pool_layout(const PreparedLog& log);
+
+/// Throws std::invalid_argument naming `name` when `other` differs from `first` (named
+/// `first_name`) in pole pairs or in a signal.
+void check_same_layout(const PoolLayout& first, const PoolLayout& other, const std::string& first_name,
+                       const std::string& name);
+
 /// Each log's floors weighted by its rows (one weight per group for all its rows):
 /// the rows-weighted pooled variance.
 [[nodiscard]] FloorReport pool_floor_reports(const std::vector<const FloorReport*>& floors,

@@ -33,23 +33,8 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
-void check_same_bench(const RunStatistics& first, const RunStatistics& other, const std::string& first_name,
-                      const std::string& name) {
-  if (other.p_r != first.p_r || other.p != first.p) {
-    throw std::invalid_argument(fmt::format("{}: pole pairs p_r = {}, p = {} differ from {}'s p_r = {}, p = {}: a "
-                                            "merge is of one bench",
-                                            name, other.p_r, other.p, first_name, first.p_r, first.p));
-  }
-  const auto differs = [&](bool a, bool b, const char* what) {
-    if (a == b) return;
-    throw std::invalid_argument(fmt::format("{} {} {} but {} {}: merged runs need the same signals", name,
-                                            b ? "has" : "lacks", what, first_name, a ? "has it" : "does not"));
-  };
-  differs(first.reference, other.reference, "a reference angle");
-  differs(first.reference_aligned, other.reference_aligned, "an aligned reference ([bench] reference_aligned)");
-  differs(first.rd, other.rd, "an R/D angle");
-  differs(first.sincos, other.sincos, "sin/cos envelopes");
-  differs(first.currents, other.currents, "phase currents");
+PoolLayout layout_of(const RunStatistics& r) {
+  return {r.p_r, r.p, r.reference, r.reference_aligned, r.rd, r.sincos, r.currents};
 }
 
 /// The run with the most fitted rows (ties: the first name): every run is moved to
@@ -309,7 +294,9 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
                      std::span<const std::string> effects, const DiscoveryOptions& options) {
   if (runs.empty()) throw std::invalid_argument("nothing to merge: no statistics given");
   if (names.size() != runs.size()) throw std::invalid_argument("merge: one name per run");
-  for (std::size_t r = 1; r < runs.size(); ++r) check_same_bench(runs.front(), runs[r], names.front(), names[r]);
+  for (std::size_t r = 1; r < runs.size(); ++r) {
+    check_same_layout(layout_of(runs.front()), layout_of(runs[r]), names.front(), names[r]);
+  }
   const std::size_t ref = reference_run(runs, names);
   MergedFit out;
   out.runs = static_cast<int>(runs.size());
