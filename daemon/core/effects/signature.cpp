@@ -34,30 +34,14 @@ void AngleBasis::set(const SignatureRow& row, const BasisTransform& transform) {
   mech_.reset(row.theta_m + (late - row.theta) / static_cast<double>(row.p_r));
 }
 
-double AngleBasis::loop_gain(double w) const {
-  if (!(transform_.omega_n > 0.0)) return 1.0;
-  // H(jw) = (wn^2 + j 2 zeta wn w) / (wn^2 - w^2 + j 2 zeta wn w), tracking_loop.h.
-  const double wn = transform_.omega_n;
-  const std::complex<double> num(wn * wn, 2.0 * transform_.zeta * wn * w);
-  const std::complex<double> den(wn * wn - w * w, 2.0 * transform_.zeta * wn * w);
-  return std::abs(num / den);
-}
+double AngleBasis::loop_gain(double w) const { return tracking_loop_gain(transform_.loop, w); }
 
-double AngleBasis::loop_phase(double w) const {
-  if (!(transform_.omega_n > 0.0)) return 0.0;
-  const double wn = transform_.omega_n;
-  const std::complex<double> num(wn * wn, 2.0 * transform_.zeta * wn * w);
-  const std::complex<double> den(wn * wn - w * w, 2.0 * transform_.zeta * wn * w);
-  return std::arg(num / den);
-}
+double AngleBasis::loop_phase(double w) const { return tracking_loop_phase(transform_.loop, w); }
 
 double AngleBasis::filtered(const Series& series, int k, double w, bool sine) const {
   const double sk = series.sin_k(k), ck = series.cos_k(k);
-  if (k == 0 || !(transform_.omega_n > 0.0)) return sine ? sk : ck;
-  const double wn = transform_.omega_n;
-  const std::complex<double> num(wn * wn, 2.0 * transform_.zeta * wn * w);
-  const std::complex<double> den(wn * wn - w * w, 2.0 * transform_.zeta * wn * w);
-  const std::complex<double> h = num / den;
+  if (k == 0 || !rd_filtered()) return sine ? sk : ck;
+  const std::complex<double> h = tracking_loop_response(transform_.loop, w);
   // g sin(x + phi) = Re(h) sin x + Im(h) cos x;  g cos(x + phi) = Re(h) cos x - Im(h) sin x.
   return sine ? h.real() * sk + h.imag() * ck : h.real() * ck - h.imag() * sk;
 }

@@ -28,6 +28,8 @@
 #include <span>
 #include <vector>
 
+#include "daemon/core/effects/tracking_loop.h"
+
 namespace resolver {
 
 /// The true angle at earlier times: the fit's rows around the current one (a
@@ -109,8 +111,7 @@ class SignatureColumns {
 /// The transform the effects that move the resolver's angle or filter it set on
 /// every other effect's harmonics (configure_basis).
 struct BasisTransform {
-  double omega_n = 0.0;  ///< [rad/s] tracking loop; 0 = ideal converter (no filtering)
-  double zeta = 0.7;     ///< [1]
+  TrackingLoopParams loop;  ///< the R/D converter's loop (tracking_loop.h); omega_n = 0: no filtering
   double delay = 0.0;    ///< [s] the resolver signals are those of t - delay
   /// [rad, resolver electrical] the angle the resolver sees is the true one plus this
   /// (mounting offset, backlash, eccentricity, mechanical harmonics): the windings'
@@ -140,7 +141,7 @@ class AngleBasis {
   [[nodiscard]] double env_mech_cos(int n) const;
   /// False when no tracking loop filters the R/D angle: rd_sin(k) == env_sin(k) then,
   /// and a caller summing both may compute one.
-  [[nodiscard]] bool rd_filtered() const { return transform_.omega_n > 0.0; }
+  [[nodiscard]] bool rd_filtered() const { return tracking_loop_active(transform_.loop); }
   /// [rad] the envelopes' resolver angle theta(t - d) + shift and mechanical angle theta_m(t - d).
   [[nodiscard]] double env_angle() const { return env_.angle; }
   [[nodiscard]] double env_mech_angle() const { return mech_.angle; }
