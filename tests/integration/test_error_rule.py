@@ -296,7 +296,7 @@ class ArgumentChecks(unittest.TestCase):
 
     def test_echo_unknown_type_is_exit_2_naming_the_option(self):
         p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--type", "nosuch_t"])
-        self.assert_one_line(p, USAGE, "resolver-echo: --type: nosuch_t: no such type; see --list-types or add it "
+        self.assert_one_line(p, USAGE, "resolver-echo: --type nosuch_t: no such type; see --list-types or add it "
                                        "with --types")
 
     def test_export_data_without_an_output_is_exit_2(self):

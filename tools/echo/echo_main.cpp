@@ -198,9 +198,8 @@ int echo(const EchoArguments& a) {
     return 0;
   }
   if (!a.type_name.empty() && !type_known(registry, a.type_name)) {
-    throw resolver::InputError(resolver::Fault::kUsage,
-                               a.type_name + ": no such type; see --list-types or add it with --types",
-                               resolver::Where::at_option("--type"));
+    throw resolver::InputError(resolver::Fault::kUsage, "no such type; see --list-types or add it with --types",
+                               resolver::Where::at_option("--type " + a.type_name));
   }
   // A bad --channel regex throws std::invalid_argument: exit 2.
   const resolver::EchoFilter filter = resolver::make_echo_filter(a.channel_regex, a.type_name);
