@@ -25,8 +25,8 @@
 // static equilibrium atan2(s, c) at every instant.
 //
 // The loop's parameters are the effect's one list (kTrackingLoopParams): the
-// simulated converter, the chain's ConverterSpec, the fit's BasisTransform and
-// tracking_loop_fit.h all hold a TrackingLoopParams and read it by name.
+// simulated converter, the chain's ConverterSpec and the fit's BasisTransform hold
+// a TrackingLoopParams, tracking_loop_fit.h's estimate gives one, all read by name.
 #pragma once
 
 #include <array>
