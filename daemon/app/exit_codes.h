@@ -1,7 +1,8 @@
 // The command-line side of the exit codes (daemon/service/program_errors.h has
 // the codes, their --help paragraph and the exception -> code rule): CLI11's
-// parse errors, and unreadable files checked before anything is read (IoError,
-// daemon/core/errors.h, which the one rule maps).
+// parse errors, and what is checked before anything is read: unreadable files
+// (IoError) and a --to before --from (InputError, usage), both of
+// daemon/core/errors.h, which the one rule maps.
 //
 // CLI11's own codes (105 for a missing --config file, 106 for a missing
 // option, ...) never leave a program: parse_command_line() maps them.
@@ -17,7 +18,9 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
+#include "daemon/decode/sample_slice.h"
 #include "daemon/service/program_errors.h"
 
 namespace resolver::exit_code {
@@ -47,6 +50,15 @@ inline void require_readable(const std::string& option, const std::string& path,
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
     throw IoError("cannot read " + option + " " + path + ": it is a directory, not a file", where);
+  }
+}
+
+/// Returns when --to is not before --from; else throws InputError (usage, option
+/// --to) "--to: T s is before --from F s" (exit 2).
+inline void require_slice(const SampleSlice& slice) {
+  if (slice.to_s < slice.from_s) {
+    throw InputError(Fault::kUsage, fmt::format("{:g} s is before --from {:g} s", slice.to_s, slice.from_s),
+                     Where::at_option("--to"));
   }
 }
 

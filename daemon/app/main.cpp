@@ -133,7 +133,7 @@ struct Options {
 };
 
 /// Parses the command line into `o`; an exit code when the program ends here (--help,
-/// --version, a usage error).
+/// --version, CLI11's usage error). A --to before --from throws InputError (usage).
 std::optional<int> parse_options(int argc, char** argv, Options& o) {
   using namespace resolver;
   CLI::App app{kDescription, "resolverd"};
@@ -180,10 +180,7 @@ std::optional<int> parse_options(int argc, char** argv, Options& o) {
                  "Locked while resolverd runs: a second resolverd on the same directory exits 3 naming the first's pid; "
                  "a save that fails exits 3");
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
-  if (o.slice.to_s < o.slice.from_s) {
-    std::cerr << "resolverd: --to " << o.slice.to_s << " s is before --from " << o.slice.from_s << " s\n";
-    return exit_code::kUsage;
-  }
+  exit_code::require_slice(o.slice);  // InputError: exit 2
   return std::nullopt;
 }
 
@@ -380,8 +377,7 @@ static int run(int argc, char** argv) {
   StopFlags flags;
   install_signal_handlers(flags);
   if (o.replay_path.empty() && o.can_iface.empty()) {
-    std::cerr << "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)\n";
-    return exit_code::kUsage;
+    throw InputError(Fault::kUsage, "nothing to read: give --replay LOG or --can IFACE (see --help)");
   }
   for (const auto& [option, path] : {std::pair{"--config", config_path}, std::pair{"--replay", o.replay_path}}) {
     if (!path.empty()) exit_code::require_readable(option, path);  // IoError: exit 3

@@ -17,12 +17,8 @@ std::shared_ptr<const FrameDecoder> make_frame_decoder(const DaemonConfig& confi
   // A DBC that does not parse throws InputError (kUsage) naming its file and line.
   auto db = std::make_shared<const dbc::Database>(config.dbc_path.empty() ? dbc::parse_dbc(embedded_bench_dbc(), path)
                                                                           : dbc::load_dbc_file(path));
-  try {
-    return std::make_shared<const FrameDecoder>(db, config.signal_map);
-  } catch (const std::invalid_argument& e) {
-    throw ConfigError((config.source.empty() ? std::string("built-in config") : config.source) + " with " + path +
-                      ": " + e.what());
-  }
+  // A signal map that does not fit it throws InputError (kUsage) naming the config and the DBC.
+  return std::make_shared<const FrameDecoder>(db, config.signal_map, Where::at_file(config.source));
 }
 
 SampleStreamConfig sample_stream_config(const DaemonConfig& config, const SampleSlice& slice) {

@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <optional>
 #include <span>
-#include <stdexcept>
 
 #include "daemon/core/angles.h"
 #include "daemon/dbc/dbc_codec.h"
@@ -136,7 +135,7 @@ std::optional<double> role_unit_factor(Role role, const std::string& message, co
 
 }  // namespace
 
-FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map)
+FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map, const Where& map_at)
     : db_(std::move(db)), map_(map) {
   std::string problems;
   auto problem = [&problems](const std::string& text) { problems += "\n  - " + text; };
@@ -201,7 +200,11 @@ FrameDecoder::FrameDecoder(std::shared_ptr<const dbc::Database> db, const Signal
           (role_bit(Role::kSin) | role_bit(Role::kCos))) {
     problem("the signal map needs rd_angle, or both sin and cos: nothing to estimate an angle from");
   }
-  if (!problems.empty()) throw std::invalid_argument("signal map does not fit the DBC:" + problems);
+  if (!problems.empty()) {
+    Where where = map_at;
+    where.option = "[layout]";
+    throw InputError(Fault::kUsage, "signal map does not fit the DBC " + db_->source + ":" + problems, where);
+  }
 }
 
 DecodeResult FrameDecoder::decode(const CanFrame& frame, DecodedPart& part, BenchInfo& info) const {

@@ -26,6 +26,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "daemon/core/errors.h"
 #include "daemon/dbc/dbc_types.h"
 #include "daemon/decode/signal_map.h"
 #include "drivers/can_frame.h"
@@ -88,12 +89,13 @@ class FrameDecoder {
     std::vector<RoleSignal> roles;
   };
 
-  /// Builds the decoder. Throws std::invalid_argument listing every problem
-  /// (unknown message or signal names, missing counter, a signal it reads
+  /// Builds the decoder. When `map` does not fit the DBC, throws InputError
+  /// (Fault::kUsage: the config's map; `map_at` is the config file, option
+  /// "[layout]") "signal map does not fit the DBC <db's source>:" listing every
+  /// problem (unknown message or signal names, missing counter, a signal it reads
   /// overlapping another signal of its message, an angle or current signal whose
-  /// unit is missing or unknown, a signal it reads under extended multiplexing)
-  /// in one message.
-  FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map);
+  /// unit is missing or unknown, a signal it reads under extended multiplexing).
+  FrameDecoder(std::shared_ptr<const dbc::Database> db, const SignalMap& map, const Where& map_at = {});
 
   /// Decodes one frame. Cannot fail beyond returning kRejected with a reason.
   DecodeResult decode(const CanFrame& frame, DecodedPart& part, BenchInfo& info) const;

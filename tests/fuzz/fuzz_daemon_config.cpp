@@ -5,13 +5,12 @@
 // Properties: the only exception parse_daemon_config may throw is ConfigError
 // (resolverd's main catches exactly that; anything else would terminate the
 // daemon), with a message that names the source; the only one FrameDecoder may
-// throw is std::invalid_argument. An accepted config keeps the invariants its
-// validation promises (decimations, revolutions and max_counter_delta >= 1,
-// rd_bits 1..16, sample_rate_hz >= 0).
+// throw is InputError (usage), naming the source too. An accepted config keeps
+// the invariants its validation promises (decimations, revolutions and
+// max_counter_delta >= 1, rd_bits 1..16, sample_rate_hz >= 0).
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <stdexcept>
 #include <string>
 
 #include "daemon/app/daemon_config.h"
@@ -51,10 +50,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   FUZZ_CHECK(config.bench.rd_bits >= 1 && config.bench.rd_bits <= 16, "accepted rd_bits outside 1..16");
   FUZZ_CHECK(config.bench.sample_rate_hz >= 0.0, "accepted a negative or NaN sample_rate_hz");
   try {
-    const resolver::FrameDecoder decoder(bench_db(), config.signal_map);
+    const resolver::FrameDecoder decoder(bench_db(), config.signal_map, resolver::Where::at_file(source));
     (void)decoder.mapped_roles();
-  } catch (const std::invalid_argument&) {
+  } catch (const resolver::InputError& e) {
     // A signal map that does not fit the bench DBC: resolverd reports it and exits 2.
+    FUZZ_CHECK(e.fault() == resolver::Fault::kUsage, "FrameDecoder's InputError is not a usage fault");
+    FUZZ_CHECK(std::string(e.what()).rfind(source, 0) == 0, "FrameDecoder's InputError does not start with the source");
   }
   return 0;
 }

@@ -28,6 +28,12 @@ real program:
   EchoMapping   resolver-echo's errors its main caught and mapped by hand: a bad .lcm
                 in --types (exit 2, file and line), a bad --channel regex (exit 2),
                 --csv into a folder that cannot be made (exit 3, "--csv: cannot write")
+  ArgumentChecks  the programs' own argument checks (were printed and returned by hand
+                in each main): resolverd and resolver-model --to before --from,
+                resolverd with nothing to read, resolver-echo without --log or --lcm
+                and with an unknown --type, resolver-model export-data without --csv or
+                --mat, fleet's MANIFEST / --out / --summarize: exit 2 (a --summarize
+                that is not a folder 3) and one line "PROGRAM: [OPTION: ]MESSAGE"
 
   test_error_rule.py --bin BUILD/bin --work DIR [unittest arguments]
 """
@@ -263,6 +269,49 @@ class EchoMapping(unittest.TestCase):
         p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--csv", out])
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertIn("wrote ", p.stdout)
+
+
+class ArgumentChecks(unittest.TestCase):
+    def assert_one_line(self, p, code, line):
+        self.assertEqual(p.returncode, code, p.stderr)
+        self.assertEqual(p.stderr, line + "\n")
+
+    def test_to_before_from_is_exit_2_naming_the_option(self):
+        self.assert_one_line(resolverd("--from", "0.4", "--to", "0.2"), USAGE,
+                             "resolverd: --to: 0.2 s is before --from 0.4 s")
+        self.assert_one_line(run([f"{ARGS.bin}/resolver-model", "fit", sim_log(), "--from", "0.4", "--to", "0.2"]),
+                             USAGE, "resolver-model: --to: 0.2 s is before --from 0.4 s")
+
+    def test_control_to_after_from_is_read(self):
+        p = resolverd("--from", "0.1", "--to", "0.4")
+        self.assertEqual(p.returncode, 0, p.stderr)
+
+    def test_resolverd_with_nothing_to_read_is_exit_2(self):
+        p = run([f"{ARGS.bin}/resolverd", "--quiet", "--lcm", "memq://"], timeout=60)
+        self.assert_one_line(p, USAGE, "resolverd: nothing to read: give --replay LOG or --can IFACE (see --help)")
+
+    def test_echo_without_log_or_lcm_is_exit_2(self):
+        p = run([f"{ARGS.bin}/resolver-echo"], timeout=60)
+        self.assert_one_line(p, USAGE, "resolver-echo: give --log FILE or --lcm URL (or --list-types); see --help")
+
+    def test_echo_unknown_type_is_exit_2_naming_the_option(self):
+        p = run([f"{ARGS.bin}/resolver-echo", "--log", lcm_log(), "--type", "nosuch_t"])
+        self.assert_one_line(p, USAGE, "resolver-echo: --type nosuch_t: no such type; see --list-types or add it "
+                                       "with --types")
+
+    def test_export_data_without_an_output_is_exit_2(self):
+        p = run([f"{ARGS.bin}/resolver-model", "export-data", sim_log()])
+        self.assert_one_line(p, USAGE, "resolver-model: export-data: give --csv OUT, --mat OUT or both")
+
+    def test_fleet_argument_checks(self):
+        model = f"{ARGS.bin}/resolver-model"
+        manifest = write("fleet.csv", f"unit,log\nu1,{sim_log()}\n")
+        self.assert_one_line(run([model, "fleet", "--summarize", ARGS.work, "--out", work("fleet_out")]), USAGE,
+                             "resolver-model: fleet: --summarize DIR takes no MANIFEST or --out")
+        self.assert_one_line(run([model, "fleet", manifest]), USAGE,
+                             "resolver-model: fleet: give MANIFEST --out DIR, or --summarize DIR")
+        self.assert_one_line(run([model, "fleet", "--summarize", manifest]), IO,
+                             f"resolver-model: fleet: --summarize {manifest}: not a folder")
 
 
 if __name__ == "__main__":

@@ -116,14 +116,12 @@ void add_echo_options(CLI::App& app, EchoArguments& a) {
       ->needs(log_opt);
 }
 
-/// No input: its exit code, after the message. A --log that cannot be read throws IoError.
-std::optional<int> check_input(const EchoArguments& a) {
+/// No input throws InputError (usage: exit 2); a --log that cannot be read IoError (exit 3).
+void check_input(const EchoArguments& a) {
   if (!a.list_types && a.log_path.empty() && a.lcm_url.empty()) {
-    std::cerr << "resolver-echo: give --log FILE or --lcm URL (or --list-types); see --help\n";
-    return exit_code::kUsage;
+    throw resolver::InputError(resolver::Fault::kUsage, "give --log FILE or --lcm URL (or --list-types); see --help");
   }
-  if (!a.log_path.empty()) exit_code::require_readable("--log", a.log_path);  // IoError: exit 3
-  return std::nullopt;
+  if (!a.log_path.empty()) exit_code::require_readable("--log", a.log_path);
 }
 
 /// The --types directories into the registry: a bad .lcm file throws LcmParseError (an
@@ -200,9 +198,8 @@ int echo(const EchoArguments& a) {
     return 0;
   }
   if (!a.type_name.empty() && !type_known(registry, a.type_name)) {
-    std::cerr << fmt::format("resolver-echo: --type {}: no such type; see --list-types or add it with --types\n",
-                             a.type_name);
-    return exit_code::kUsage;
+    throw resolver::InputError(resolver::Fault::kUsage, "no such type; see --list-types or add it with --types",
+                               resolver::Where::at_option("--type " + a.type_name));
   }
   // A bad --channel regex throws std::invalid_argument: exit 2.
   const resolver::EchoFilter filter = resolver::make_echo_filter(a.channel_regex, a.type_name);
@@ -223,7 +220,7 @@ int run(int argc, char** argv) {
   EchoArguments a;
   add_echo_options(app, a);
   if (auto code = exit_code::parse_command_line(app, argc, argv)) return *code;
-  if (auto code = check_input(a)) return *code;
+  check_input(a);
   try {
     return echo(a);
   } catch (...) {

@@ -228,22 +228,20 @@ std::string sub_footer(const char* examples) {
 /// `fleet`: every unit of MANIFEST into OUT, then OUT/fleet.json; or --summarize DIR alone.
 int run_fleet(const std::string& manifest, const std::string& out, const std::string& summarize_dir,
               std::vector<std::string> effects, const std::string& config_path, int points) {
+  using resolver::Fault, resolver::InputError, resolver::Where;
   if (!summarize_dir.empty() && (!manifest.empty() || !out.empty())) {
-    std::cerr << "resolver-model fleet: --summarize DIR takes no MANIFEST or --out\n";
-    return resolver::exit_code::kUsage;
+    throw InputError(Fault::kUsage, "--summarize DIR takes no MANIFEST or --out", Where::at_option("fleet"));
   }
   int failed = 0;
   if (!summarize_dir.empty()) {
     if (!std::filesystem::is_directory(summarize_dir)) {
-      std::cerr << "resolver-model fleet: --summarize " << summarize_dir << ": not a folder\n";
-      return resolver::exit_code::kIo;
+      throw resolver::IoError("--summarize " + summarize_dir + ": not a folder", Where::at_option("fleet"));
     }
     std::cout << resolver::summarize_fleet(summarize_dir, failed);
     return failed > 0 ? resolver::exit_code::kNoUsableData : resolver::exit_code::kDone;
   }
   if (manifest.empty() || out.empty()) {
-    std::cerr << "resolver-model fleet: give MANIFEST --out DIR, or --summarize DIR\n";
-    return resolver::exit_code::kUsage;
+    throw InputError(Fault::kUsage, "give MANIFEST --out DIR, or --summarize DIR", Where::at_option("fleet"));
   }
   resolver::exit_code::require_readable("MANIFEST", manifest);  // IoError: exit 3
   resolver::FleetOptions options;
@@ -468,20 +466,17 @@ void add_calibration_subcommands(CLI::App& app, Arguments& a, Subcommands& subs)
   add_statistics_subcommands(app, a, subs);
 }
 
-/// A usage error or an unreadable input, said before anything is read: its exit code.
-std::optional<int> check_arguments(const Arguments& a) {
-  if (a.slice.to_s < a.slice.from_s) {
-    std::cerr << "resolver-model: --to " << a.slice.to_s << " s is before --from " << a.slice.from_s << " s\n";
-    return resolver::exit_code::kUsage;
-  }
+/// A usage error (InputError: exit 2) or an unreadable input (IoError: exit 3), thrown
+/// before anything is read.
+void check_arguments(const Arguments& a) {
+  resolver::exit_code::require_slice(a.slice);
   for (const auto& [option, path] : {std::pair{"LOG", a.log}, std::pair{"--config", a.config_path}}) {
-    if (!path.empty()) resolver::exit_code::require_readable(option, path);  // IoError: exit 3
+    if (!path.empty()) resolver::exit_code::require_readable(option, path);
   }
   if (a.command == Command::kExportData && a.csv_out.empty() && a.mat_out.empty()) {
-    std::cerr << "resolver-model export-data: give --csv OUT, --mat OUT or both\n";
-    return resolver::exit_code::kUsage;
+    throw resolver::InputError(resolver::Fault::kUsage, "give --csv OUT, --mat OUT or both",
+                               resolver::Where::at_option("export-data"));
   }
-  return std::nullopt;
 }
 
 /// The config (its defaults without --config) and the model's effects.
@@ -705,7 +700,7 @@ int run(int argc, char** argv) {
     const Model model = load_model(a);
     return resolver::run_merge(a.stats_files, split_effects(a.effects_args), a.json, discovery_options(a, model.config));
   }
-  if (auto code = check_arguments(a)) return *code;
+  check_arguments(a);
   return run_on_log(a);
 }
 

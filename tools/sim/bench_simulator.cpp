@@ -134,7 +134,7 @@ BenchSimulator::BenchSimulator(SimConfig config)
     : config_(validated(std::move(config))),
       profile_(config_.profile),
       chain_(config_.chain, config_.p_r, config_.p),
-      loop_(TrackingLoopConfig{chain_.converter().omega_n, chain_.converter().zeta}),
+      loop_(chain_.converter().loop),
       engine_(config_.seed),
       alpha0_(config_.chain.get("amplitude_imbalance", "alpha")) {
   // Samples at t = 0, 1/fs, ... strictly inside the profile's duration.

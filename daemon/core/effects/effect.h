@@ -52,6 +52,7 @@
 #include "daemon/core/effects/phase_currents.h"
 #include "daemon/core/effects/sin_cos.h"
 #include "daemon/core/effects/signature.h"
+#include "daemon/core/effects/tracking_loop.h"
 
 namespace resolver {
 
@@ -88,8 +89,7 @@ struct ChannelTiming {
 
 /// The R/D converter the chain simulates.
 struct ConverterSpec {
-  double omega_n = 0.0;  ///< [rad/s] type-II loop natural frequency; 0 = ideal (atan2)
-  double zeta = 0.7;     ///< [1] loop damping
+  TrackingLoopParams loop;  ///< the type-II loop (tracking_loop.h); omega_n = 0: ideal (atan2)
   int rd_bits = 16;      ///< [bits] resolution of the rd_angle field
 };
 

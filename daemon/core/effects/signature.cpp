@@ -34,28 +34,14 @@ void AngleBasis::set(const SignatureRow& row, const BasisTransform& transform) {
   mech_.reset(row.theta_m + (late - row.theta) / static_cast<double>(row.p_r));
 }
 
-std::complex<double> AngleBasis::loop_response(double w) const {
-  // H(jw) = (a + ib) / (c + ib), a = wn^2, b = 2 zeta wn w, c = wn^2 - w^2 (tracking_loop.h),
-  // divided out by hand: std::complex's division (__divdc3, with its inf and NaN cases)
-  // was a tenth of a fit's time; c^2 + b^2 > 0 for zeta > 0 (its range starts at 0.01).
-  const double wn = transform_.omega_n;
-  const double a = wn * wn, b = 2.0 * transform_.zeta * wn * w, c = a - w * w;
-  const double inv = 1.0 / (c * c + b * b);
-  return {(a * c + b * b) * inv, (b * c - a * b) * inv};
-}
+double AngleBasis::loop_gain(double w) const { return tracking_loop_gain(transform_.loop, w); }
 
-double AngleBasis::loop_gain(double w) const {
-  return transform_.omega_n > 0.0 ? std::abs(loop_response(w)) : 1.0;
-}
-
-double AngleBasis::loop_phase(double w) const {
-  return transform_.omega_n > 0.0 ? std::arg(loop_response(w)) : 0.0;
-}
+double AngleBasis::loop_phase(double w) const { return tracking_loop_phase(transform_.loop, w); }
 
 double AngleBasis::filtered(const Series& series, int k, double w, bool sine) const {
   const double sk = series.sin_k(k), ck = series.cos_k(k);
-  if (k == 0 || !(transform_.omega_n > 0.0)) return sine ? sk : ck;
-  const std::complex<double> h = loop_response(w);
+  if (k == 0 || !rd_filtered()) return sine ? sk : ck;
+  const std::complex<double> h = tracking_loop_response(transform_.loop, w);
   // g sin(x + phi) = Re(h) sin x + Im(h) cos x;  g cos(x + phi) = Re(h) cos x - Im(h) sin x.
   return sine ? h.real() * sk + h.imag() * ck : h.real() * ck - h.imag() * sk;
 }

@@ -29,6 +29,8 @@
 #include <span>
 #include <vector>
 
+#include "daemon/core/effects/tracking_loop.h"
+
 namespace resolver {
 
 /// The true angle at earlier times: the fit's rows around the current one (a
@@ -110,8 +112,7 @@ class SignatureColumns {
 /// The transform the effects that move the resolver's angle or filter it set on
 /// every other effect's harmonics (configure_basis).
 struct BasisTransform {
-  double omega_n = 0.0;  ///< [rad/s] tracking loop; 0 = ideal converter (no filtering)
-  double zeta = 0.7;     ///< [1]
+  TrackingLoopParams loop;  ///< the R/D converter's loop (tracking_loop.h); omega_n = 0: no filtering
   double delay = 0.0;    ///< [s] the resolver signals are those of t - delay
   /// [rad, resolver electrical] the angle the resolver sees is the true one plus this
   /// (mounting offset, backlash, eccentricity, mechanical harmonics): the windings'
@@ -142,11 +143,11 @@ class AngleBasis {
   /// H(j k omega) of the R/D loop for order k of the resolver angle (1 without a loop):
   /// rd_sin(k) = Re(H) env_sin(k) + Im(H) env_cos(k); rd_cos(k) = Re(H) env_cos(k) - Im(H) env_sin(k).
   [[nodiscard]] std::complex<double> rd_response(int k) const {
-    return transform_.omega_n > 0.0 && k != 0 ? loop_response(k * row_.omega) : std::complex<double>(1.0, 0.0);
+    return k != 0 ? tracking_loop_response(transform_.loop, k * row_.omega) : std::complex<double>(1.0, 0.0);
   }
   /// False when no tracking loop filters the R/D angle: rd_sin(k) == env_sin(k) then,
   /// and a caller summing both may compute one.
-  [[nodiscard]] bool rd_filtered() const { return transform_.omega_n > 0.0; }
+  [[nodiscard]] bool rd_filtered() const { return tracking_loop_active(transform_.loop); }
   /// [rad] the envelopes' resolver angle theta(t - d) + shift and mechanical angle theta_m(t - d).
   [[nodiscard]] double env_angle() const { return env_.angle; }
   [[nodiscard]] double env_mech_angle() const { return mech_.angle; }
@@ -182,8 +183,6 @@ class AngleBasis {
   };
   /// g sin(k a + phi) or g cos(k a + phi) with g e^{j phi} = H(j k w).
   [[nodiscard]] double filtered(const Series& series, int k, double w, bool sine) const;
-  /// The R/D loop's closed-loop response H(j w) (transform_.omega_n > 0).
-  [[nodiscard]] std::complex<double> loop_response(double w) const;
 
   SignatureRow row_;
   BasisTransform transform_;

@@ -9,9 +9,9 @@
 
 namespace resolver {
 
-int tracking_loop_substeps(const TrackingLoopConfig& config, double duration) {
-  if (!config.active() || duration <= 0.0) return 1;
-  const double n = std::ceil(config.omega_n * duration / TrackingLoopConfig::kMaxOmegaNStep);
+int tracking_loop_substeps(const TrackingLoopParams& config, double duration) {
+  if (!tracking_loop_active(config) || duration <= 0.0) return 1;
+  const double n = std::ceil(config["omega_n"] * duration / kTrackingLoopMaxOmegaNStep);
   return n < 1.0 ? 1 : static_cast<int>(n);
 }
 
@@ -21,9 +21,10 @@ struct Derivative {
   double domega;
 };
 
-Derivative loop_derivative(const TrackingLoopConfig& c, const SinCos& sc, double phi, double omega) {
+Derivative loop_derivative(const TrackingLoopParams& c, const SinCos& sc, double phi, double omega) {
   const double e = rd_error_signal(sc, phi);
-  return {omega + 2.0 * c.zeta * c.omega_n * e, c.omega_n * c.omega_n * e};
+  const double omega_n = c["omega_n"];
+  return {omega + 2.0 * c["zeta"] * omega_n * e, omega_n * omega_n * e};
 }
 }  // namespace
 
@@ -38,23 +39,24 @@ void TrackingLoop::rk4_step(const SinCos& at_start, const SinCos& at_mid, const 
   state_.omega = omega + h / 6.0 * (k1.domega + 2.0 * k2.domega + 2.0 * k3.domega + k4.domega);
 }
 
-namespace {
-std::complex<double> closed_loop(const TrackingLoopConfig& c, double omega) {
-  const std::complex<double> s(0.0, omega);
-  const double wn = c.omega_n;
-  const std::complex<double> num = 2.0 * c.zeta * wn * s + wn * wn;
-  return num / (s * s + num);
-}
-}  // namespace
-
-double tracking_loop_gain(const TrackingLoopConfig& config, double omega) {
-  if (!config.active()) return 1.0;
-  return std::abs(closed_loop(config, omega));
+std::complex<double> tracking_loop_response(const TrackingLoopParams& config, double omega) {
+  if (!tracking_loop_active(config)) return {1.0, 0.0};
+  // H(j w) = (a + ib) / (c + ib) with a = wn^2, b = 2 zeta wn w, c = wn^2 - w^2, divided
+  // out by hand: std::complex's division (__divdc3, with its inf and NaN cases) was a
+  // tenth of a fit's time (every row's R/D columns); c^2 + b^2 > 0 for zeta > 0 (its
+  // range starts at 0.01).
+  const double wn = config["omega_n"];
+  const double a = wn * wn, b = 2.0 * config["zeta"] * wn * omega, c = a - omega * omega;
+  const double inv = 1.0 / (c * c + b * b);
+  return {(a * c + b * b) * inv, (b * c - a * b) * inv};
 }
 
-double tracking_loop_phase(const TrackingLoopConfig& config, double omega) {
-  if (!config.active()) return 0.0;
-  return std::arg(closed_loop(config, omega));
+double tracking_loop_gain(const TrackingLoopParams& config, double omega) {
+  return std::abs(tracking_loop_response(config, omega));
+}
+
+double tracking_loop_phase(const TrackingLoopParams& config, double omega) {
+  return std::arg(tracking_loop_response(config, omega));
 }
 
 }  // namespace resolver
@@ -63,15 +65,6 @@ double tracking_loop_phase(const TrackingLoopConfig& config, double omega) {
 namespace resolver {
 namespace {
 
-constexpr std::array kParams{
-    ParamInfo{.name = "omega_n", .unit = "[rad/s]", .description = "closed-loop natural frequency (0 = ideal converter)",
-              .min = 0.0, .max = 1e6, .neutral = 0.0, .nonlinear = true, .scale = FitScale::kInverseSquare},
-    ParamInfo{.name = "zeta", .unit = "[1]", .description = "closed-loop damping ratio", .min = 0.01, .max = 10.0,
-              .neutral = 0.7, .nonlinear = true, .default_fit = false},
-};
-/// Typed, named access to the values of kParams (param_set.h).
-using TrackingLoopParams = ParamSet<kParams>;
-
 class TrackingLoopEffect final : public BasicEffect {
  public:
   TrackingLoopEffect()
@@ -79,24 +72,20 @@ class TrackingLoopEffect final : public BasicEffect {
                      "Hanselman II.A, Hwang Fig. 2; tracking_loop.h",
                      "the R/D converter's closed loop filters the error harmonics: the ripple of the R/D angle changes "
                      "in amplitude and phase with speed, the sin/cos signals do not"},
-                    kParams, EffectStage::kConverter) {}
+                    kTrackingLoopParams, EffectStage::kConverter) {}
   [[nodiscard]] bool needs_speed_change() const override { return true; }
   [[nodiscard]] Needs identifiable_with() const override { return Needs::kSpeedChangeOrSinCos; }
-  [[nodiscard]] bool active(Values v) const override { return TrackingLoopParams(v)["omega_n"] > 0.0; }
+  [[nodiscard]] bool active(Values v) const override { return tracking_loop_active(TrackingLoopParams(v)); }
   void validate(Values v) const override {
     const TrackingLoopParams p(v);
-    if (p["omega_n"] > 0.0 && !(p["zeta"] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
+    if (tracking_loop_active(p) && !(p["zeta"] > 0.0)) throw std::invalid_argument("tracking_loop.zeta must be > 0");
   }
   void converter(Values v, ConverterSpec& spec) const override {
-    const TrackingLoopParams p(v);
-    spec.omega_n = p["omega_n"];
-    spec.zeta = p["zeta"];
+    spec.loop = TrackingLoopParams(v);
   }
   [[nodiscard]] bool shapes_basis() const override { return true; }
   void configure_basis(const SignatureRow& /*row*/, Values v, BasisTransform& t) const override {
-    const TrackingLoopParams p(v);
-    t.omega_n = p["omega_n"];
-    t.zeta = p["zeta"];
+    t.loop = TrackingLoopParams(v);
   }
   // Both parameters act through the basis (every other effect's rd harmonics),
   // so they have no columns of their own; the fit differentiates numerically.

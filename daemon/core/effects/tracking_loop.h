@@ -18,29 +18,44 @@
 // each stage time, so the true angle advances continuously inside a control
 // sample period. The loop's poles have |lambda| = omega_n; RK4 is stable for
 // |lambda h| < ~2.8 and its one-step error is ~(lambda h)^5 / 120. We keep
-// omega_n h <= kMaxOmegaNStep = 0.05: the per-step error is ~3e-9 relative, i.e.
-// the integration is far below any quantization or noise level.
+// omega_n h <= kTrackingLoopMaxOmegaNStep = 0.05: the per-step error is ~3e-9
+// relative, i.e. the integration is far below any quantization or noise level.
 //
 // omega_n == 0 selects the ideal, infinitely fast converter: phi equals the
 // static equilibrium atan2(s, c) at every instant.
+//
+// The loop's parameters are the effect's one list (kTrackingLoopParams): the
+// simulated converter, the chain's ConverterSpec and the fit's BasisTransform hold
+// a TrackingLoopParams, tracking_loop_fit.h's estimate gives one, all read by name.
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <complex>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/effects/param_set.h"
 #include "daemon/core/effects/sin_cos.h"
 
 namespace resolver {
 
-struct TrackingLoopConfig {
-  /// Largest omega_n * h of one RK4 substep [1] (see the header comment).
-  static constexpr double kMaxOmegaNStep = 0.05;
-  /// [rad/s] closed-loop natural frequency; 0 = ideal converter; must be >= 0.
-  double omega_n = 0.0;
-  /// [1] damping ratio; must be > 0.
-  double zeta = 0.7;
-  [[nodiscard]] bool active() const { return omega_n > 0.0; }
+/// The effect's parameters, listed once (param_set.h).
+inline constexpr std::array kTrackingLoopParams{
+    ParamInfo{.name = "omega_n", .unit = "[rad/s]",
+              .description = "closed-loop natural frequency (0 = ideal converter)", .min = 0.0, .max = 1e6,
+              .neutral = 0.0, .nonlinear = true, .scale = FitScale::kInverseSquare},
+    ParamInfo{.name = "zeta", .unit = "[1]", .description = "closed-loop damping ratio", .min = 0.01, .max = 10.0,
+              .neutral = 0.7, .nonlinear = true, .default_fit = false},
 };
+/// A loop: omega_n [rad/s] (0 = ideal converter, >= 0) and zeta [1] (> 0), by name.
+using TrackingLoopParams = ParamSet<kTrackingLoopParams>;
+
+/// Largest omega_n * h of one RK4 substep [1] (see the header comment).
+inline constexpr double kTrackingLoopMaxOmegaNStep = 0.05;
+
+/// True when the loop filters (omega_n > 0); omega_n = 0 is the ideal converter
+/// whatever zeta is (the effect's rule, not ParamSet::active's).
+[[nodiscard]] constexpr bool tracking_loop_active(const TrackingLoopParams& p) { return p["omega_n"] > 0.0; }
 
 struct TrackingLoopState {
   double phi = 0.0;    ///< [rad] converter angle, continuous (not wrapped)
@@ -48,11 +63,11 @@ struct TrackingLoopState {
 };
 
 /// Number of RK4 substeps advance() takes over `duration` [s]. At least 1.
-[[nodiscard]] int tracking_loop_substeps(const TrackingLoopConfig& config, double duration);
+[[nodiscard]] int tracking_loop_substeps(const TrackingLoopParams& config, double duration);
 
 class TrackingLoop {
  public:
-  explicit TrackingLoop(const TrackingLoopConfig& config) : config_(config) {}
+  explicit TrackingLoop(const TrackingLoopParams& config) : config_(config) {}
 
   /// Sets the state, e.g. to a converged loop: phi = true angle, omega = true speed.
   void reset(const TrackingLoopState& state) { state_ = state; }
@@ -62,7 +77,7 @@ class TrackingLoop {
   /// evaluated at t0, the substep mid-points and ends.
   template <typename EnvelopeAt>
   void advance(EnvelopeAt&& envelope_at, double t0, double duration) {
-    if (!config_.active()) {
+    if (!tracking_loop_active(config_)) {
       // Ideal converter: follow the static angle, keep phi continuous.
       const double target = static_rd_angle(envelope_at(t0 + duration));
       const double step = wrap_pi(target - state_.phi);
@@ -83,21 +98,24 @@ class TrackingLoop {
   }
 
   [[nodiscard]] const TrackingLoopState& state() const { return state_; }
-  [[nodiscard]] const TrackingLoopConfig& config() const { return config_; }
+  [[nodiscard]] const TrackingLoopParams& config() const { return config_; }
   /// Converter angle wrapped to [0, 2pi) [rad].
   [[nodiscard]] double angle() const { return wrap_2pi(state_.phi); }
 
  private:
   void rk4_step(const SinCos& at_start, const SinCos& at_mid, const SinCos& at_end, double h);
 
-  TrackingLoopConfig config_;
+  TrackingLoopParams config_;
   TrackingLoopState state_;
 };
 
+/// H(j omega) of the linearised closed loop [1] at angular frequency omega [rad/s],
+/// signed (the negative-frequency response is the conjugate); 1 for the ideal converter.
+[[nodiscard]] std::complex<double> tracking_loop_response(const TrackingLoopParams& config, double omega);
 /// The linearised closed-loop gain |H(j omega)| of the loop at angular frequency omega [rad/s].
-[[nodiscard]] double tracking_loop_gain(const TrackingLoopConfig& config, double omega);
+[[nodiscard]] double tracking_loop_gain(const TrackingLoopParams& config, double omega);
 /// The linearised closed-loop phase arg H(j omega) [rad].
-[[nodiscard]] double tracking_loop_phase(const TrackingLoopConfig& config, double omega);
+[[nodiscard]] double tracking_loop_phase(const TrackingLoopParams& config, double omega);
 
 /// The registry unit of this effect (registry.h).
 class Effect;

@@ -291,11 +291,6 @@ std::optional<Eigen::MatrixXd> parameter_covariance(const Problem& p, const Eige
 
 }  // namespace
 
-std::complex<double> tracking_loop_response(const TrackingLoopConfig& loop, double omega) {
-  if (!loop.active()) return {1.0, 0.0};
-  return loop_response(loop.omega_n, loop.zeta, omega).h;
-}
-
 TrackingLoopEstimate fit_tracking_loop(std::complex<double> static_coefficient,
                                        std::span<const RippleObservation> observations,
                                        const TrackingLoopFitConfig& config) {

@@ -119,12 +119,8 @@ struct TrackingLoopEstimate {
   bool ok = false;              ///< converged, dof >= 1, identifiable (see config)
   std::string message;          ///< why not ok (empty when ok)
 
-  [[nodiscard]] TrackingLoopConfig loop() const { return {omega_n, zeta}; }
+  [[nodiscard]] TrackingLoopParams loop() const { return {{"omega_n", omega_n}, {"zeta", zeta}}; }
 };
-
-/// H(j omega) of the linearised closed loop [1] (the complex form of
-/// tracking_loop_gain / tracking_loop_phase). omega [rad/s], signed.
-[[nodiscard]] std::complex<double> tracking_loop_response(const TrackingLoopConfig& loop, double omega);
 
 /// Fits (omega_n, zeta) to observations of one harmonic order. Never throws on
 /// data: bad data give ok = false and a message (fewer than 2 observations, a

@@ -287,7 +287,7 @@ TEST_F(PipelineReload, AConfigThatCannotRunChangesNothing) {
   Pipeline pipeline(DaemonConfig{}, sink, diag);
   feed_samples(pipeline, 0, 20);
   const DaemonConfig bad = parse_daemon_config("[layout.signals]\ni_a = \"PHASE_CURRENTS.i_a\"\n", "bad.toml");
-  EXPECT_THROW((void)pipeline.reload(bad), ConfigError);
+  EXPECT_THROW((void)pipeline.reload(bad), InputError);  // the map does not fit the DBC: usage
   EXPECT_TRUE(pipeline.reloads().empty());
   feed_samples(pipeline, 20, 40);
   EXPECT_GE(pipeline.intake().stats().samples_complete, 39);  // the 40th may still be open

@@ -344,10 +344,14 @@ TEST(FrameDecoder, SignalMapErrorsNameTheProblem) {
   map.roles[static_cast<std::size_t>(Role::kSin)] = SignalRef{"RESOLVER_SAMPLE", "sine"};
   map.roles[static_cast<std::size_t>(Role::kIA)] = SignalRef{"CURRENTS", "i_a"};
   try {
-    FrameDecoder d(db, map);
-    FAIL() << "expected std::invalid_argument";
-  } catch (const std::invalid_argument& e) {
+    FrameDecoder d(db, map, Where::at_file("bench.toml"));
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
     const std::string what = e.what();
+    EXPECT_EQ(e.fault(), Fault::kUsage);  // the config's map: exit 2
+    // The config, its [layout], and the DBC it does not fit.
+    EXPECT_EQ(what.rfind("bench.toml: [layout]: signal map does not fit the DBC " + db->source + ":\n  - ", 0), 0U)
+        << what;
     EXPECT_NE(what.find("no signal 'sine'"), std::string::npos) << what;
     EXPECT_NE(what.find("no message 'CURRENTS'"), std::string::npos) << what;
   }

@@ -125,7 +125,7 @@ TEST(Multiplexed, RolesOffThePageAreAbsentAndCounted) {
 std::string construction_error(const std::string& text, const SignalMap& m) {
   try {
     FrameDecoder d(parse(text), m);
-  } catch (const std::invalid_argument& e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   return "";

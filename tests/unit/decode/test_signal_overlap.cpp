@@ -39,7 +39,7 @@ SignalMap sincos_map() {
 std::string construction_error(const std::string& signals) {
   try {
     FrameDecoder d(parse(signals), sincos_map());
-  } catch (const std::invalid_argument& e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   return "";

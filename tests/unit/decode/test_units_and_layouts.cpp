@@ -58,7 +58,7 @@ CanFrame frame(std::uint32_t id, std::int64_t t_us, std::uint16_t a, std::uint16
 std::string decoder_error(const std::string& dbc_text, const SignalMap& map) {
   try {
     FrameDecoder d(parse(dbc_text), map);
-  } catch (const std::invalid_argument& e) {
+  } catch (const InputError& e) {
     return e.what();
   }
   return "";

@@ -109,7 +109,7 @@ bool forward_hooks_finite(ForwardChain& chain) {
   const ChannelTiming& t = chain.timing();
   const Impairments& imp = chain.impairments();
   return std::isfinite(chain.time_shift()) && std::isfinite(t.converter_cos_dt) && std::isfinite(t.dsp_cos_dt) &&
-         std::isfinite(chain.converter().omega_n) && std::isfinite(imp.sigma_sc) && std::isfinite(imp.sigma_i);
+         std::isfinite(chain.converter().loop["omega_n"]) && std::isfinite(imp.sigma_sc) && std::isfinite(imp.sigma_i);
 }
 
 // Issue 22: a range is written once, in the list. Every end of it, the others

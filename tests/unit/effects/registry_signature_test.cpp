@@ -65,10 +65,10 @@ SignalValues forward_signals(const ChainValues& values, const Bench& b, int i) {
   };
   double phi = 0.0;
   const ConverterSpec conv = chain.converter();
-  if (conv.omega_n > 0.0) {
+  if (tracking_loop_active(conv.loop)) {
     // Steady state: start converged 40 / (zeta omega_n) earlier (e^-40 of any transient left).
-    const double settle = 40.0 / (conv.zeta * conv.omega_n);
-    TrackingLoop loop(TrackingLoopConfig{conv.omega_n, conv.zeta});
+    const double settle = 40.0 / (conv.loop["zeta"] * conv.loop["omega_n"]);
+    TrackingLoop loop(conv.loop);
     const double t0 = t - settle;
     const double static0 = static_rd_angle(converter_env(t0));
     const double th0 = b.p_r * theta_m_at(b, t0);

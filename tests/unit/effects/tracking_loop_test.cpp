@@ -6,18 +6,14 @@
 #include <numbers>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/effects/effect.h"
 #include "daemon/core/effects/tracking_loop.h"
 #include "tests/unit/effects/chain_test_support.h"
 
 namespace resolver {
 namespace {
 
-TrackingLoopConfig loop_config(double omega_n, double zeta) {
-  TrackingLoopConfig c;
-  c.omega_n = omega_n;
-  c.zeta = zeta;
-  return c;
-}
+TrackingLoopParams loop_config(double omega_n, double zeta) { return {{"omega_n", omega_n}, {"zeta", zeta}}; }
 
 /// Independent closed form of |H(j w)| and arg H(j w) for
 /// H(s) = (2 zeta wn s + wn^2) / (s^2 + 2 zeta wn s + wn^2).
@@ -30,12 +26,19 @@ std::complex<double> analytic_h(double wn, double zeta, double w) {
   return {(re_num * re_den + im_num * im_den) / den, (im_num * re_den - re_num * im_den) / den};
 }
 
+TEST(EffectsTrackingLoop, TheSimulatedLoopIsTheEffectsOneList) {
+  // The registry unit, the simulated converter and the fit read one list: no second
+  // set of names, ranges or defaults beside it to drift from it.
+  EXPECT_EQ(tracking_loop_effect().params().data(), kTrackingLoopParams.data());
+  EXPECT_FALSE(tracking_loop_active(TrackingLoopParams{}));  // neutral omega_n = 0: the ideal converter
+}
+
 TEST(EffectsTrackingLoop, SubstepsKeepOmegaNStepSmall) {
-  const TrackingLoopConfig c = loop_config(3000.0, 0.7);
+  const TrackingLoopParams c = loop_config(3000.0, 0.7);
   const int n = tracking_loop_substeps(c, 1.0 / 2000.0);
   EXPECT_GE(n, 1);
-  EXPECT_LE(c.omega_n * (1.0 / 2000.0) / n, TrackingLoopConfig::kMaxOmegaNStep);
-  EXPECT_EQ(tracking_loop_substeps(TrackingLoopConfig{}, 1.0 / 2000.0), 1);
+  EXPECT_LE(c["omega_n"] * (1.0 / 2000.0) / n, kTrackingLoopMaxOmegaNStep);
+  EXPECT_EQ(tracking_loop_substeps(TrackingLoopParams{}, 1.0 / 2000.0), 1);
 }
 
 TEST(EffectsTrackingLoop, ConstantSpeedHasZeroSteadyStateError) {
@@ -82,26 +85,26 @@ TEST(EffectsTrackingLoop, ConstantAccelerationLagsByAOverOmegaNSquared) {
 }
 
 TEST(EffectsTrackingLoop, LibraryGainAndPhaseMatchClosedForm) {
-  const TrackingLoopConfig c = loop_config(2500.0, 0.5);
+  const TrackingLoopParams c = loop_config(2500.0, 0.5);
   for (const double w : {10.0, 800.0, 2500.0, 7000.0}) {
-    const std::complex<double> h = analytic_h(c.omega_n, c.zeta, w);
+    const std::complex<double> h = analytic_h(c["omega_n"], c["zeta"], w);
     EXPECT_NEAR(tracking_loop_gain(c, w), std::abs(h), 1e-12);
     EXPECT_NEAR(tracking_loop_phase(c, w), std::arg(h), 1e-12);
   }
   // At w = wn: H = (1 + 2 zeta j)/(2 zeta j), |H| = sqrt(1 + 4 zeta^2) / (2 zeta) > 1.
-  EXPECT_NEAR(tracking_loop_gain(c, c.omega_n), std::sqrt(1.0 + 4.0 * 0.25) / 1.0, 1e-12);
+  EXPECT_NEAR(tracking_loop_gain(c, c["omega_n"]), std::sqrt(1.0 + 4.0 * 0.25) / 1.0, 1e-12);
 }
 
 /// Runs the loop on theta(t) = w0 t + a sin(2 pi f t) and returns the measured
 /// complex gain of phi's modulation at f (Fourier coefficient over whole periods).
-std::complex<double> measured_gain(const TrackingLoopConfig& c, double f, double w0, double a) {
+std::complex<double> measured_gain(const TrackingLoopParams& c, double f, double w0, double a) {
   TrackingLoop loop(c);
   loop.reset({0.0, w0});
   const double wm = kTwoPi * f;
   const auto theta = [&](double t) { return w0 * t + a * std::sin(wm * t); };
   const auto envelope = [&](double t) { return ideal_envelopes(theta(t)); };
   // Settle: 30 loop time constants, rounded up to whole modulation periods.
-  const double settle = std::ceil(30.0 / (c.zeta * c.omega_n) * f) / f;
+  const double settle = std::ceil(30.0 / (c["zeta"] * c["omega_n"]) * f) / f;
   const int per_period = 200;
   const double dt = 1.0 / (f * per_period);
   const int settle_steps = static_cast<int>(std::lround(settle / dt));
@@ -122,12 +125,12 @@ std::complex<double> measured_gain(const TrackingLoopConfig& c, double f, double
 }
 
 TEST(EffectsTrackingLoop, ClosedLoopGainMatchesAnalyticH) {
-  const TrackingLoopConfig c = loop_config(3000.0, 0.7);
-  const double fn = c.omega_n / kTwoPi;
+  const TrackingLoopParams c = loop_config(3000.0, 0.7);
+  const double fn = c["omega_n"] / kTwoPi;
   for (const double ratio : {0.1, 0.5, 1.0, 2.0, 4.0}) {
     const double f = ratio * fn;
     const std::complex<double> h_meas = measured_gain(c, f, 60.0, 1e-3);
-    const std::complex<double> h = analytic_h(c.omega_n, c.zeta, kTwoPi * f);
+    const std::complex<double> h = analytic_h(c["omega_n"], c["zeta"], kTwoPi * f);
     // Linearisation: sin(e) vs e with |e| <= a |1 - H| ~ 2e-3 -> relative error ~e^2/6 ~ 1e-6.
     // RK4 with wm h <= 0.2 per step: phase/gain error ~1e-5. Tolerance 1e-4 covers both.
     EXPECT_NEAR(std::abs(h_meas), std::abs(h), 1e-4 * std::abs(h) + 1e-6) << "f/fn=" << ratio;
@@ -142,8 +145,8 @@ TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
   const ForwardChain chain = test::forward_chain(
       {{"amplitude_imbalance", "alpha", alpha}, {"tracking_loop", "omega_n", 3000.0}, {"tracking_loop", "zeta", 0.7}});
   // The converter the registry's tracking_loop hook sets up (what the simulator integrates).
-  const TrackingLoopConfig c{chain.converter().omega_n, chain.converter().zeta};
-  ASSERT_EQ(c.omega_n, 3000.0);
+  const TrackingLoopParams c = chain.converter().loop;
+  ASSERT_EQ(c["omega_n"], 3000.0);
   for (const double w : {50.0, 1500.0, 4000.0}) {  // |H(j2w)| from ~1 down to ~0.3
     TrackingLoop loop(c);
     loop.reset({0.0, w});
@@ -151,7 +154,7 @@ TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
     const double period_2 = kPi / w;  // period of the 2theta ripple [s]
     const int per_period = 400;
     const double dt = period_2 / per_period;
-    const int settle = static_cast<int>(std::ceil(30.0 / (c.zeta * c.omega_n) / period_2)) * per_period;
+    const int settle = static_cast<int>(std::ceil(30.0 / (c["zeta"] * c["omega_n"]) / period_2)) * per_period;
     for (int k = 0; k < settle; ++k) loop.advance(envelope, k * dt, dt);
     std::complex<double> acc = 0.0;
     for (int k = 0; k < 2 * per_period; ++k) {
@@ -161,7 +164,7 @@ TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
       acc += wrap_pi(theta - loop.state().phi) * std::exp(std::complex<double>(0.0, -2.0 * theta));
     }
     const std::complex<double> measured = acc / static_cast<double>(2 * per_period) * std::complex<double>(0.0, 2.0);
-    const std::complex<double> expected = 0.5 * alpha * analytic_h(c.omega_n, c.zeta, 2.0 * w);
+    const std::complex<double> expected = 0.5 * alpha * analytic_h(c["omega_n"], c["zeta"], 2.0 * w);
     // Omitted: O(alpha^2) terms of the static error (<= ~alpha^2/4 at 2theta, see
     // the signature test) times a gain <= 1.2; integration error ~1e-5 relative.
     EXPECT_NEAR(std::abs(measured - expected), 0.0, 0.5 * 0.002 * 0.002) << "w=" << w;
@@ -171,8 +174,8 @@ TEST(EffectsTrackingLoop, ImbalanceRippleIsFilteredBySpeed) {
 TEST(EffectsTrackingLoop, IdealConverterFollowsStaticAngle) {
   const ForwardChain chain = test::forward_chain({{"amplitude_imbalance", "alpha", 0.01}});
   // The chain's converter without a tracking_loop setting: omega_n = 0, ideal.
-  ASSERT_EQ(chain.converter().omega_n, 0.0);
-  TrackingLoop loop(TrackingLoopConfig{chain.converter().omega_n, chain.converter().zeta});
+  ASSERT_EQ(chain.converter().loop["omega_n"], 0.0);
+  TrackingLoop loop(chain.converter().loop);
   const double w = 100.0;
   for (int k = 0; k < 400; ++k) {
     loop.advance([&](double t) { return chain.envelopes(w * t); }, k * 1e-3, 1e-3);

@@ -45,13 +45,13 @@ struct Sweep {
 
 /// Constant segments of `hold_s` (longer at low speed) at each speed [r/min]
 /// joined by 50 ms ramps.
-Sweep simulate_sweep(const TrackingLoopConfig& loop, const std::vector<double>& rpms, double hold_s = 0.3) {
+Sweep simulate_sweep(const TrackingLoopParams& loop, const std::vector<double>& rpms, double hold_s = 0.3) {
   Sweep sw;
   SimConfig& cfg = sw.config;
   cfg.sample_rate_hz = 20000;
   cfg.chain.set("amplitude_imbalance", "alpha", kAlpha);
-  cfg.chain.set("tracking_loop", "omega_n", loop.omega_n);
-  cfg.chain.set("tracking_loop", "zeta", loop.zeta);
+  cfg.chain.set("tracking_loop", "omega_n", loop["omega_n"]);
+  cfg.chain.set("tracking_loop", "zeta", loop["zeta"]);
   cfg.profile.clear();
   double prev = rpms.front();
   for (const double r : rpms) {
@@ -82,9 +82,9 @@ Sweep simulate_sweep(const TrackingLoopConfig& loop, const std::vector<double>& 
 double rpm_to_omega_e(double rpm, int p_r) { return p_r * rpm_to_rad_s(rpm); }
 
 /// The loop the ripple actually sees (header: gain scaled by the mean of 1 + alpha cos^2).
-TrackingLoopConfig effective_loop(const TrackingLoopConfig& loop) {
+TrackingLoopParams effective_loop(const TrackingLoopParams& loop) {
   const double g = std::sqrt(1.0 + 0.5 * kAlpha);
-  return {loop.omega_n * g, loop.zeta * g};
+  return {{"omega_n", loop["omega_n"] * g}, {"zeta", loop["zeta"] * g}};
 }
 
 const RippleObservation* find_speed(const std::vector<RippleObservation>& obs, double omega_e) {
@@ -103,7 +103,8 @@ void print_estimate(const char* what, const TrackingLoopEstimate& e) {
 }
 
 TEST(TrackingLoopResponse, MatchesTheEffectCatalogGainAndPhase) {
-  for (const TrackingLoopConfig loop : {TrackingLoopConfig{3000.0, 0.7}, TrackingLoopConfig{1500.0, 0.5}}) {
+  for (const TrackingLoopParams loop : {TrackingLoopParams{{"omega_n", 3000.0}, {"zeta", 0.7}},
+                                        TrackingLoopParams{{"omega_n", 1500.0}, {"zeta", 0.5}}}) {
     for (const double w : {0.0, 100.0, 1000.0, 1500.0, 3000.0, 10000.0}) {
       const cd h = tracking_loop_response(loop, w);
       EXPECT_NEAR(std::abs(h), tracking_loop_gain(loop, w), 1e-12);
@@ -112,14 +113,14 @@ TEST(TrackingLoopResponse, MatchesTheEffectCatalogGainAndPhase) {
       EXPECT_NEAR(std::abs(hn - std::conj(h)), 0.0, 1e-12);
     }
   }
-  EXPECT_EQ(tracking_loop_response(TrackingLoopConfig{0.0, 0.7}, 1000.0), cd(1.0, 0.0));  // ideal converter
+  EXPECT_EQ(tracking_loop_response(TrackingLoopParams{{"omega_n", 0.0}}, 1000.0), cd(1.0, 0.0));  // ideal converter
 }
 
 // The physics behind the fit, checked before trusting it: the measured 2x ripple
 // at each constant speed is C_static H(j 2 omega_e) of the (effective) closed loop,
 // to second order (alpha |C_static| = 5e-5 rad) — not 1 - H, not H(j omega_e).
 TEST(TrackingLoopFit, SimulatedRippleIsTheStaticRippleFilteredByTheClosedLoop) {
-  const TrackingLoopConfig loop{3000.0, 0.7};
+  const TrackingLoopParams loop{{"omega_n", 3000.0}, {"zeta", 0.7}};
   const Sweep sw = simulate_sweep(loop, {100, 500, 1000, 1500, 2000, 3000, 4000, 5000, 6000, 8000});
   const auto obs = ripple_observations(sw.t, sw.ref, sw.rd);
   ASSERT_EQ(obs.size(), 10U);
@@ -132,10 +133,10 @@ TEST(TrackingLoopFit, SimulatedRippleIsTheStaticRippleFilteredByTheClosedLoop) {
     worst = std::max(worst, dev);
     std::printf("  omega_e %7.1f rad/s (2w/wn %.2f): |C| %.4e arg %+7.2f deg; C/C_static %.4f%+.4fj, H %.4f%+.4fj, "
                 "dev %.1e (se %.1e)\n",
-                o.omega_e, 2.0 * o.omega_e / loop.omega_n, std::abs(o.measured), rad_to_deg(std::arg(o.measured)),
+                o.omega_e, 2.0 * o.omega_e / loop["omega_n"], std::abs(o.measured), rad_to_deg(std::arg(o.measured)),
                 ratio.real(), ratio.imag(), h.real(), h.imag(), dev, o.std_error);
     EXPECT_LT(dev, kAlpha * std::abs(cs)) << "omega_e " << o.omega_e;
-    if (2.0 * o.omega_e > 0.5 * loop.omega_n) {  // where the loop shows, the alternatives are far off
+    if (2.0 * o.omega_e > 0.5 * loop["omega_n"]) {  // where the loop shows, the alternatives are far off
       EXPECT_GT(std::abs(o.measured - cs * (1.0 - h)), 20.0 * kAlpha * std::abs(cs));
       EXPECT_GT(std::abs(o.measured - cs * tracking_loop_response(loop, o.omega_e)), 2.0 * kAlpha * std::abs(cs));
     }
@@ -145,7 +146,7 @@ TEST(TrackingLoopFit, SimulatedRippleIsTheStaticRippleFilteredByTheClosedLoop) {
 
 TEST(TrackingLoopFit, BinsAreTheConstantSegmentsOnly) {
   const std::vector<double> rpms{500, 1500, 3000, 5000};
-  const Sweep sw = simulate_sweep({3000.0, 0.7}, rpms);
+  const Sweep sw = simulate_sweep({{"omega_n", 3000.0}, {"zeta", 0.7}}, rpms);
   const auto obs = ripple_observations(sw.t, sw.ref, sw.rd);
   ASSERT_EQ(obs.size(), rpms.size());
   for (std::size_t k = 0; k < rpms.size(); ++k) {
@@ -161,7 +162,7 @@ TEST(TrackingLoopFit, BinsAreTheConstantSegmentsOnly) {
 }
 
 struct LoopCase {
-  TrackingLoopConfig loop;
+  TrackingLoopParams loop;
   std::vector<double> fit_rpm;
   double held_out_rpm;
 };
@@ -184,17 +185,17 @@ TEST_P(SweepFit, RecoversTheLoopAndPredictsAHeldOutSpeed) {
     if (std::abs(o.omega_e - held_w) > 1e-3 * held_w) fit_obs.push_back(o);
   }
   ASSERT_EQ(fit_obs.size(), lc.fit_rpm.size());
-  const TrackingLoopConfig eff = effective_loop(lc.loop);
+  const TrackingLoopParams eff = effective_loop(lc.loop);
   std::printf("  nominal omega_n %.1f zeta %.3f; effective %.2f %.5f; C_static from sin/cos LS %.6e +- %.1e\n",
-              lc.loop.omega_n, lc.loop.zeta, eff.omega_n, eff.zeta, sw.static_value.real(), sw.static_std);
+              lc.loop["omega_n"], lc.loop["zeta"], eff["omega_n"], eff["zeta"], sw.static_value.real(), sw.static_std);
 
   const auto check = [&](const char* what, const TrackingLoopEstimate& e) {
     print_estimate(what, e);
     ASSERT_TRUE(e.ok) << e.message;
-    EXPECT_LT(std::abs(e.omega_n - eff.omega_n), 4.0 * e.omega_n_stderr);
-    EXPECT_LT(std::abs(e.zeta - eff.zeta), 4.0 * e.zeta_stderr);
-    EXPECT_LT(std::abs(e.omega_n - lc.loop.omega_n), 0.1 * lc.loop.omega_n);
-    EXPECT_LT(std::abs(e.zeta - lc.loop.zeta), 0.1 * lc.loop.zeta);
+    EXPECT_LT(std::abs(e.omega_n - eff["omega_n"]), 4.0 * e.omega_n_stderr);
+    EXPECT_LT(std::abs(e.zeta - eff["zeta"]), 4.0 * e.zeta_stderr);
+    EXPECT_LT(std::abs(e.omega_n - lc.loop["omega_n"]), 0.1 * lc.loop["omega_n"]);
+    EXPECT_LT(std::abs(e.zeta - lc.loop["zeta"]), 0.1 * lc.loop["zeta"]);
     EXPECT_LT(e.omega_n_stderr, 0.01 * e.omega_n);  // the sweep does pin the loop down
     EXPECT_LT(e.zeta_stderr, 0.02 * e.zeta);
     // Held-out speed: measured vs predicted per component, within 4 sigma of the
@@ -229,15 +230,19 @@ TEST_P(SweepFit, RecoversTheLoopAndPredictsAHeldOutSpeed) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Loops, SweepFit,
-                         ::testing::Values(LoopCase{{3000.0, 0.7}, {500, 1000, 1500, 3000, 4000, 5000, 6000}, 2000},
-                                           LoopCase{{1500.0, 0.5}, {250, 500, 1000, 1500, 3000, 5000}, 2000}),
+                         ::testing::Values(LoopCase{{{"omega_n", 3000.0}, {"zeta", 0.7}},
+                                                    {500, 1000, 1500, 3000, 4000, 5000, 6000},
+                                                    2000},
+                                           LoopCase{{{"omega_n", 1500.0}, {"zeta", 0.5}},
+                                                    {250, 500, 1000, 1500, 3000, 5000},
+                                                    2000}),
                          [](const ::testing::TestParamInfo<LoopCase>& p) {
-                           return "omega_n_" + std::to_string(static_cast<int>(p.param.loop.omega_n));
+                           return "omega_n_" + std::to_string(static_cast<int>(p.param.loop["omega_n"]));
                          });
 
 // Negative speed: the ripple sees conj(H) and the fit gives the same loop.
 TEST(TrackingLoopFit, NegativeSpeedsGiveTheSameLoop) {
-  const TrackingLoopConfig loop{3000.0, 0.7};
+  const TrackingLoopParams loop{{"omega_n", 3000.0}, {"zeta", 0.7}};
   const Sweep sw = simulate_sweep(loop, {-500, -1000, -1500, -3000, -4000, -5000, -6000});
   const auto obs = ripple_observations(sw.t, sw.ref, sw.rd);
   ASSERT_EQ(obs.size(), 7U);
@@ -250,8 +255,8 @@ TEST(TrackingLoopFit, NegativeSpeedsGiveTheSameLoop) {
   print_estimate("negative speeds", e);
   EXPECT_GT(e.residual, 1.0);
   ASSERT_TRUE(e.ok) << e.message;
-  EXPECT_LT(std::abs(e.omega_n - effective_loop(loop).omega_n), 4.0 * e.omega_n_stderr);
-  EXPECT_LT(std::abs(e.zeta - effective_loop(loop).zeta), 4.0 * e.zeta_stderr);
+  EXPECT_LT(std::abs(e.omega_n - effective_loop(loop)["omega_n"]), 4.0 * e.omega_n_stderr);
+  EXPECT_LT(std::abs(e.zeta - effective_loop(loop)["zeta"]), 4.0 * e.zeta_stderr);
 }
 
 // The coarse sweep, four speeds (500, 1500, 3000, ~5000 r/min). 4950 rather
@@ -261,20 +266,21 @@ TEST(TrackingLoopFit, NegativeSpeedsGiveTheSameLoop) {
 // worst point printed by the test above); with only four speeds that alone pulls
 // zeta by 6 std errors (measured: 0.7067 vs 0.7018). Off-synchronous, chi^2/dof ~10.
 TEST(TrackingLoopFit, CoarseFourSpeedSweepRecoversTheLoop) {
-  for (const TrackingLoopConfig loop : {TrackingLoopConfig{3000.0, 0.7}, TrackingLoopConfig{1500.0, 0.5}}) {
+  for (const TrackingLoopParams loop : {TrackingLoopParams{{"omega_n", 3000.0}, {"zeta", 0.7}},
+                                        TrackingLoopParams{{"omega_n", 1500.0}, {"zeta", 0.5}}}) {
     const Sweep sw = simulate_sweep(loop, {500, 1500, 3000, 4950});
     const auto obs = ripple_observations(sw.t, sw.ref, sw.rd);
     ASSERT_EQ(obs.size(), 4U);
     const auto e = fit_tracking_loop(StaticRipple{sw.static_value, sw.static_std}, obs);
-    print_estimate(loop.omega_n > 2000.0 ? "4 speeds, 3000/0.7" : "4 speeds, 1500/0.5", e);
-    const TrackingLoopConfig eff = effective_loop(loop);
+    print_estimate(loop["omega_n"] > 2000.0 ? "4 speeds, 3000/0.7" : "4 speeds, 1500/0.5", e);
+    const TrackingLoopParams eff = effective_loop(loop);
     std::printf("    error vs effective: omega_n %.2f sigma, zeta %.2f sigma\n",
-                (e.omega_n - eff.omega_n) / e.omega_n_stderr, (e.zeta - eff.zeta) / e.zeta_stderr);
+                (e.omega_n - eff["omega_n"]) / e.omega_n_stderr, (e.zeta - eff["zeta"]) / e.zeta_stderr);
     ASSERT_TRUE(e.ok) << e.message;
-    EXPECT_LT(std::abs(e.omega_n - loop.omega_n), 0.1 * loop.omega_n);
-    EXPECT_LT(std::abs(e.zeta - loop.zeta), 0.1 * loop.zeta);
-    EXPECT_LT(std::abs(e.omega_n - eff.omega_n), 4.0 * e.omega_n_stderr);
-    EXPECT_LT(std::abs(e.zeta - eff.zeta), 4.0 * e.zeta_stderr);
+    EXPECT_LT(std::abs(e.omega_n - loop["omega_n"]), 0.1 * loop["omega_n"]);
+    EXPECT_LT(std::abs(e.zeta - loop["zeta"]), 0.1 * loop["zeta"]);
+    EXPECT_LT(std::abs(e.omega_n - eff["omega_n"]), 4.0 * e.omega_n_stderr);
+    EXPECT_LT(std::abs(e.zeta - eff["zeta"]), 4.0 * e.zeta_stderr);
   }
 }
 
@@ -282,7 +288,7 @@ TEST(TrackingLoopFit, CoarseFourSpeedSweepRecoversTheLoop) {
 // pulls (error / reported std error) over many noise draws have mean ~0 and rms ~1
 // (slightly below 1: the Birge factor only ever inflates).
 TEST(TrackingLoopFit, ReportedStdErrorsMatchTheScatterOnSyntheticData) {
-  const TrackingLoopConfig truth{2000.0, 0.6};
+  const TrackingLoopParams truth{{"omega_n", 2000.0}, {"zeta", 0.6}};
   const cd cs(3e-3, -1e-3);
   const std::vector<double> speeds{100, 300, 500, 700, 900, 1200, 1600, 2000};  // omega_e [rad/s]
   constexpr double kSigma = 2e-5;
@@ -301,8 +307,8 @@ TEST(TrackingLoopFit, ReportedStdErrorsMatchTheScatterOnSyntheticData) {
     }
     const auto e = fit_tracking_loop(cs, obs);
     ASSERT_TRUE(e.ok) << e.message;
-    const double pn = (e.omega_n - truth.omega_n) / e.omega_n_stderr;
-    const double pz = (e.zeta - truth.zeta) / e.zeta_stderr;
+    const double pn = (e.omega_n - truth["omega_n"]) / e.omega_n_stderr;
+    const double pz = (e.zeta - truth["zeta"]) / e.zeta_stderr;
     ASSERT_LT(std::abs(pn), 5.0);
     ASSERT_LT(std::abs(pz), 5.0);
     sum_n += pn, sum2_n += pn * pn, sum_z += pz, sum2_z += pz * pz;
@@ -320,24 +326,24 @@ TEST(TrackingLoopFit, ReportedStdErrorsMatchTheScatterOnSyntheticData) {
 }
 
 TEST(TrackingLoopFit, NoiseFreeObservationsAreFittedExactly) {
-  const TrackingLoopConfig truth{1234.0, 0.37};
+  const TrackingLoopParams truth{{"omega_n", 1234.0}, {"zeta", 0.37}};
   const cd cs(-2e-3, 4e-3);
   std::vector<RippleObservation> obs;
   for (const double w : {50.0, 400.0, 600.0, 900.0}) obs.push_back({w, cs * tracking_loop_response(truth, 2.0 * w), 1e-6});
   const auto e = fit_tracking_loop(cs, obs);
   ASSERT_TRUE(e.ok) << e.message;
-  EXPECT_NEAR(e.omega_n, truth.omega_n, 1e-6 * truth.omega_n);
-  EXPECT_NEAR(e.zeta, truth.zeta, 1e-6 * truth.zeta);
+  EXPECT_NEAR(e.omega_n, truth["omega_n"], 1e-6 * truth["omega_n"]);
+  EXPECT_NEAR(e.zeta, truth["zeta"], 1e-6 * truth["zeta"]);
   EXPECT_LT(e.residual, 1e-12);
   // Free static coefficient, pinned by the lowest speed.
   const auto f = fit_tracking_loop(StaticRipple{obs.front().measured, std::numeric_limits<double>::infinity()}, obs);
   ASSERT_TRUE(f.ok) << f.message;
-  EXPECT_NEAR(f.omega_n, truth.omega_n, 1e-6 * truth.omega_n);
+  EXPECT_NEAR(f.omega_n, truth["omega_n"], 1e-6 * truth["omega_n"]);
   EXPECT_NEAR(std::abs(f.static_coefficient - cs), 0.0, 1e-9);
 }
 
 TEST(TrackingLoopFit, FailsHonestlyOnBadOrUninformativeData) {
-  const TrackingLoopConfig truth{3000.0, 0.7};
+  const TrackingLoopParams truth{{"omega_n", 3000.0}, {"zeta", 0.7}};
   const cd cs(5e-3, 0.0);
   const auto obs_at = [&](std::vector<double> ws, double sigma) {
     std::vector<RippleObservation> obs;
