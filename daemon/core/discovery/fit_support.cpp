@@ -87,17 +87,19 @@ void check_model_against_log(const ModelSpec& spec, const PreparedLog& log) {
 
 /// Cross-validated rms of group g: fitted on one fold, evaluated on the other.
 double held_back_rms(const PassStatistics& stats, const GroupFloors& floors, std::span<const int> cols, Group g) {
+  std::vector<NormalEquations> only_b(kGroups);
+  for (int k = 0; k < kGroups; ++k) only_b[static_cast<std::size_t>(k)] = stats.fold_b(static_cast<Group>(k));
+  return held_back_rms(stats.fold_a, only_b, floors, cols, g);
+}
+
+double held_back_rms(const std::vector<NormalEquations>& fold_a, const std::vector<NormalEquations>& fold_b,
+                     const GroupFloors& floors, std::span<const int> cols, Group g) {
   const auto i = static_cast<std::size_t>(g);
-  const NormalEquations b = stats.fold_b(g);
-  const NormalEquations& a = stats.fold_a[i];
+  const NormalEquations& a = fold_a[i];
+  const NormalEquations& b = fold_b[i];
   if (a.n() == 0 || b.n() == 0) return std::numeric_limits<double>::quiet_NaN();
-  std::vector<NormalEquations> only_a(kGroups), only_b(kGroups);
-  for (int k = 0; k < kGroups; ++k) {
-    only_a[static_cast<std::size_t>(k)] = stats.fold_a[static_cast<std::size_t>(k)];
-    only_b[static_cast<std::size_t>(k)] = stats.fold_b(static_cast<Group>(k));
-  }
-  const StepSolution fa = solve_step(only_a, floors, cols);
-  const StepSolution fb = solve_step(only_b, floors, cols);
+  const StepSolution fa = solve_step(fold_a, floors, cols);
+  const StepSolution fb = solve_step(fold_b, floors, cols);
   if (!fa.ok || !fb.ok) return std::numeric_limits<double>::quiet_NaN();
   return rms(b.rss(fa.dz) + a.rss(fb.dz), a.n() + b.n());
 }

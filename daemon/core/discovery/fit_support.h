@@ -47,6 +47,10 @@ void check_model_against_log(const ModelSpec& spec, const PreparedLog& log);
 /// other (NaN without two folds).
 [[nodiscard]] double held_back_rms(const PassStatistics& stats, const GroupFloors& floors, std::span<const int> cols,
                                    Group g);
+/// The same from each fold's statistics by group (a merge's, whose folds are reduced apart).
+[[nodiscard]] double held_back_rms(const std::vector<NormalEquations>& fold_a,
+                                   const std::vector<NormalEquations>& fold_b, const GroupFloors& floors,
+                                   std::span<const int> cols, Group g);
 
 /// "%.3g" formatting for messages.
 [[nodiscard]] std::string num(double v, const char* format = "%.3g");

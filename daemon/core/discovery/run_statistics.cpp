@@ -50,8 +50,8 @@ std::size_t reference_run(const std::vector<RunStatistics>& runs, const std::vec
   return best;
 }
 
-/// The merged design: `spec` at the reference run's values, each run one part with
-/// its frame shift, then every candidate column all runs have.
+/// The merged design: `spec` at the reference run's values, then every candidate
+/// column all runs have.
 Design merged_design(const ModelSpec& spec, const std::vector<RunStatistics>& runs, std::size_t ref,
                      const DiscoveryOptions& options) {
   const ModelSpec ref_spec = ModelSpec::parse(runs[ref].effects, options.customs);
@@ -62,15 +62,9 @@ Design merged_design(const ModelSpec& spec, const std::vector<RunStatistics>& ru
     values.push_back(it == ref_spec.terms.end() ? std::vector<double>{}
                                                 : runs[ref].values[static_cast<std::size_t>(it - ref_spec.terms.begin())]);
   }
-  PreparedLog layout;
-  layout.rd = runs[ref].rd;
-  layout.sincos = runs[ref].sincos;
-  layout.currents = runs[ref].currents;
-  layout.reference = runs[ref].reference;
-  layout.reference_aligned = runs[ref].reference_aligned;
-  Design d(spec, values, nuisances_for(layout));
-  d.set_parts(static_cast<int>(runs.size()));
-  for (std::size_t r = 0; r < runs.size(); ++r) d.set_frame_shift(static_cast<int>(r), runs[r].frame_shift);
+  // No nuisance columns: every run's own constants are profiled out of its statistics
+  // (reduce_run), so the merged problem has the shared columns only, whatever the runs.
+  Design d(spec, values, {});
   // Candidates: the columns every run has that the model does not, grouped by effect.
   const std::vector<std::string> have = d.column_names();
   std::map<const Effect*, std::vector<int>> extra;
@@ -95,78 +89,145 @@ Design merged_design(const ModelSpec& spec, const std::vector<RunStatistics>& ru
   return d;
 }
 
-/// Adds run `r` (part `part` of `d`) to `into`, moved from its point to the design's:
-/// b + M d and yy + 2 d'b + d'M d (header). Columns the design lacks are held at
-/// their neutral value.
-void add_run(const RunStatistics& run, int part, const Design& d, const Eigen::VectorXd& z0, PassStatistics& into) {
+/// Where a run's columns go in the merged design and how far each is moved: its own
+/// constants (the first columns) are profiled out, the design's columns kept, the rest
+/// held at their neutral value.
+struct RunColumns {
+  std::vector<int> to;    ///< run column -> design column, -1: a constant or held
+  Eigen::VectorXd shift;  ///< z_r - target (0 for the constants)
+};
+
+RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::VectorXd& z0) {
   const std::vector<std::string> names = d.column_names();
-  const auto k = static_cast<Eigen::Index>(run.columns.size());
-  std::vector<int> to(static_cast<std::size_t>(k), -1);
-  Eigen::VectorXd shift = run.point;  // z_r - target: the target is 0 unless the design has the column
-  for (Eigen::Index c = 0; c < k; ++c) {
-    if (c < run.nuisance_columns) {
-      to[static_cast<std::size_t>(c)] = d.nuisance_column(part, static_cast<std::size_t>(c));
-      shift[c] = 0.0;
+  RunColumns rc{std::vector<int>(run.columns.size(), -1), run.point};
+  for (std::size_t c = 0; c < run.columns.size(); ++c) {
+    const auto i = static_cast<Eigen::Index>(c);
+    if (static_cast<int>(c) < run.nuisance_columns) {
+      rc.shift[i] = 0.0;
       continue;
     }
-    const int at = index_of(names, run.columns[static_cast<std::size_t>(c)]);
-    if (at < d.nuisance_columns()) continue;  // not in the design: held at neutral
-    to[static_cast<std::size_t>(c)] = at;
-    shift[c] = run.point[c] - z0[at];
+    const int at = index_of(names, run.columns[c]);
+    if (at < 0) continue;  // held at neutral: shifted there, then left out
+    rc.to[c] = at;
+    rc.shift[i] = run.point[i] - z0[at];
   }
-  const auto add = [&](const NormalEquations& from, NormalEquations& out) {
-    const Eigen::VectorXd b = from.b() + from.m() * shift;
-    const double yy = from.yy() + 2.0 * shift.dot(from.b()) + shift.dot(from.m() * shift);
-    Eigen::MatrixXd m = out.m();
-    Eigen::VectorXd bo = out.b();
-    for (Eigen::Index i = 0; i < k; ++i) {
-      const int ti = to[static_cast<std::size_t>(i)];
-      if (ti < 0) continue;
-      bo[ti] += b[i];
-      for (Eigen::Index j = 0; j < k; ++j) {
-        const int tj = to[static_cast<std::size_t>(j)];
-        if (tj >= 0) m(ti, tj) += from.m()(i, j);
-      }
-    }
-    out.set(std::move(m), std::move(bo), out.yy() + std::max(0.0, yy), out.n() + from.n());
-  };
-  for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
-    add(run.stats.all[g], into.all[g]);
-    add(run.stats.fold_a[g], into.fold_a[g]);
-  }
+  return rc;
 }
 
-/// Each run's nuisance constants at the solution, named "...[run]".
-std::vector<ModelParameter> nuisances_of(const Design& d, const StepSolution& s, const std::vector<std::string>& names) {
-  std::vector<ModelParameter> out;
-  for (int part = 0; part < d.parts(); ++part) {
-    for (std::size_t j = 0; j < d.nuisances().size(); ++j) {
-      double v = s.dz[d.nuisance_column(part, j)];
-      const Nuisance n = d.nuisances()[j];
-      if (n == Nuisance::kRdConstant || n == Nuisance::kSaConstant) v -= d.frame_shift(part);
-      out.push_back({std::string(nuisance_name(n)) + "[" + names[static_cast<std::size_t>(part)] + "]", v, kNaN, ""});
+/// The run's constants of one group: those its rows carry (a constant of another
+/// group's signal has an empty column here).
+std::vector<Eigen::Index> constants_in(const NormalEquations& ne, int nuisance_columns) {
+  std::vector<Eigen::Index> out;
+  for (Eigen::Index j = 0; j < nuisance_columns; ++j) {
+    if (ne.m()(j, j) > 0.0) out.push_back(j);
+  }
+  return out;
+}
+
+/// One group's statistics of a run moved to the design's point (b + M d, yy + 2 d'b +
+/// d'M d: header) and with the run's constants profiled out (the Schur complement
+/// M_ss - M_sn M_nn^-1 M_ns): over the design's columns. Exact: a constant enters one
+/// group's signal only, so profiling group by group is profiling the weighted sum.
+NormalEquations reduce_run(const NormalEquations& ne, const RunColumns& rc, int nuisance_columns, int k_design) {
+  const Eigen::VectorXd b = ne.b() + ne.m() * rc.shift;
+  double yy = ne.yy() + 2.0 * rc.shift.dot(ne.b()) + rc.shift.dot(ne.m() * rc.shift);
+  std::vector<Eigen::Index> kept;
+  for (std::size_t c = 0; c < rc.to.size(); ++c) {
+    if (rc.to[c] >= 0) kept.push_back(static_cast<Eigen::Index>(c));
+  }
+  const std::vector<Eigen::Index> own = constants_in(ne, nuisance_columns);
+  Eigen::MatrixXd m = ne.m()(kept, kept);
+  Eigen::VectorXd bk = b(kept);
+  if (!own.empty()) {
+    const Eigen::LDLT<Eigen::MatrixXd> nn(ne.m()(own, own));
+    const Eigen::MatrixXd ns = ne.m()(own, kept);
+    const Eigen::VectorXd bn = b(own);
+    m -= ns.transpose() * nn.solve(ns);
+    bk -= ns.transpose() * nn.solve(bn);
+    yy -= bn.dot(nn.solve(bn));
+  }
+  Eigen::MatrixXd mo = Eigen::MatrixXd::Zero(k_design, k_design);
+  Eigen::VectorXd bo = Eigen::VectorXd::Zero(k_design);
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const int ti = rc.to[static_cast<std::size_t>(kept[i])];
+    bo[ti] = bk[static_cast<Eigen::Index>(i)];
+    for (std::size_t j = 0; j < kept.size(); ++j) {
+      mo(ti, rc.to[static_cast<std::size_t>(kept[j])]) = m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
+    }
+  }
+  NormalEquations out;
+  out.set(std::move(mo), std::move(bo), std::max(0.0, yy), ne.n());
+  return out;
+}
+
+/// Every run reduced to the design's columns and added: all rows, and each fold apart
+/// (a fold's constants are its own: profiling is not linear in the rows).
+struct MergedStatistics {
+  std::vector<NormalEquations> all, fold_a, fold_b;  ///< by Group
+};
+
+MergedStatistics assemble(const Design& d, const std::vector<RunStatistics>& runs) {
+  const Eigen::VectorXd z0 = d.z();
+  MergedStatistics out;
+  for (int g = 0; g < kGroups; ++g) {
+    out.all.emplace_back(d.columns());
+    out.fold_a.emplace_back(d.columns());
+    out.fold_b.emplace_back(d.columns());
+  }
+  for (const RunStatistics& run : runs) {
+    const RunColumns rc = run_columns(run, d, z0);
+    for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
+      const NormalEquations fold_b = run.stats.fold_b(static_cast<Group>(g));
+      out.all[g].merge(reduce_run(run.stats.all[g], rc, run.nuisance_columns, d.columns()));
+      out.fold_a[g].merge(reduce_run(run.stats.fold_a[g], rc, run.nuisance_columns, d.columns()));
+      out.fold_b[g].merge(reduce_run(fold_b, rc, run.nuisance_columns, d.columns()));
     }
   }
   return out;
 }
 
-/// Every run moved to the point of `d` and added (add_run).
-PassStatistics assemble(const Design& d, const std::vector<RunStatistics>& runs) {
+/// Each run's constants at the solution `s` (profiled: M_nn^-1 (b_n - M_ns ds) of the
+/// group that carries each), named "...[run]"; the position errors' constants in the
+/// log's frame (the frame shift taken off, as nuisance_at_solution).
+std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s, const std::vector<RunStatistics>& runs,
+                                         const std::vector<std::string>& names) {
   const Eigen::VectorXd z0 = d.z();
-  PassStatistics stats(d.columns());
-  for (std::size_t r = 0; r < runs.size(); ++r) add_run(runs[r], static_cast<int>(r), d, z0, stats);
-  return stats;
+  std::vector<ModelParameter> out;
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const RunStatistics& run = runs[r];
+    const RunColumns rc = run_columns(run, d, z0);
+    Eigen::VectorXd ds = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(run.columns.size()));
+    for (std::size_t c = 0; c < rc.to.size(); ++c) {
+      if (rc.to[c] >= 0) ds[static_cast<Eigen::Index>(c)] = s.dz[rc.to[c]];
+    }
+    Eigen::VectorXd value = Eigen::VectorXd::Constant(run.nuisance_columns, kNaN);
+    for (const NormalEquations& ne : run.stats.all) {
+      const std::vector<Eigen::Index> own = constants_in(ne, run.nuisance_columns);
+      if (own.empty()) continue;
+      // b of the moved statistics minus what the shared step explains, over the constants.
+      const Eigen::VectorXd b = ne.b() + ne.m() * rc.shift - ne.m() * ds;
+      const Eigen::VectorXd dn = ne.m()(own, own).ldlt().solve(Eigen::VectorXd(b(own)));
+      for (std::size_t i = 0; i < own.size(); ++i) value[own[i]] = dn[static_cast<Eigen::Index>(i)];
+    }
+    for (int j = 0; j < run.nuisance_columns; ++j) {
+      const std::string& column = run.columns[static_cast<std::size_t>(j)];
+      double v = value[j];
+      if (column == nuisance_name(Nuisance::kRdConstant) || column == nuisance_name(Nuisance::kSaConstant)) {
+        v -= run.frame_shift;
+      }
+      out.push_back({column + "[" + names[r] + "]", v, kNaN, ""});
+    }
+  }
+  return out;
 }
 
 /// The residual with only each run's constants fitted ("before": every model column
 /// moved to its neutral value, linearised).
-StepSolution raw_solution(const Design& d, const std::vector<RunStatistics>& runs, const GroupFloors& floors) {
-  Design none(ModelSpec{}, {}, d.nuisances());
-  none.set_parts(d.parts());
-  return solve_step(assemble(none, runs).all, floors);
+StepSolution raw_solution(const std::vector<RunStatistics>& runs, const GroupFloors& floors) {
+  return solve_step(assemble(Design(ModelSpec{}, {}, {}), runs).all, floors);
 }
 
-std::vector<SignalResidual> merged_signals(const PassStatistics& stats, const StepSolution& s, const StepSolution& raw,
+std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const StepSolution& s, const StepSolution& raw,
                                            const GroupFloors& floors, const std::vector<int>& cols) {
   const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
   std::vector<SignalResidual> out;
@@ -178,7 +239,7 @@ std::vector<SignalResidual> merged_signals(const PassStatistics& stats, const St
     r.rms = rms(s.rss[g], s.n[g]);
     r.floor = f;
     r.raw_rms = raw.ok ? rms(raw.rss[g], raw.n[g]) : kNaN;
-    r.held_back_rms = held_back_rms(stats, floors, cols, static_cast<Group>(g));
+    r.held_back_rms = held_back_rms(stats.fold_a, stats.fold_b, floors, cols, static_cast<Group>(g));
     r.rms_with_outliers = r.rms;  // outliers stay out of the statistics
     r.rows = s.n[g];
     out.push_back(r);
@@ -189,7 +250,7 @@ std::vector<SignalResidual> merged_signals(const PassStatistics& stats, const St
 /// Every candidate term of `d` (after the model's) scored against `base`.
 /// What the runs' motion together lacks for candidates (motion_missing): every run's
 /// speeds and reversals.
-void rank_merged(const Design& d, const PassStatistics& stats, const StepSolution& base, const GroupFloors& floors,
+void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolution& base, const GroupFloors& floors,
                  const std::vector<RunStatistics>& runs, const DiscoveryOptions& options, MergedFit& out) {
   MotionSummary motion;
   for (std::size_t r = 0; r < runs.size(); ++r) add_motion(motion, runs[r].motion, r == 0);
@@ -305,7 +366,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   const Design d = merged_design(spec, runs, ref, options);
   const std::vector<std::string> columns = d.column_names();
   for (std::size_t r = 0; r < runs.size(); ++r) {
-    for (int c = d.nuisance_columns(); c < d.columns(); ++c) {
+    for (int c = 0; c < d.columns(); ++c) {
       if (index_of(runs[r].columns, columns[static_cast<std::size_t>(c)]) >= 0) continue;
       throw std::invalid_argument(fmt::format("{} has no column {} (its model: {}; its candidates are the catalog "
                                               "effects its signals allow): make its statistics with --effects {}",
@@ -323,7 +384,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   out.floors = pool_floor_reports(floors, rows);
   const GroupFloors gf = out.floors.floors();
   const Eigen::VectorXd z0 = d.z();
-  const PassStatistics stats = assemble(d, runs);
+  const MergedStatistics stats = assemble(d, runs);
   const std::vector<int> cols = model_columns(d);
   const StepSolution s = solve_step(stats.all, gf, cols);
   if (!s.ok) {
@@ -334,8 +395,8 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     if (d.terms()[i].candidate) continue;
     for (ModelParameter& p : term_params(d, i, s, true)) out.params.push_back(std::move(p));
   }
-  out.nuisance = nuisances_of(d, s, names);
-  out.signals = merged_signals(stats, s, raw_solution(d, runs, gf), gf, cols);
+  out.nuisance = constants_at(d, s, runs, names);
+  out.signals = merged_signals(stats, s, raw_solution(runs, gf), gf, cols);
   out.explained = !out.signals.empty();
   for (const SignalResidual& r : out.signals) {
     if (r.rms > options.explained_ratio * r.floor) out.explained = false;
