@@ -62,6 +62,7 @@ void write_stats_file(const StatsFile& file, const std::string& out) {
 int run_merge(const std::vector<std::string>& paths, std::span<const std::string> effects, bool json,
               const DiscoveryOptions& options) {
   std::vector<StatsFile> files;
+  files.reserve(paths.size());
   for (const std::string& p : paths) files.push_back(read_stats_file(p));
   check_same_layout(files, paths);
   return print_merge(files, paths, effects, json, options);

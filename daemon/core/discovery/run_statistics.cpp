@@ -418,8 +418,8 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     out.comparisons = compare_with_pool(merged, alone, names);
     for (std::string& n : disagreement_notes(out.comparisons)) out.notes.push_back(std::move(n));
   }
-  out.notes.push_back("standard errors are formal (the merged residual variance): statistics keep no "
-                      "revolution-to-revolution spread");
+  out.notes.emplace_back("standard errors are formal (the merged residual variance): statistics keep no "
+                         "revolution-to-revolution spread");
   if (d.nonlinear()) {
     if (std::string n = nonlinear_note(d, runs, s, z0); !n.empty()) out.notes.push_back(std::move(n));
   }
