@@ -9,7 +9,8 @@ namespace {
 
 constexpr const char* kOutOfMemory =
     "out of memory: the input needs more memory than this process may use (ulimit -v, cgroup limit, the "
-    "machine's RAM); give it more, or a shorter input (--from/--to where the program has them)";
+    "machine's RAM); give it more, or a shorter input (--from/--to where the program has them; resolver-model "
+    "fit, explain and stats --chunk 30 read a log of any length in bounded memory)";
 
 /// The exit code of `error` and, unless it is out of memory, its message.
 int classify(const std::exception_ptr& error, std::string* message) {

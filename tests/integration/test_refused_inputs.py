@@ -279,6 +279,14 @@ class OutOfMemory(unittest.TestCase):
         self.assertRegex(p.stderr, r"^resolver-model: out of memory: ")
         self.assertNotIn("std::bad_alloc", p.stderr)
         self.assertEqual(p.stderr.count("\n"), 1, "one line: " + p.stderr)
+        self.assertIn("--chunk", p.stderr, "the message names the way to read a long log")
+        # The way out it names: 16 MiB more than the 1 s log needs does not hold the 60 s log
+        # (~40 MiB more), but read in 1 s chunks it is fitted (two chunks and the statistics).
+        roomy = f"--as={(mib + 16) << 20}"
+        self.assertEqual(run([prlimit, roomy, model, "fit", big]).returncode, 4, "control: whole, it does not fit")
+        p = run([prlimit, roomy, model, "fit", big, "--chunk", "1"])
+        self.assertEqual(p.returncode, 0, f"{roomy}: fit --chunk 1: {p.stderr}")
+        self.assertIn("merged 60 runs", p.stdout)
 
 
 class NotAFile(unittest.TestCase):

@@ -188,6 +188,25 @@ def main():
                 for n, v in merged_chunks["params"].items()),
             "explain --chunk 2 = stats --chunk 2 then merge, in one command")
 
+    # Real recordings (tests/data/corpus): the chunked verdict is the whole log's, and a
+    # chunk too short for the motion a fit needs is refused with the reason, never fitted.
+    repo = Path(__file__).resolve().parents[2]
+    servo = [repo / "tests/data/corpus/servoproject/optical_encoder_ab.txt", "--config",
+             repo / "tools/examples/servoproject_ab.toml"]
+    whole_servo = json.loads(run([model, "explain", *servo, "--json"]).stdout)
+    r = run([model, "explain", *servo, "--chunk", 5, "--json"])
+    chunked_servo = json.loads(r.stdout) if r.returncode == 0 else {"verdict": "?", "params": {}}
+    a_whole = whole_servo["params"]["amplitude_imbalance.alpha"]["value"]
+    a_chunk = chunked_servo["params"].get("amplitude_imbalance.alpha", {"value": float("nan")})["value"]
+    c.check(chunked_servo["verdict"] == whole_servo["verdict"] == "unexplained" and abs(a_chunk - a_whole) < 0.01 * abs(a_whole),
+            f"optical encoder recording in 5 s chunks: {chunked_servo['verdict']} as whole, alpha {a_chunk:.4g} against "
+            f"{a_whole:.4g}")
+    moteus = [repo / "tests/data/corpus/moteus/encoder_calibration_sweep.csv", "--config",
+              repo / "tools/examples/moteus_sweep.toml"]
+    r = run([model, "explain", *moteus, "--chunk", 5])
+    c.check(r.returncode == 1 and "no chunk of the log could be fitted" in r.stderr and "4 bins" in r.stderr,
+            f"a one-turn sweep in 5 s chunks: exit 1, each chunk's missing angle range named ({r.returncode})")
+
     # 6. bad input
     text = sa.read_text()
     bad = {"v2.stats": text.replace('"version":1', '"version":2', 1), "cut.stats": text[: len(text) // 2],

@@ -633,7 +633,9 @@ resolver::StatsFile statistics_of_log(const Arguments& a, const Model& model, co
   }
   if (file.runs.empty()) {
     throw resolver::InputError(resolver::Fault::kData,
-                               fmt::format("no chunk of the log could be fitted: {}", fmt::join(file.left_out, "; ")),
+                               fmt::format("no chunk of the log could be fitted: {} (each --chunk of {:g} s must hold "
+                                           "the motion a fit needs: a longer chunk, or none, covers more)",
+                                           fmt::join(file.left_out, "; "), a.chunk_s),
                                resolver::Where::at_file(a.log));
   }
   resolver::mark_untrusted(file, options.untrusted_input);

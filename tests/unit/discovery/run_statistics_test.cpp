@@ -73,6 +73,7 @@ TEST(RunStatistics, MergedRunsGiveThePooledFitOfTheSameRuns) {
   }
   EXPECT_NEAR(param(merged.params, "amplitude_imbalance.alpha").value, 0.03, 1e-4);
   EXPECT_TRUE(merged.explained);
+  for (const Candidate& c : merged.candidates) EXPECT_FALSE(c.proposed) << c.effect << ": proposed although explained";
   EXPECT_EQ(merged.rows, r.slow_log.fitted_rows() + r.fast_log.fitted_rows());
 }
 
