@@ -12,6 +12,19 @@ import subprocess
 import sys
 
 
+# One sensor recorded in several runs (test_pooled_fit.py, test_stats_merge.py): a 3 % gain
+# error, a 1 % quadrature and the simulator's 3000 rad/s R/D loop, fitted with this model.
+RUN_MODEL = "amplitude_imbalance,quadrature,tracking_loop"
+RUN_ALPHA, RUN_BETA = 0.03, 0.01
+# Tolerance on alpha and beta: their position error at 2 theta is x/2; 1e-5 leaves 5e-6 rad,
+# a sixth of this 16-bit bench's noise floor (2.9e-5 rad, measured by the fit).
+RUN_TOL = 1e-5
+# [rad] a run's reference-zero constant: the fit finds it to a few standard errors of the
+# position error's mean (floor / sqrt(12000 samples) ~ 3e-7); 1e-4 is far above that and far
+# below the 1.5 rad the runs' zeros differ by.
+RUN_TOL_ZERO = 1e-4
+
+
 def run(cmd, timeout=300, **kwargs):
     """Runs cmd (any path-like items), returns the CompletedProcess with text output."""
     return subprocess.run([str(c) for c in cmd], capture_output=True, text=True, timeout=timeout, **kwargs)

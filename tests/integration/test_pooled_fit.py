@@ -23,17 +23,10 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_test_kit import Checks, run, simulate_run  # noqa: E402
+from bench_test_kit import (Checks, run, simulate_run, RUN_MODEL, RUN_ALPHA, RUN_BETA, RUN_TOL,  # noqa: E402
+                            RUN_TOL_ZERO)
 
-MODEL = "amplitude_imbalance,quadrature,tracking_loop"
-ALPHA, BETA = 0.03, 0.01
-# Tolerance on alpha and beta: their position error at 2 theta is x/2; 1e-5 leaves 5e-6 rad,
-# a sixth of this 16-bit bench's noise floor (2.9e-5 rad, measured by the fit).
-TOL = 1e-5
-# [rad] the reference-zero constant: the fit finds it to a few standard errors of the
-# position error's mean (floor / sqrt(12000 samples) ~ 3e-7); 1e-4 is far above that and far
-# below the 1.5 rad the two runs' zeros differ by.
-TOL_ZERO = 1e-4
+MODEL, ALPHA, BETA, TOL, TOL_ZERO = RUN_MODEL, RUN_ALPHA, RUN_BETA, RUN_TOL, RUN_TOL_ZERO  # bench_test_kit.py
 
 checks = Checks()
 check = checks.check

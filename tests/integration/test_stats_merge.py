@@ -25,16 +25,10 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_test_kit import Checks, run, simulate_run  # noqa: E402
+from bench_test_kit import (Checks, run, simulate_run, RUN_MODEL, RUN_ALPHA, RUN_BETA, RUN_TOL,  # noqa: E402
+                            RUN_TOL_ZERO)
 
-MODEL = "amplitude_imbalance,quadrature,tracking_loop"
-ALPHA, BETA = 0.03, 0.01
-# Tolerance on alpha and beta: their position error at 2 theta is x/2; 1e-5 leaves 5e-6 rad,
-# a sixth of this 16-bit bench's noise floor (2.9e-5 rad, measured by the fit).
-TOL = 1e-5
-# [rad] each run's reference-zero constant: the position error's mean is known to
-# floor / sqrt(12000 samples) ~ 3e-7; 1e-4 is far above that, far below the runs' 1.5 rad apart.
-TOL_ZERO = 1e-4
+MODEL, ALPHA, BETA, TOL, TOL_ZERO = RUN_MODEL, RUN_ALPHA, RUN_BETA, RUN_TOL, RUN_TOL_ZERO  # bench_test_kit.py
 # Merge against the pooled fit: the pooled fit iterates to convergence, the merge takes one
 # pooled Gauss-Newton step from each run's own solution: second order in how far those lie
 # apart. Measured 0.01 standard errors and less (run_statistics_test.cpp); 0.05 is a decision-free margin.

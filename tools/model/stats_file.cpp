@@ -177,14 +177,15 @@ class Reader {
 };
 
 void read_run(const Reader& r, const json::Json& root, RunStatistics& run) {
-  run.p_r = static_cast<int>(r.integer(r.at(root, "bench"), "p_r"));
-  run.p = static_cast<int>(r.integer(r.at(root, "bench"), "p"));
+  PoolLayout& l = run.layout;
+  l.p_r = static_cast<int>(r.integer(r.at(root, "bench"), "p_r"));
+  l.p = static_cast<int>(r.integer(r.at(root, "bench"), "p"));
   const json::Json& sig = r.at(root, "signals");
-  run.reference = r.boolean(sig, "reference");
-  run.reference_aligned = r.boolean(sig, "reference_aligned");
-  run.rd = r.boolean(sig, "rd");
-  run.sincos = r.boolean(sig, "sincos");
-  run.currents = r.boolean(sig, "currents");
+  l.reference = r.boolean(sig, "reference");
+  l.reference_aligned = r.boolean(sig, "reference_aligned");
+  l.rd = r.boolean(sig, "rd");
+  l.sincos = r.boolean(sig, "sincos");
+  l.currents = r.boolean(sig, "currents");
   run.effects = r.strings(root, "effects");
   for (const json::Json& p : r.items(root, "params")) {
     run.params.push_back({r.text(p, "name"), r.number(p, "value"), r.number(p, "std_error"), r.text(p, "unit")});
@@ -235,8 +236,8 @@ std::string format_run(const std::string& name, const RunStatistics& run) {
       "\"floors\":{{\"rd\":{},\"sc\":{},\"cur\":{}}},\n"
       "\"counts\":{{\"fitted_rows\":{},\"samples\":{},\"span_s\":{},\"electrical_revolutions\":{}}},\n"
       "\"motion\":{},\n\"notes\":{},\"untrusted\":{},\n\"groups\":{}}}",
-      json::str(name), run.p_r, run.p, run.reference, run.reference_aligned, run.rd, run.sincos,
-      run.currents, strings(run.effects), params_of(run.params), values, num(run.frame_shift), strings(run.columns), run.nuisance_columns,
+      json::str(name), run.layout.p_r, run.layout.p, run.layout.reference, run.layout.reference_aligned,
+      run.layout.rd, run.layout.sincos, run.layout.currents, strings(run.effects), params_of(run.params), values, num(run.frame_shift), strings(run.columns), run.nuisance_columns,
       run.model_columns, vector_of(run.point), floor_estimate(run.floors.rd), floor_estimate(run.floors.sc),
       floor_estimate(run.floors.cur), run.fitted_rows, run.samples, num(run.span_s), num(run.electrical_revolutions),
       motion_of(run.motion), strings(run.notes), strings(run.untrusted), groups);

@@ -33,10 +33,6 @@ int index_of(const std::vector<std::string>& names, const std::string& name) {
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
-PoolLayout layout_of(const RunStatistics& r) {
-  return {r.p_r, r.p, r.reference, r.reference_aligned, r.rd, r.sincos, r.currents};
-}
-
 /// The run with the most fitted rows (ties: the first name): every run is moved to
 /// its point, so the merge does not depend on the order the runs are given in.
 std::size_t reference_run(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names) {
@@ -256,14 +252,14 @@ void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolut
                  const std::vector<RunStatistics>& runs, const DiscoveryOptions& options, MergedFit& out) {
   MotionSummary motion;
   for (std::size_t r = 0; r < runs.size(); ++r) add_motion(motion, runs[r].motion, r == 0);
-  const bool rd = runs.front().rd;
+  const bool rd = runs.front().layout.rd;
   const std::vector<int> base_cols = model_columns(d);
   for (std::size_t i = 0; i < d.terms().size(); ++i) {
     if (!d.terms()[i].candidate) continue;
     std::vector<int> cols = base_cols;
     for (int c : term_columns(d, i)) cols.push_back(c);
     const ModelTerm term{d.terms()[i].effect, d.terms()[i].params};
-    if (const std::string missing = motion_missing(*term.effect, motion, runs.front().sincos && rd); !missing.empty()) {
+    if (const std::string missing = motion_missing(*term.effect, motion, runs.front().layout.sincos && rd); !missing.empty()) {
       out.not_evaluated.push_back(term.reference() + ": not identifiable in these runs: " + missing);
       continue;
     }
@@ -321,13 +317,7 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
                              const DiscoveryOptions& options) {
   const ModelFit fit = fit_prepared(log, effects, options);
   RunStatistics out;
-  out.p_r = log.p_r;
-  out.p = log.p;
-  out.reference = log.reference;
-  out.reference_aligned = log.reference_aligned;
-  out.rd = log.rd;
-  out.sincos = log.sincos;
-  out.currents = log.currents;
+  out.layout = pool_layout(log);
   out.effects = fit.model.spec().references();
   out.params = fit.params;
   out.values = fit.model.values();
@@ -358,7 +348,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   if (runs.empty()) throw std::invalid_argument("nothing to merge: no statistics given");
   if (names.size() != runs.size()) throw std::invalid_argument("merge: one name per run");
   for (std::size_t r = 1; r < runs.size(); ++r) {
-    check_same_layout(layout_of(runs.front()), layout_of(runs[r]), names.front(), names[r]);
+    check_same_layout(runs.front().layout, runs[r].layout, names.front(), names[r]);
   }
   const std::size_t ref = reference_run(runs, names);
   MergedFit out;

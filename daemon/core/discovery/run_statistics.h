@@ -34,9 +34,7 @@
 namespace resolver {
 
 struct RunStatistics {
-  // What the statistics are of: a merge needs the same in every run.
-  int p_r = 0, p = 0;
-  bool reference = false, reference_aligned = false, rd = false, sincos = false, currents = false;
+  PoolLayout layout;  ///< the bench and the signals: a merge needs the same in every run
   std::vector<std::string> effects;  ///< the model fitted to the run (references, e.g. "harmonics(k3)")
   /// The run's own fit of that model (standard errors robust where it has the revolutions):
   /// what a merge compares each run with the others by.

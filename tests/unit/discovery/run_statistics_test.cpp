@@ -112,7 +112,7 @@ TEST(RunStatistics, RunsOfAnotherBenchOrWithoutAColumnAreRefusedByName) {
   const TwoRuns& r = runs();
   RunStatistics a = run_statistics(r.slow_log, kModel, kAligned);
   RunStatistics b = a;
-  b.p_r = 2;
+  b.layout.p_r = 2;
   try {
     (void)merge_runs({a, b}, {"a.stats", "b.stats"}, {}, kAligned);
     FAIL() << "merged runs of two benches";
