@@ -143,6 +143,9 @@ def main():
     with_beta = merge(model, [w / "a_nobeta.stats", w / "b_nobeta.stats"], ["--effects", MODEL])
     c.check(abs(with_beta["params"]["quadrature.beta"]["value"] - BETA) < 3e-4,
             f"--effects adds a candidate from the same files: beta {with_beta['params']['quadrature.beta']['value']:.5g}")
+    # Its residual is linearised, not evaluated at that beta: never "explained" from it.
+    c.check(with_beta["verdict"] != "explained" and any("linearised step from zero" in n for n in with_beta["notes"]),
+            f"a candidate fitted from the files is not called explained ({with_beta['verdict']})")
 
     # 5. halves of one log against the whole: each half is its own run (its own reference
     # zero, amplitude, operating point, folds, floor), so this is not a rounding-level

@@ -38,6 +38,11 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
     return {"explained", "every signal's residual is within " + ratio +
                              "x its pooled noise floor, on held-back samples too (linearised, from the statistics)"};
   }
+  if (!m.linearised.empty()) {
+    return {"unexplained", fmt::format("not judged: {} only linearised from zero in these statistics (see the note); "
+                                       "make the statistics with the model in --effects and merge again",
+                                       fmt::join(m.linearised, ", "))};
+  }
   const Candidate* best = m.candidates.empty() || !m.candidates.front().proposed ? nullptr : &m.candidates.front();
   if (best != nullptr && best->reaches_floor) {
     return {"missing_effect", "adding " + best->effect + " brings every signal to within " + ratio +

@@ -246,6 +246,30 @@ std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const 
 }
 
 /// Every candidate term of `d` (after the model's) scored against `base`.
+/// The model's nonlinear effects that some run has only as a candidate (columns at
+/// zero): their merged value is one linearised step from there, and the residual the
+/// statistics give for it leaves out the step's second-order terms (a 1 % quadrature
+/// fitted so is 2.5 % off and the residual above its floor), so it cannot say "explained".
+std::vector<std::string> linearised_from_zero(const Design& d, const std::vector<RunStatistics>& runs) {
+  const std::vector<std::string> names = d.column_names();
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < d.terms().size(); ++i) {
+    const DesignTerm& t = d.terms()[i];
+    bool nonlinear = t.effect->envelope_only() || t.effect->shapes_basis();
+    for (int p : t.params) nonlinear = nonlinear || t.effect->params()[static_cast<std::size_t>(p)].nonlinear;
+    if (t.candidate || !nonlinear) continue;
+    const auto candidate_in = [&](const RunStatistics& r) {
+      for (int c : term_columns(d, i)) {
+        const int at = index_of(r.columns, names[static_cast<std::size_t>(c)]);
+        if (at >= r.nuisance_columns + r.model_columns) return true;
+      }
+      return false;
+    };
+    if (std::any_of(runs.begin(), runs.end(), candidate_in)) out.emplace_back(t.effect->name());
+  }
+  return out;
+}
+
 /// What the runs' motion together lacks for candidates (motion_missing): every run's
 /// speeds and reversals.
 void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolution& base, const GroupFloors& floors,
@@ -394,6 +418,14 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     if (r.rms > options.explained_ratio * r.floor) out.explained = false;
     if (std::isfinite(r.held_back_rms) && r.held_back_rms > options.explained_ratio * r.floor) out.explained = false;
   }
+  out.linearised = linearised_from_zero(d, runs);
+  if (const std::vector<std::string>& stepped = out.linearised; !stepped.empty()) {
+    out.explained = false;
+    out.notes.push_back(fmt::format("{} {} only a candidate in some run's statistics: fitted here by one linearised "
+                                    "step from zero, so the residual is not evaluated at the value and the merge "
+                                    "does not say explained; make the statistics with it in --effects",
+                                    fmt::join(stepped, ", "), stepped.size() == 1 ? "is" : "are"));
+  }
   for (std::size_t r = 0; r < runs.size(); ++r) {
     for (const std::string& u : runs[r].untrusted) {
       out.explained = false;
@@ -402,7 +434,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     }
   }
   rank_merged(d, stats, s, gf, runs, options, out);
-  if (out.explained) {
+  if (out.explained || !out.linearised.empty()) {
     // As explain: a model at the floor needs nothing; a candidate's BIC drop there is noise
     // fitted (with formal errors on 10^5 rows a few thousandths of the residual).
     for (Candidate& c : out.candidates) c.proposed = false;

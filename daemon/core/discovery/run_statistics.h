@@ -84,6 +84,9 @@ struct MergedFit {
   std::int64_t rows = 0;
   int runs = 0;
   bool explained = false;  ///< every signal within explained_ratio x its floor, held back too
+  /// The model's nonlinear effects some run had only as a candidate: fitted by one
+  /// linearised step, so the merge neither says explained nor proposes an effect.
+  std::vector<std::string> linearised;
   std::vector<std::string> notes;
 };
 
