@@ -1,5 +1,6 @@
 #include "tools/model/merge_report.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -38,20 +39,37 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
     return {"explained", "every signal's residual is within " + ratio +
                              "x its pooled noise floor, on held-back samples too (linearised, from the statistics)"};
   }
+  if (m.untrusted) {
+    return {"unexplained", "the signals are faulty for a large part of a run (see the notes): a fit on them says "
+                           "nothing about the resolver, and no effect is proposed; fix the input and record again"};
+  }
   if (!m.linearised.empty()) {
     return {"unexplained", fmt::format("not judged: {} only linearised from zero in these statistics (see the note); "
                                        "make the statistics with the model in --effects and merge again",
                                        fmt::join(m.linearised, ", "))};
   }
   const Candidate* best = m.candidates.empty() || !m.candidates.front().proposed ? nullptr : &m.candidates.front();
-  if (best != nullptr && best->reaches_floor) {
-    return {"missing_effect", "adding " + best->effect + " brings every signal to within " + ratio +
-                                  "x its floor: " + best->reason + " Its value is one step linearised from zero: "
-                                  "make the statistics again with it in --effects (or fit the logs) for the exact fit."};
+  std::int64_t rows = 0;
+  for (const SignalResidual& r : m.signals) rows += r.rows;
+  // explain's rule (model_discovery.cpp): named when it reaches the floor or removes most
+  // of what lies above it.
+  if (best != nullptr && (best->reaches_floor || removes_most_excess(m.signals, rows, m.rd, best->weighted_rss))) {
+    const bool exact = std::find(m.refitted.begin(), m.refitted.end(), best->effect) != m.refitted.end();
+    const bool linear = std::find(m.stepped.begin(), m.stepped.end(), best->effect) == m.stepped.end();
+    return {"missing_effect",
+            "adding " + best->effect +
+                (best->reaches_floor ? " brings every signal to within " + ratio + "x its floor: "
+                                     : " removes most of the residual above the floor: ") +
+                best->reason +
+                (exact    ? " Fitted to convergence on every run (the statistics made again with it in the model)."
+                 : linear ? " Its parameters enter linearly: the step from the statistics is its fit."
+                          : " Its value is one step linearised from zero: make the statistics again with it in "
+                            "--effects (or fit the logs) for the exact fit.")};
   }
   return {"unexplained", best == nullptr ? "no candidate in the statistics lowers the residual enough to be proposed"
                                          : "the best candidate, " + best->effect +
-                                               ", does not reach the floor: run resolver-model explain on the logs"};
+                                               ", does not bring the residual near the floor: run resolver-model "
+                                               "explain on the logs"};
 }
 
 std::string format_merge_text(const MergedFit& m, const std::vector<std::string>& runs,

@@ -617,8 +617,10 @@ int run_on_logs(const Arguments& a, const Model& model, const resolver::Progress
 }
 
 /// The log's statistics, whole or one run per chunk (--chunk S).
-resolver::StatsFile statistics_of_log(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
+resolver::StatsFile statistics_of_log(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown,
+                                      bool candidates = true) {
   resolver::DiscoveryOptions options = discovery_options(a, model.config);
+  options.statistics_candidates = candidates;
   resolver::StatsFile file = resolver::stats_file_header(a.log, model.config);
   std::function<void(resolver::DiscoveryInput&&)> on_chunk;
   if (a.chunk_s > 0.0) {
@@ -649,14 +651,38 @@ int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMe
     resolver::write_stats_file(statistics_of_log(a, model, shown), a.stats_out);
     return 0;
   }
-  std::vector<resolver::StatsFile> files;
   const std::vector<std::string> logs = a.logs.empty() ? std::vector<std::string>{a.log} : a.logs;
-  for (const std::string& log : logs) {
-    Arguments one = a;
-    one.log = log;
-    files.push_back(statistics_of_log(one, model, shown));
+  // The first pass keeps every candidate's columns; a refit's only the model's.
+  const auto statistics_with = [&](const std::vector<std::string>& effects, bool candidates) {
+    Model with = model;
+    with.effects = effects;
+    std::vector<resolver::StatsFile> files;
+    for (const std::string& log : logs) {
+      Arguments one = a;
+      one.log = log;
+      files.push_back(statistics_of_log(one, with, shown, candidates));
+    }
+    return files;
+  };
+  const resolver::DiscoveryOptions options = discovery_options(a, model.config);
+  resolver::MergedFiles merged = resolver::merge_files(statistics_with(model.effects, true), logs, {}, options);
+  if (a.command == Command::kExplain) {
+    // As explain in memory: a candidate whose linearised step is not its fit is refitted,
+    // here by a further pass over the logs (they are files: read again).
+    const bool readable_again = std::all_of(logs.begin(), logs.end(), [](const std::string& l) {
+      std::error_code ec;
+      return std::filesystem::is_regular_file(l, ec);
+    });
+    if (readable_again) {
+      resolver::refit_from_logs(
+          merged, [&](const std::vector<std::string>& effects) { return statistics_with(effects, false); }, options);
+    } else if (!resolver::candidates_to_refit(merged.fit, options).empty()) {
+      merged.fit.notes.emplace_back("the candidates are not refitted: a log is not a regular file and cannot be read "
+                                    "a second time (their scores are one linearised step)");
+    }
   }
-  return resolver::print_merge(files, logs, {}, a.json, discovery_options(a, model.config));
+  resolver::print_merged(merged, a.json, options);
+  return 0;
 }
 
 /// Every subcommand but fleet: read the log, then fit, explain or write.

@@ -68,29 +68,60 @@ int run_merge(const std::vector<std::string>& paths, std::span<const std::string
   return print_merge(files, paths, effects, json, options);
 }
 
-int print_merge(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
-                std::span<const std::string> effects, bool json, const DiscoveryOptions& options) {
-  std::vector<RunStatistics> runs;
-  std::vector<std::string> names;
+MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+                        std::span<const std::string> effects, const DiscoveryOptions& options) {
+  MergedFiles out;
   for (std::size_t i = 0; i < files.size(); ++i) {
     // A file of one run is named by its path; a chunked log's runs by path and span.
     for (const NamedRun& r : files[i].runs) {
-      names.push_back(files[i].runs.size() == 1 ? paths[i]
-                                                : paths[i] + ": " + r.name.substr(r.name.rfind(" [") + 1));
-      runs.push_back(r.run);
+      out.names.push_back(files[i].runs.size() == 1 ? paths[i]
+                                                    : paths[i] + ": " + r.name.substr(r.name.rfind(" [") + 1));
+      out.runs.push_back(r.run);
     }
   }
-  MergedFit merged;
   try {
-    merged = merge_runs(runs, names, effects, options);
+    out.fit = merge_runs(out.runs, out.names, effects, options);
   } catch (const std::invalid_argument& e) {
     throw InputError(Fault::kData, e.what());
   }
   for (const StatsFile& f : files) {
-    for (const std::string& l : f.left_out) merged.notes.push_back("left out when the statistics were made: " + l);
+    for (const std::string& l : f.left_out) out.fit.notes.push_back("left out when the statistics were made: " + l);
   }
-  std::cout << (json ? format_merge_json(merged, names, runs, options.explained_ratio)
-                     : format_merge_text(merged, names, runs, options.explained_ratio));
+  return out;
+}
+
+void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
+  for (const std::string& effect : candidates_to_refit(merged.fit, options)) {
+    const auto not_refitted = [&](const char* why) {
+      merged.fit.notes.push_back(fmt::format("{} not refitted (its score stays one linearised step): {}", effect, why));
+    };
+    std::vector<std::string> effects = merged.fit.effects;
+    effects.push_back(effect);
+    try {
+      std::vector<RunStatistics> runs;
+      for (const StatsFile& f : statistics_with(effects)) {
+        for (const NamedRun& r : f.runs) runs.push_back(r.run);
+      }
+      if (runs.size() != merged.runs.size()) {
+        throw std::invalid_argument(fmt::format("{} of the {} runs could be fitted with it", runs.size(), merged.runs.size()));
+      }
+      take_exact_refit(merged.fit, effect, merge_runs(runs, merged.names, effects, options), options);
+    } catch (const std::invalid_argument& e) {
+      not_refitted(e.what());
+    } catch (const InputError& e) {
+      not_refitted(e.what());
+    }
+  }
+}
+
+void print_merged(const MergedFiles& merged, bool json, const DiscoveryOptions& options) {
+  std::cout << (json ? format_merge_json(merged.fit, merged.names, merged.runs, options.explained_ratio)
+                     : format_merge_text(merged.fit, merged.names, merged.runs, options.explained_ratio));
+}
+
+int print_merge(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+                std::span<const std::string> effects, bool json, const DiscoveryOptions& options) {
+  print_merged(merge_files(files, paths, effects, options), json, options);
   return 0;
 }
 

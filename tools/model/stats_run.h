@@ -2,6 +2,7 @@
 // a log's statistics written once, fits of many runs made from them without the logs.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,8 +34,33 @@ void mark_untrusted(StatsFile& file, const std::vector<std::string>& untrusted);
 /// Writes `file` to `out` (IoError: exit 3) and says what it holds on stdout.
 void write_stats_file(const StatsFile& file, const std::string& out);
 
+/// The runs of several statistics files, merged.
+struct MergedFiles {
+  std::vector<RunStatistics> runs;
+  std::vector<std::string> names;  ///< a file's path; a chunk's with its span
+  MergedFit fit;
+};
+
 /// Merges the runs of `files` (named by `paths`, a chunk by its span too) with `effects`
-/// and prints text or JSON on stdout; returns 0. InputError (data) when they do not merge.
+/// (empty: the first run's model); what the statistics left out goes into the notes.
+/// InputError (data) when they do not merge.
+[[nodiscard]] MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+                                      std::span<const std::string> effects, const DiscoveryOptions& options);
+
+/// The same logs' statistics made again with the model `effects` (one file per log, the
+/// runs in the same order): a second pass over the logs.
+using StatisticsWith = std::function<std::vector<StatsFile>(const std::vector<std::string>& effects)>;
+
+/// explain on statistics, as on a log in memory: each candidate whose linearised step is
+/// not its fit (candidates_to_refit) is refitted to convergence by making the statistics
+/// again with it in the model, and scored by that merge (take_exact_refit). A refit that
+/// fails leaves the candidate linearised, with a note saying why.
+void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options);
+
+/// Prints `merged` as text or JSON on stdout.
+void print_merged(const MergedFiles& merged, bool json, const DiscoveryOptions& options);
+
+/// merge_files, then print_merged; returns 0.
 int print_merge(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
                 std::span<const std::string> effects, bool json, const DiscoveryOptions& options);
 

@@ -124,6 +124,20 @@ std::string std_error_basis(const ModelFit& f) {
                      kMinRobustBlocks);
 }
 
+bool removes_most_excess(const std::vector<SignalResidual>& signals, std::int64_t rows, bool rd,
+                         double weighted_rss_after) {
+  // Share of the weighted residual power above the floor the candidate removes
+  // (a row at the floor weighs 1).
+  double base = 0.0;
+  for (const SignalResidual& r : signals) {
+    if (r.signal == "position_error" && !rd) continue;
+    base += static_cast<double>(r.rows) * (r.rms * r.rms) / (r.floor * r.floor);
+  }
+  const double excess = base - static_cast<double>(rows);
+  const double after = weighted_rss_after - static_cast<double>(rows);
+  return excess > 0.0 && (excess - after) >= kExcessExplainedShare * excess;
+}
+
 std::string_view to_string(Verdict v) {
   switch (v) {
     case Verdict::kExplained: return "explained";
@@ -428,21 +442,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
   const Candidate* best = ex.candidates.empty() || !ex.candidates.front().proposed ? nullptr : &ex.candidates.front();
   bool named = false;
   if (best != nullptr) {
-    if (best->reaches_floor) {
-      named = true;
-    } else {
-      // Share of the weighted residual power above the floor the candidate removes
-      // (a row at the floor weighs 1).
-      const double rows = static_cast<double>(ex.fit.rows);
-      double base = 0.0;
-      for (const SignalResidual& r : ex.fit.signals) {
-        if (r.signal == "position_error" && !log.rd) continue;
-        base += static_cast<double>(r.rows) * (r.rms * r.rms) / (r.floor * r.floor);
-      }
-      const double excess = base - rows;
-      const double after = best->weighted_rss - rows;
-      named = excess > 0.0 && (excess - after) >= kExcessExplainedShare * excess;
-    }
+    named = best->reaches_floor || removes_most_excess(ex.fit.signals, ex.fit.rows, log.rd, best->weighted_rss);
   }
   if (!named && best != nullptr) ex.missing_pair = find_missing_pair(log, ex.fit, ex.candidates, options);
   const std::string alternatives =

@@ -65,6 +65,9 @@ struct DiscoveryOptions {
   int series_points = 0;
   /// Rank the candidates even when the model explains the log (never proposed then).
   bool rank_when_explained = true;
+  /// A run's statistics keep every candidate's columns (run_statistics.h); without, only
+  /// the model's: a candidate's exact refit needs no others.
+  bool statistics_candidates = true;
   /// Slicing of the log's samples (direction, moving only).
   PrepareOptions prepare;
   /// The config's [[model.custom]] effects (may be null): usable in models and ranked as candidates.
@@ -225,6 +228,13 @@ struct Candidate {
   /// smaller candidate reaches the floor (the simplest explanation first).
   bool family = false;
 };
+
+/// Whether a candidate that leaves `weighted_rss_after` (a row at its floor weighs 1)
+/// removes most of what the model leaves above the floors of `signals` (`rows`: the
+/// model's fitted rows over every signal; `rd`: the position error counts). Such an
+/// effect is named although it does not reach the floor alone.
+[[nodiscard]] bool removes_most_excess(const std::vector<SignalResidual>& signals, std::int64_t rows, bool rd,
+                                       double weighted_rss_after);
 
 enum class Verdict : std::uint8_t { kExplained, kMissingEffect, kUnexplained };
 [[nodiscard]] std::string_view to_string(Verdict v);

@@ -240,6 +240,24 @@ void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSol
   c.reaches_floor = groups_explained(s, floors, options.explained_ratio);
 }
 
+bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options) {
+  const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
+  const ModelTerm& term = one.terms.front();
+  bool nonlinear = term.effect->envelope_only() && !c.family && !c.reaches_floor;
+  for (int p : term.params) nonlinear = nonlinear || term.effect->params()[static_cast<std::size_t>(p)].nonlinear;
+  return nonlinear;
+}
+
+std::vector<std::string> exact_refits(const std::vector<Candidate>& ranked, const DiscoveryOptions& options) {
+  std::vector<std::string> out;
+  for (const Candidate& c : ranked) {
+    if (static_cast<int>(out.size()) < kNonlinearRefits && c.proposed && needs_exact_refit(c, options)) {
+      out.push_back(c.effect);
+    }
+  }
+  return out;
+}
+
 namespace {
 
 /// The linearised step of candidate `term` (design `d`) on the model's columns.
@@ -277,15 +295,11 @@ StepSolution solve_candidate(const Design& d, std::size_t term, ModelTerm& t, co
 /// the floor (small magnitudes) a refit would only cost the live daemon its time.
 void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
                      const GroupFloors& floors, const DiscoveryOptions& options) {
-  int refits = 0;
-  for (Candidate& c : out.candidates) {
-    if (refits >= kNonlinearRefits || !c.proposed) continue;
+  for (const std::string& effect : exact_refits(out.candidates, options)) {
+    Candidate& c = *std::find_if(out.candidates.begin(), out.candidates.end(),
+                                 [&](const Candidate& x) { return x.effect == effect; });
     const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
     const ModelTerm& term = one.terms.front();
-    bool nonlinear = term.effect->envelope_only() && !c.family && !c.reaches_floor;
-    for (int p : term.params) nonlinear = nonlinear || term.effect->params()[static_cast<std::size_t>(p)].nonlinear;
-    if (!nonlinear) continue;
-    ++refits;
     ModelSpec with = fit.model.spec();
     with.add(term);
     Design dm(with, fit.model.values(), nuisances_for(log));

@@ -44,6 +44,15 @@ struct Ranking {
 void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSolution& base, const GroupFloors& floors,
                      const DiscoveryOptions& options);
 
+/// Whether a candidate's linearised score is not its fit: an envelope effect (through
+/// atan2) whose step does not already reach the floor, or one with a nonlinear parameter
+/// (delay, tracking loop). Such candidates are refitted to convergence with the model.
+[[nodiscard]] bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options);
+
+/// The effects of `ranked` (best first) to refit so: the best kNonlinearRefits proposed
+/// ones that need it. The same rule for a log in memory and for merged statistics.
+[[nodiscard]] std::vector<std::string> exact_refits(const std::vector<Candidate>& ranked, const DiscoveryOptions& options);
+
 /// Ranks the candidates for the fitted model `fit` on `log`.
 [[nodiscard]] Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options);
 

@@ -110,6 +110,20 @@ RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::V
   return rc;
 }
 
+/// Statistics linearised at a point moved to another `shift` = (point - other point)
+/// away: b + M d and yy + 2 d'b + d'M d (the header), in the same columns.
+NormalEquations moved(const NormalEquations& ne, const Eigen::VectorXd& shift) {
+  NormalEquations out;
+  out.set(ne.m(), ne.b() + ne.m() * shift, ne.yy() + 2.0 * shift.dot(ne.b()) + shift.dot(ne.m() * shift), ne.n());
+  return out;
+}
+
+/// The reference zero's constants (the position errors'), which a run holds in its
+/// own fit's frame (frame_shift) rather than at zero.
+bool frame_constant(const std::string& column) {
+  return column == nuisance_name(Nuisance::kRdConstant) || column == nuisance_name(Nuisance::kSaConstant);
+}
+
 /// The run's constants of one group: those its rows carry (a constant of another
 /// group's signal has an empty column here).
 std::vector<Eigen::Index> constants_in(const NormalEquations& ne, int nuisance_columns) {
@@ -125,8 +139,9 @@ std::vector<Eigen::Index> constants_in(const NormalEquations& ne, int nuisance_c
 /// M_ss - M_sn M_nn^-1 M_ns): over the design's columns. Exact: a constant enters one
 /// group's signal only, so profiling group by group is profiling the weighted sum.
 NormalEquations reduce_run(const NormalEquations& ne, const RunColumns& rc, int nuisance_columns, int k_design) {
-  const Eigen::VectorXd b = ne.b() + ne.m() * rc.shift;
-  double yy = ne.yy() + 2.0 * rc.shift.dot(ne.b()) + rc.shift.dot(ne.m() * rc.shift);
+  const NormalEquations at = moved(ne, rc.shift);
+  const Eigen::VectorXd& b = at.b();
+  double yy = at.yy();
   std::vector<Eigen::Index> kept;
   for (std::size_t c = 0; c < rc.to.size(); ++c) {
     if (rc.to[c] >= 0) kept.push_back(static_cast<Eigen::Index>(c));
@@ -210,9 +225,7 @@ std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s,
     for (int j = 0; j < run.nuisance_columns; ++j) {
       const std::string& column = run.columns[static_cast<std::size_t>(j)];
       double v = value[j];
-      if (column == nuisance_name(Nuisance::kRdConstant) || column == nuisance_name(Nuisance::kSaConstant)) {
-        v -= run.frame_shift;
-      }
+      if (frame_constant(column)) v -= run.frame_shift;
       out.push_back({column + "[" + names[r] + "]", v, kNaN, ""});
     }
   }
@@ -350,7 +363,9 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
   out.nuisance_columns = d.nuisance_columns();
   out.model_columns = d.columns() - d.nuisance_columns();
   for (const Effect* e : effect_registry()) {
-    if (candidate_for(*e, fit.model.spec(), log)) d.add_candidate(ModelTerm{e, default_params(*e)});
+    if (options.statistics_candidates && candidate_for(*e, fit.model.spec(), log)) {
+      d.add_candidate(ModelTerm{e, default_params(*e)});
+    }
   }
   out.columns = d.column_names();
   out.point = d.z();
@@ -411,6 +426,9 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     if (d.terms()[i].candidate) continue;
     for (ModelParameter& p : term_params(d, i, s, true)) out.params.push_back(std::move(p));
   }
+  out.rd = runs.front().layout.rd;
+  out.bic = bic_of(s);
+  out.weighted_rss = s.rss_w;
   out.nuisance = constants_at(d, s, runs, names);
   out.signals = merged_signals(stats, s, raw_solution(runs, gf), gf, cols);
   out.explained = !out.signals.empty();
@@ -429,14 +447,19 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   for (std::size_t r = 0; r < runs.size(); ++r) {
     for (const std::string& u : runs[r].untrusted) {
       out.explained = false;
+      out.untrusted = true;
       out.notes.push_back(fmt::format("{}: signal health: {} (a fit on faulty signals is no evidence: not explained)",
                                       names[r], u));
     }
   }
   rank_merged(d, stats, s, gf, runs, options, out);
-  if (out.explained || !out.linearised.empty()) {
+  for (const Candidate& c : out.candidates) {
+    if (needs_exact_refit(c, options)) out.stepped.push_back(c.effect);
+  }
+  if (out.explained || out.untrusted || !out.linearised.empty()) {
     // As explain: a model at the floor needs nothing; a candidate's BIC drop there is noise
-    // fitted (with formal errors on 10^5 rows a few thousandths of the residual).
+    // fitted (with formal errors on 10^5 rows a few thousandths of the residual). Fitted
+    // to faulty signals a candidate names the fault's shape, not the resolver's physics.
     for (Candidate& c : out.candidates) c.proposed = false;
   }
   if (runs.size() > 1) {
@@ -453,6 +476,52 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     if (std::string n = nonlinear_note(d, runs, s, z0); !n.empty()) out.notes.push_back(std::move(n));
   }
   return out;
+}
+
+std::vector<std::string> candidates_to_refit(const MergedFit& m, const DiscoveryOptions& options) {
+  if (m.explained || m.untrusted || !m.linearised.empty()) return {};
+  std::vector<std::string> out = exact_refits(m.candidates, options);
+  std::erase_if(out, [&](const std::string& e) { return std::find(m.stepped.begin(), m.stepped.end(), e) == m.stepped.end(); });
+  return out;
+}
+
+void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& with, const DiscoveryOptions& options) {
+  const auto it = std::find_if(m.candidates.begin(), m.candidates.end(), [&](const Candidate& c) { return c.effect == effect; });
+  if (it == m.candidates.end() || with.signals.empty()) return;
+  Candidate& c = *it;
+  const auto rms_of = [&](const char* signal) {
+    for (const SignalResidual& r : with.signals) {
+      if (r.signal == signal) return r.rms;
+    }
+    return kNaN;
+  };
+  // As score_candidate, from the merged exact fit instead of the linearised step.
+  c.residual_after_rad = rms_of(m.rd ? "position_error" : "sin_cos");
+  c.sincos_residual_after = rms_of("sin_cos");
+  c.dq_residual_after = rms_of("i_dq");
+  c.weighted_rss = with.weighted_rss;
+  c.score = with.bic;
+  c.bic_drop = m.bic - c.score;
+  c.err = m.weighted_rss > 0.0 ? (m.weighted_rss - with.weighted_rss) / m.weighted_rss : 0.0;
+  c.proposed = c.bic_drop > options.proposal_bic_drop;
+  c.reaches_floor = std::all_of(with.signals.begin(), with.signals.end(), [&](const SignalResidual& r) {
+    return r.rms <= options.explained_ratio * r.floor;
+  });
+  const ModelSpec one = ModelSpec::parse(std::vector<std::string>{effect}, options.customs);
+  const ModelTerm& term = one.terms.front();
+  c.params.clear();
+  for (int p : term.params) {
+    const std::string name =
+        std::string(term.effect->name()) + "." + std::string(term.effect->params()[static_cast<std::size_t>(p)].name);
+    for (const ModelParameter& q : with.params) {
+      if (q.name == name) c.params.push_back(q);
+    }
+  }
+  c.reason = reason_of(term, c.params);
+  m.refitted.push_back(effect);
+  std::erase(m.stepped, effect);
+  std::stable_sort(m.candidates.begin(), m.candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
 }
 
 }  // namespace resolver

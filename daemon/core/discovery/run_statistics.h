@@ -22,6 +22,7 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -87,6 +88,16 @@ struct MergedFit {
   /// The model's nonlinear effects some run had only as a candidate: fitted by one
   /// linearised step, so the merge neither says explained nor proposes an effect.
   std::vector<std::string> linearised;
+  /// Candidates whose score is their exact fit: statistics made again with each in the
+  /// model and merged (take_exact_refit), not the one linearised step from zero.
+  std::vector<std::string> refitted;
+  /// Candidates whose score is still one linearised step although their fit is not
+  /// (ranking.h needs_exact_refit): their value and residual are approximate.
+  std::vector<std::string> stepped;
+  bool untrusted = false;  ///< some run's signals were faulty for long: never explained, nothing proposed
+  bool rd = false;         ///< the position error is the R/D angle's (ranking.h score_candidate)
+  double bic = std::numeric_limits<double>::quiet_NaN();  ///< of the model's merged solution (fit_support.h bic_of)
+  double weighted_rss = 0.0;  ///< its residual, each signal over its floor squared
   std::vector<std::string> notes;
 };
 
@@ -98,5 +109,16 @@ struct MergedFit {
 /// (beyond rounding): they are moved to the point of the run with the most rows.
 [[nodiscard]] MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names,
                                    std::span<const std::string> effects, const DiscoveryOptions& options);
+
+/// The candidates of `m` whose linearised step is not their fit (ranking.h exact_refits:
+/// envelope effects at real magnitudes, nonlinear parameters), to be refitted from
+/// statistics made again with each in the model. None when the merge needs no effect or
+/// is not judged (explained, untrusted, linearised).
+[[nodiscard]] std::vector<std::string> candidates_to_refit(const MergedFit& m, const DiscoveryOptions& options);
+
+/// Replaces candidate `effect` of `m` by its exact fit: `with` merges the same runs'
+/// statistics made with the model plus `effect` (every run fitted to convergence with
+/// it), as explain refits a log in memory. The candidates are sorted again.
+void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& with, const DiscoveryOptions& options);
 
 }  // namespace resolver
