@@ -43,6 +43,20 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
     return {"unexplained", "the signals are faulty for a large part of a run (see the notes): a fit on them says "
                            "nothing about the resolver, and no effect is proposed; fix the input and record again"};
   }
+  // As explain: where the model is at the floor without the outliers, they are the finding.
+  bool in_sample = !m.signals.empty(), outliers_matter = false;
+  double worst = 0.0;
+  for (const SignalResidual& r : m.signals) {
+    in_sample = in_sample && r.rms <= explained_ratio * r.floor;
+    outliers_matter = outliers_matter || (m.outlier_samples > 0 && r.rms_with_outliers > explained_ratio * r.floor);
+    worst = std::max(worst, r.rms_with_outliers / r.floor);
+  }
+  if (outliers_matter && in_sample) {
+    return {"unexplained", fmt::format("{} impulsive samples (outliers) carry the residual to {:.1f}x the floor; without "
+                                       "them the model explains the runs. Find their source (EMI, bit errors) before "
+                                       "trusting a fit; they are kept out of this one.",
+                                       m.outlier_samples, worst)};
+  }
   if (!m.linearised.empty()) {
     return {"unexplained", fmt::format("not judged: {} only linearised from zero in these statistics (see the note); "
                                        "make the statistics with the model in --effects and merge again",

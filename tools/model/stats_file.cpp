@@ -208,6 +208,14 @@ void read_run(const Reader& r, const json::Json& root, RunStatistics& run) {
   run.motion = r.motion(r.at(root, "motion"));
   run.notes = r.strings(root, "notes");
   run.untrusted = r.strings(root, "untrusted");
+  const json::Json& outliers = r.at(root, "outliers");
+  run.outlier_samples = r.integer(outliers, "samples");
+  const Eigen::VectorXd rss = r.vector(outliers, "rss", kGroups);
+  const Eigen::VectorXd rows = r.vector(outliers, "rows", kGroups);
+  for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
+    run.outlier_rss[g] = rss[static_cast<Eigen::Index>(g)];
+    run.outlier_rows[g] = static_cast<std::int64_t>(std::llround(rows[static_cast<Eigen::Index>(g)]));
+  }
   run.stats = PassStatistics(static_cast<int>(k));
   const json::Json& groups = r.at(root, "groups");
   for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
@@ -235,12 +243,15 @@ std::string format_run(const std::string& name, const RunStatistics& run) {
       "\"columns\":{},\"nuisance_columns\":{},\"model_columns\":{},\n\"point\":{},\n"
       "\"floors\":{{\"rd\":{},\"sc\":{},\"cur\":{}}},\n"
       "\"counts\":{{\"fitted_rows\":{},\"samples\":{},\"span_s\":{},\"electrical_revolutions\":{}}},\n"
-      "\"motion\":{},\n\"notes\":{},\"untrusted\":{},\n\"groups\":{}}}",
+      "\"motion\":{},\n\"notes\":{},\"untrusted\":{},\n"
+      "\"outliers\":{{\"samples\":{},\"rows\":{},\"rss\":{}}},\n\"groups\":{}}}",
       json::str(name), run.layout.p_r, run.layout.p, run.layout.reference, run.layout.reference_aligned,
       run.layout.rd, run.layout.sincos, run.layout.currents, strings(run.effects), params_of(run.params), values, num(run.frame_shift), strings(run.columns), run.nuisance_columns,
       run.model_columns, vector_of(run.point), floor_estimate(run.floors.rd), floor_estimate(run.floors.sc),
       floor_estimate(run.floors.cur), run.fitted_rows, run.samples, num(run.span_s), num(run.electrical_revolutions),
-      motion_of(run.motion), strings(run.notes), strings(run.untrusted), groups);
+      motion_of(run.motion), strings(run.notes), strings(run.untrusted), run.outlier_samples,
+      json::array(std::vector<double>(run.outlier_rows.begin(), run.outlier_rows.end()), kExact),
+      json::array(run.outlier_rss, kExact), groups);
 }
 
 }  // namespace

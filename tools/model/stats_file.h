@@ -2,19 +2,22 @@
 // (daemon/core/discovery/run_statistics.h) as self-describing JSON that `merge`
 // reads back exactly (every double with 17 significant digits).
 //
-//   {"format": "resolver-model stats", "version": 1, "tool": "resolver-model ...",
+//   {"format": "resolver-model stats", "version": 2, "tool": "resolver-model ...",
 //    "log": ..., "layout": {"id", "description"},
 //    "runs": [{"name": ..., "bench": {"p_r", "p"}, "signals": {...}, "effects": [...],
 //              "params": [...], "values": [[...]], "frame_shift": ..., "columns": [...],
 //              "nuisance_columns": n, "model_columns": m, "point": [...],
 //              "floors": {"rd": {...}, "sc": {...}, "cur": {...}}, "counts": {...},
 //              "motion": {...}, "notes": [...], "untrusted": [...],
+//              "outliers": {"samples", "rows": [per group], "rss": [per group]},
 //              "groups": {"rd": {"all": {"n", "yy", "b", "m_upper"}, "fold_a": {...}}, "sc": ..., "cur": ...}}]}
 // One run per log, or one per chunk of a long log (stats --chunk): each chunk is a run
 // with its own constants, so a log of any length is read in bounded memory.
 //
 // A file of another format or version, or one that does not parse, is refused naming
 // the file (InputError, usage: exit 2); so are files of different layouts in one merge.
+// Version 2 added the outliers a run's fit left out (a merge is not explained where
+// they carry a signal above its floor): a version 1 file lacks them, so it is made again.
 #pragma once
 
 #include <string>
@@ -24,7 +27,7 @@
 
 namespace resolver {
 
-inline constexpr int kStatsFileVersion = 1;
+inline constexpr int kStatsFileVersion = 2;
 
 /// One run of a file: its name (the log, or "LOG [t0-t1 s]" for a chunk) and statistics.
 struct NamedRun {

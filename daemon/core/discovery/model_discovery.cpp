@@ -250,6 +250,7 @@ std::vector<std::string> signal_residuals(const PreparedLog& log, const FitResul
     r.held_back_rms = held_back_rms(fr.stats, floors, cols, static_cast<Group>(g));
     r.rows = s.n[g];
     r.rms_with_outliers = rms(pass.rss_with_outliers[g], pass.n_with_outliers[g]);
+    r.rows_with_outliers = pass.n_with_outliers[g];
     f.signals.push_back(r);
   }
   if (!log.rd && log.sincos) {

@@ -86,6 +86,7 @@ struct SignalResidual {
   double held_back_rms = 0.0;  ///< cross-validated: fitted on one fold, evaluated on the other (NaN: no folds)
   double rms_with_outliers = 0.0;  ///< including the outlier samples the fit left out
   std::int64_t rows = 0;
+  std::int64_t rows_with_outliers = 0;  ///< rows of rms_with_outliers
 };
 
 struct HarmonicResidual {

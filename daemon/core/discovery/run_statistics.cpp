@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "daemon/core/discovery/fit_support.h"
+#include "daemon/core/discovery/outliers.h"
 #include "daemon/core/discovery/pool.h"
 #include "daemon/core/discovery/ranking.h"
 #include "daemon/core/effects/registry.h"
@@ -239,7 +240,8 @@ StepSolution raw_solution(const std::vector<RunStatistics>& runs, const GroupFlo
 }
 
 std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const StepSolution& s, const StepSolution& raw,
-                                           const GroupFloors& floors, const std::vector<int>& cols) {
+                                           const GroupFloors& floors, const std::vector<int>& cols,
+                                           const std::vector<RunStatistics>& runs) {
   const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
   std::vector<SignalResidual> out;
   for (int g = 0; g < kGroups; ++g) {
@@ -251,8 +253,16 @@ std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const 
     r.floor = f;
     r.raw_rms = raw.ok ? rms(raw.rss[g], raw.n[g]) : kNaN;
     r.held_back_rms = held_back_rms(stats.fold_a, stats.fold_b, floors, cols, static_cast<Group>(g));
-    r.rms_with_outliers = r.rms;  // outliers stay out of the statistics
+    // The outliers stay out of the statistics; what they carried at each run's fit is kept.
+    double rss_out = 0.0;
+    std::int64_t rows_out = 0;
+    for (const RunStatistics& run : runs) {
+      rss_out += run.outlier_rss[static_cast<std::size_t>(g)];
+      rows_out += run.outlier_rows[static_cast<std::size_t>(g)];
+    }
+    r.rms_with_outliers = rms(s.rss[g] + rss_out, s.n[g] + rows_out);
     r.rows = s.n[g];
+    r.rows_with_outliers = s.n[g] + rows_out;
     out.push_back(r);
   }
   return out;
@@ -348,6 +358,22 @@ std::string nonlinear_note(const Design& d, const std::vector<RunStatistics>& ru
                      which, widest, widest > 3.0 ? "; fit the logs together (resolver-model fit A.log B.log) to iterate" : "");
 }
 
+/// The outlier rows of the run's fit per group, and what they carry at its solution.
+void take_outliers(const ModelFit& fit, RunStatistics& out) {
+  for (const OutlierSignal& o : fit.outliers) out.outlier_samples += o.count;
+  const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
+  for (const SignalResidual& r : fit.signals) {
+    for (int g = 0; g < kGroups; ++g) {
+      // Without an R/D angle the fit's "position_error" is the sin/cos angle's, not group 0.
+      if (r.signal != names[g] || (g == 0 && !out.layout.rd)) continue;
+      const auto gi = static_cast<std::size_t>(g);
+      out.outlier_rows[gi] = std::max<std::int64_t>(0, r.rows_with_outliers - r.rows);
+      out.outlier_rss[gi] = std::max(0.0, r.rms_with_outliers * r.rms_with_outliers * static_cast<double>(r.rows_with_outliers) -
+                                              r.rms * r.rms * static_cast<double>(r.rows));
+    }
+  }
+}
+
 }  // namespace
 
 RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string> effects,
@@ -379,6 +405,7 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
   out.motion = log.motion;
   out.notes = fit.notes;
   out.untrusted = options.untrusted_input;
+  take_outliers(fit, out);
   return out;
 }
 
@@ -430,11 +457,14 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   out.bic = bic_of(s);
   out.weighted_rss = s.rss_w;
   out.nuisance = constants_at(d, s, runs, names);
-  out.signals = merged_signals(stats, s, raw_solution(runs, gf), gf, cols);
+  out.signals = merged_signals(stats, s, raw_solution(runs, gf), gf, cols, runs);
+  for (const RunStatistics& r : runs) out.outlier_samples += r.outlier_samples;
   out.explained = !out.signals.empty();
   for (const SignalResidual& r : out.signals) {
     if (r.rms > options.explained_ratio * r.floor) out.explained = false;
     if (std::isfinite(r.held_back_rms) && r.held_back_rms > options.explained_ratio * r.floor) out.explained = false;
+    // As explain: impulsive samples that carry a signal above its floor are no explanation.
+    if (out.outlier_samples > 0 && r.rms_with_outliers > options.explained_ratio * r.floor) out.explained = false;
   }
   out.linearised = linearised_from_zero(d, runs);
   if (const std::vector<std::string>& stepped = out.linearised; !stepped.empty()) {

@@ -59,6 +59,12 @@ struct RunStatistics {
   double electrical_revolutions = 0.0;
   MotionSummary motion;  ///< what a candidate needs of the motion is judged on the runs' together
   std::vector<std::string> notes;  ///< the run's fit's notes
+  /// Impulsive samples the run's fit left out (outliers.h) and, per group, the rows
+  /// they are and the squared residual they carry at the run's fit: a merge is then
+  /// explained only if its signals are at the floor with them too, as explain.
+  std::int64_t outlier_samples = 0;
+  std::vector<std::int64_t> outlier_rows = std::vector<std::int64_t>(kGroups, 0);
+  std::vector<double> outlier_rss = std::vector<double>(kGroups, 0.0);
   /// Signal faults that held for a large part of the run (DiscoveryOptions::untrusted_input):
   /// a merge with any is never "explained".
   std::vector<std::string> untrusted;
@@ -95,6 +101,7 @@ struct MergedFit {
   /// (ranking.h needs_exact_refit): their value and residual are approximate.
   std::vector<std::string> stepped;
   bool untrusted = false;  ///< some run's signals were faulty for long: never explained, nothing proposed
+  std::int64_t outlier_samples = 0;  ///< left out of the runs' fits (SignalResidual::rms_with_outliers)
   bool rd = false;         ///< the position error is the R/D angle's (ranking.h score_candidate)
   double bic = std::numeric_limits<double>::quiet_NaN();  ///< of the model's merged solution (fit_support.h bic_of)
   double weighted_rss = 0.0;  ///< its residual, each signal over its floor squared
