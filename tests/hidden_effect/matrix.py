@@ -201,4 +201,20 @@ XFAIL = [
     # found (mounting offset's winding frame, delay across speed steps, ranking's
     # alike(), backlash's take-up, the model-reference split, sin/cos outliers, the
     # drift's suggested block) are fixed; a new one goes here with the command that shows it.
+    #
+    # The streaming path (run_hidden_effect.py --streaming: explain --chunk against explain
+    # in memory), issue 23, still open:
+    (["*/k3_opp/*:stream_*", "*/k5/*:stream_*", "*/k2/*:stream_*", "*/mechanical_harmonics/angle1:stream_*"],
+     "a run's statistics carry each catalog effect's default columns; explain in memory tries "
+     "the harmonic orders its residual asks for (harmonics(k5), harmonics(k3_opp), a family), "
+     "whose columns the statistics do not hold yet: the merge finds no candidate that reaches "
+     "the floor (run_hidden_effect.py --streaming --generator sim k5)"),
+    (["*/backlash/*:stream_named", "*/envelope_drift/*:stream_value", "*/eccentricity/steps:stream_value",
+      "*/mounting_offset/reversals:stream_value"],
+     "each chunk is a run with its own constants (its reference zero; its sin/cos normalised by "
+     "its own amplitude), so what is a constant within a chunk is taken by them: a play split "
+     "at the reversal (one direction per chunk), a drift of the envelopes over time, part of a "
+     "mounting offset or an eccentricity's phase at one speed per chunk. Sharing the log's "
+     "constants across its chunks needs each chunk's amplitude normalisation in the statistics "
+     "(tried: sharing them without it was 0.2 se off; run_statistics_test.cpp)"),
 ]
