@@ -193,6 +193,7 @@ void read_run(const Reader& r, const json::Json& root, RunStatistics& run) {
   for (const json::Json& v : r.items(root, "values")) run.values.push_back(r.numbers(v.items));
   run.frame_shift = r.number(root, "frame_shift");
   run.columns = r.strings(root, "columns");
+  run.candidate_sets = r.strings(root, "candidate_sets");
   run.nuisance_columns = static_cast<int>(r.integer(root, "nuisance_columns"));
   run.model_columns = static_cast<int>(r.integer(root, "model_columns"));
   const std::size_t k = run.columns.size();
@@ -240,13 +241,13 @@ std::string format_run(const std::string& name, const RunStatistics& run) {
       "{{\"name\":{},\"bench\":{{\"p_r\":{},\"p\":{}}},\n"
       "\"signals\":{{\"reference\":{},\"reference_aligned\":{},\"rd\":{},\"sincos\":{},\"currents\":{}}},\n"
       "\"effects\":{},\"params\":{},\n\"values\":{},\"frame_shift\":{},\n"
-      "\"columns\":{},\"nuisance_columns\":{},\"model_columns\":{},\n\"point\":{},\n"
+      "\"columns\":{},\"candidate_sets\":{},\"nuisance_columns\":{},\"model_columns\":{},\n\"point\":{},\n"
       "\"floors\":{{\"rd\":{},\"sc\":{},\"cur\":{}}},\n"
       "\"counts\":{{\"fitted_rows\":{},\"samples\":{},\"span_s\":{},\"electrical_revolutions\":{}}},\n"
       "\"motion\":{},\n\"notes\":{},\"untrusted\":{},\n"
       "\"outliers\":{{\"samples\":{},\"rows\":{},\"rss\":{}}},\n\"groups\":{}}}",
       json::str(name), run.layout.p_r, run.layout.p, run.layout.reference, run.layout.reference_aligned,
-      run.layout.rd, run.layout.sincos, run.layout.currents, strings(run.effects), params_of(run.params), values, num(run.frame_shift), strings(run.columns), run.nuisance_columns,
+      run.layout.rd, run.layout.sincos, run.layout.currents, strings(run.effects), params_of(run.params), values, num(run.frame_shift), strings(run.columns), strings(run.candidate_sets), run.nuisance_columns,
       run.model_columns, vector_of(run.point), floor_estimate(run.floors.rd), floor_estimate(run.floors.sc),
       floor_estimate(run.floors.cur), run.fitted_rows, run.samples, num(run.span_s), num(run.electrical_revolutions),
       motion_of(run.motion), strings(run.notes), strings(run.untrusted), run.outlier_samples,

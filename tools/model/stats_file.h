@@ -6,6 +6,7 @@
 //    "log": ..., "layout": {"id", "description"},
 //    "runs": [{"name": ..., "bench": {"p_r", "p"}, "signals": {...}, "effects": [...],
 //              "params": [...], "values": [[...]], "frame_shift": ..., "columns": [...],
+//              "candidate_sets": ["harmonics(k5)", ...],
 //              "nuisance_columns": n, "model_columns": m, "point": [...],
 //              "floors": {"rd": {...}, "sc": {...}, "cur": {...}}, "counts": {...},
 //              "motion": {...}, "notes": [...], "untrusted": [...],
@@ -17,7 +18,8 @@
 // A file of another format or version, or one that does not parse, is refused naming
 // the file (InputError, usage: exit 2); so are files of different layouts in one merge.
 // Version 2 added the outliers a run's fit left out (a merge is not explained where
-// they carry a signal above its floor): a version 1 file lacks them, so it is made again.
+// they carry a signal above its floor) and the harmonic orders its residual asks for
+// (candidate_sets): a version 1 file lacks them, so it is made again.
 #pragma once
 
 #include <string>

@@ -130,16 +130,12 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
     }
     return true;
   };
-  const FitResidualSpectrum residual(fit, fit.account.fitted);
+  std::vector<const Effect*> answered;
+  for (const ModelTerm& t : residual_candidate_terms(fit, opt, &answered)) {
+    if (usable(t)) out.push_back(t);
+  }
   for (const Effect* e : effect_registry()) {
-    if (!e->fittable()) continue;
-    if (const auto sets = e->residual_candidates(residual, opt.harmonic_families)) {
-      for (const CandidateParams& set : *sets) {
-        const ModelTerm t = set.family ? family_term(*e, spec, set.groups) : listed_term(*e, spec, set.groups.front());
-        if (!t.params.empty() && usable(t)) out.push_back(t);
-      }
-      continue;
-    }
+    if (!e->fittable() || std::find(answered.begin(), answered.end(), e) != answered.end()) continue;
     if (spec.find(*e) != nullptr) continue;
     const ModelTerm t{e, default_params(*e)};
     if (!t.params.empty() && usable(t)) out.push_back(t);
@@ -370,6 +366,33 @@ void sort_by_score(std::vector<Candidate>& candidates) {
 
 }  // namespace
 
+std::vector<ModelTerm> residual_candidate_terms(const ModelFit& fit, const DiscoveryOptions& opt,
+                                                std::vector<const Effect*>* answered) {
+  std::vector<ModelTerm> out;
+  const ModelSpec& spec = fit.model.spec();
+  const FitResidualSpectrum residual(fit, fit.account.fitted);
+  for (const Effect* e : effect_registry()) {
+    if (!e->fittable()) continue;
+    const auto sets = e->residual_candidates(residual, opt.harmonic_families);
+    if (!sets) continue;
+    if (answered != nullptr) answered->push_back(e);
+    for (const CandidateParams& set : *sets) {
+      const ModelTerm t = set.family ? family_term(*e, spec, set.groups) : listed_term(*e, spec, set.groups.front());
+      if (!t.params.empty()) out.push_back(t);
+    }
+  }
+  return out;
+}
+
+bool is_family(const ModelTerm& t) { return t.params.size() >= 2 * static_cast<std::size_t>(kFamilyFrom); }
+
+void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
+  for (Candidate& c : candidates) c.fits_as_well.clear();  // ordered again after a refit: listed anew
+  sort_by_score(candidates);
+  order_alike_simplest_first(candidates, options);
+  family_first_only_alone(candidates);
+}
+
 Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
   Ranking out;
   std::vector<ModelTerm> terms = candidate_terms(log, fit, options, out.not_evaluated);
@@ -398,7 +421,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     }
     Candidate c;
     c.effect = terms[i].reference();
-    c.family = terms[i].params.size() >= 2 * static_cast<std::size_t>(kFamilyFrom);
+    c.family = is_family(terms[i]);
     score_candidate(c, s, log.rd, base, floors, options);
     c.params = term_params(d, term, s, true);
     std::erase_if(c.params, [&](const ModelParameter& pv) {
@@ -413,9 +436,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   }
   sort_by_score(out.candidates);
   refit_nonlinear(out, log, fit, base, floors, options);
-  sort_by_score(out.candidates);
-  order_alike_simplest_first(out.candidates, options);
-  family_first_only_alone(out.candidates);
+  order_ranked(out.candidates, options);
   return out;
 }
 

@@ -53,6 +53,20 @@ void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSol
 /// ones that need it. The same rule for a log in memory and for merged statistics.
 [[nodiscard]] std::vector<std::string> exact_refits(const std::vector<Candidate>& ranked, const DiscoveryOptions& options);
 
+/// The candidate terms effects ask for from the fit's residual (Effect::residual_candidates:
+/// the harmonic orders of the residual, each alone, with its quadrature part, and every
+/// significant order as a family), before the log's checks; the model's own parameters
+/// are left out. `answered` (may be null) gets each effect that answered.
+[[nodiscard]] std::vector<ModelTerm> residual_candidate_terms(const ModelFit& fit, const DiscoveryOptions& opt,
+                                                              std::vector<const Effect*>* answered = nullptr);
+
+/// A harmonic family: every significant order at once (named first only alone).
+[[nodiscard]] bool is_family(const ModelTerm& t);
+
+/// explain's order of scored candidates: best BIC first, candidates the log cannot tell
+/// apart simplest first (fits_as_well), a family first only when nothing smaller does.
+void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& options);
+
 /// Ranks the candidates for the fitted model `fit` on `log`.
 [[nodiscard]] Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options);
 

@@ -21,11 +21,41 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A candidate the run's layout allows: the model lacks it, and the signals it needs are there.
-bool candidate_for(const Effect& e, const ModelSpec& spec, const PreparedLog& log) {
-  if (!e.fittable() || spec.find(e) != nullptr) return false;
+bool signals_allow(const Effect& e, const PreparedLog& log) {
+  if (!e.fittable()) return false;
   if (e.needs_reference() && !log.reference) return false;
   if (e.needs_aligned_reference() && !log.reference_aligned) return false;
   return !(e.current_side() && !log.currents);
+}
+
+bool candidate_for(const Effect& e, const ModelSpec& spec, const PreparedLog& log) {
+  return spec.find(e) == nullptr && signals_allow(e, log);
+}
+
+/// The candidates' columns of a run: an effect that asks its residual which of its
+/// parameters to try (the harmonic orders: ranking.h residual_candidate_terms) gets one
+/// term over every parameter its sets need, and the sets are kept by name for the merge
+/// to score each as explain does; every other effect the model lacks, its default term.
+void add_candidate_columns(Design& d, const ModelFit& fit, const PreparedLog& log, const DiscoveryOptions& options,
+                           std::vector<std::string>& sets) {
+  std::vector<const Effect*> answered;
+  const std::vector<ModelTerm> terms = residual_candidate_terms(fit, options, &answered);
+  for (const Effect* e : effect_registry()) {
+    if (std::find(answered.begin(), answered.end(), e) == answered.end()) {
+      if (candidate_for(*e, fit.model.spec(), log)) d.add_candidate(ModelTerm{e, default_params(*e)});
+      continue;
+    }
+    if (!signals_allow(*e, log)) continue;
+    std::vector<int> params;
+    for (const ModelTerm& t : terms) {
+      if (t.effect != e) continue;
+      params.insert(params.end(), t.params.begin(), t.params.end());
+      sets.push_back(t.reference());
+    }
+    std::sort(params.begin(), params.end());
+    params.erase(std::unique(params.begin(), params.end()), params.end());
+    if (!params.empty()) d.add_candidate(ModelTerm{e, params});
+  }
 }
 
 /// Position of `name` in `names`, or -1.
@@ -268,7 +298,6 @@ std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const 
   return out;
 }
 
-/// Every candidate term of `d` (after the model's) scored against `base`.
 /// The model's nonlinear effects that some run has only as a candidate (columns at
 /// zero): their merged value is one linearised step from there, and the residual the
 /// statistics give for it leaves out the step's second-order terms (a 1 % quadrature
@@ -293,36 +322,68 @@ std::vector<std::string> linearised_from_zero(const Design& d, const std::vector
   return out;
 }
 
-/// What the runs' motion together lacks for candidates (motion_missing): every run's
-/// speeds and reversals.
+/// One candidate scored from the merged statistics: `set` (a subset of candidate term
+/// `i`'s parameters) with the model's columns.
+void score_merged(const Design& d, std::size_t i, const ModelTerm& set, const MergedStatistics& stats,
+                  const StepSolution& base, const GroupFloors& floors, bool rd, const DiscoveryOptions& options,
+                  MergedFit& out) {
+  std::vector<int> cols = model_columns(d);
+  const DesignTerm& t = d.terms()[i];
+  for (int p : set.params) {
+    const auto k = std::find(t.params.begin(), t.params.end(), p);
+    if (k == t.params.end()) {
+      out.not_evaluated.push_back(set.reference() + ": not in every run's statistics");
+      return;
+    }
+    cols.push_back(d.term_column(i) + static_cast<int>(k - t.params.begin()));
+  }
+  const StepSolution s = solve_step(stats.all, floors, cols);
+  if (!s.ok) {
+    out.not_evaluated.push_back(set.reference() + ": not separable from the model with the merged runs");
+    return;
+  }
+  Candidate c;
+  c.effect = set.reference();
+  c.family = is_family(set);
+  score_candidate(c, s, rd, base, floors, options);
+  c.params = term_params(d, i, s, true);
+  std::erase_if(c.params, [&](const ModelParameter& pv) {
+    for (std::size_t k = 0; k < set.params.size(); ++k) {
+      if (pv.name == set.param_name(k)) return false;
+    }
+    return true;
+  });
+  c.reason = reason_of(set, c.params);
+  out.candidates.push_back(std::move(c));
+}
+
+/// Every candidate term of `d` (after the model's) scored against `base`: an effect's
+/// sets as the reference run's fit asked for them (RunStatistics::candidate_sets), else
+/// its whole term. What the runs' motion together lacks for candidates (motion_missing):
+/// every run's speeds and reversals.
 void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolution& base, const GroupFloors& floors,
-                 const std::vector<RunStatistics>& runs, const DiscoveryOptions& options, MergedFit& out) {
+                 const std::vector<RunStatistics>& runs, std::size_t ref, const DiscoveryOptions& options,
+                 MergedFit& out) {
   MotionSummary motion;
   for (std::size_t r = 0; r < runs.size(); ++r) add_motion(motion, runs[r].motion, r == 0);
   const bool rd = runs.front().layout.rd;
-  const std::vector<int> base_cols = model_columns(d);
   for (std::size_t i = 0; i < d.terms().size(); ++i) {
     if (!d.terms()[i].candidate) continue;
-    std::vector<int> cols = base_cols;
-    for (int c : term_columns(d, i)) cols.push_back(c);
     const ModelTerm term{d.terms()[i].effect, d.terms()[i].params};
     if (const std::string missing = motion_missing(*term.effect, motion, runs.front().layout.sincos && rd); !missing.empty()) {
       out.not_evaluated.push_back(term.reference() + ": not identifiable in these runs: " + missing);
       continue;
     }
-    const StepSolution s = solve_step(stats.all, floors, cols);
-    if (!s.ok) {
-      out.not_evaluated.push_back(term.reference() + ": not separable from the model with the merged runs");
-      continue;
+    bool by_sets = false;
+    for (const std::string& name : runs[ref].candidate_sets) {
+      const ModelSpec one = ModelSpec::parse(std::vector<std::string>{name}, options.customs);
+      if (one.terms.front().effect != term.effect) continue;
+      by_sets = true;
+      score_merged(d, i, one.terms.front(), stats, base, floors, rd, options, out);
     }
-    Candidate c;
-    c.effect = term.reference();
-    score_candidate(c, s, rd, base, floors, options);
-    c.params = term_params(d, i, s, true);
-    c.reason = reason_of(term, c.params);
-    out.candidates.push_back(std::move(c));
+    if (!by_sets) score_merged(d, i, term, stats, base, floors, rd, options, out);
   }
-  std::sort(out.candidates.begin(), out.candidates.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
+  order_ranked(out.candidates, options);
 }
 
 /// How far the runs' own fits of the nonlinear parameters lie from the merged value,
@@ -388,11 +449,7 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
   out.frame_shift = d.frame_shift(0);
   out.nuisance_columns = d.nuisance_columns();
   out.model_columns = d.columns() - d.nuisance_columns();
-  for (const Effect* e : effect_registry()) {
-    if (options.statistics_candidates && candidate_for(*e, fit.model.spec(), log)) {
-      d.add_candidate(ModelTerm{e, default_params(*e)});
-    }
-  }
+  if (options.statistics_candidates) add_candidate_columns(d, fit, log, options, out.candidate_sets);
   out.columns = d.column_names();
   out.point = d.z();
   out.stats = PassStatistics(d.columns());
@@ -482,7 +539,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
                                       names[r], u));
     }
   }
-  rank_merged(d, stats, s, gf, runs, options, out);
+  rank_merged(d, stats, s, gf, runs, ref, options, out);
   for (const Candidate& c : out.candidates) {
     if (needs_exact_refit(c, options)) out.stepped.push_back(c.effect);
   }
@@ -550,8 +607,7 @@ void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& 
   c.reason = reason_of(term, c.params);
   m.refitted.push_back(effect);
   std::erase(m.stepped, effect);
-  std::stable_sort(m.candidates.begin(), m.candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
+  order_ranked(m.candidates, options);
 }
 
 }  // namespace resolver

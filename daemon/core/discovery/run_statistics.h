@@ -43,6 +43,10 @@ struct RunStatistics {
   /// Every column's name: the run's nuisances ("nuisance.sr_gain"), then the model's
   /// parameters, then the candidates' ("quadrature.beta").
   std::vector<std::string> columns;
+  /// The candidate terms the run's residual asked for (ranking.h residual_candidate_terms,
+  /// e.g. "harmonics(k5)", "harmonics(k5,k5_q)"): subsets of one candidate term's columns
+  /// per effect, scored apart by the merge as explain scores them.
+  std::vector<std::string> candidate_sets;
   int nuisance_columns = 0;  ///< the first columns are the run's own constants
   int model_columns = 0;     ///< then the model's parameters; the rest are candidates
   /// Internal coordinate (design.h) of every column at the linearisation point: the
@@ -125,7 +129,7 @@ struct MergedFit {
 
 /// Replaces candidate `effect` of `m` by its exact fit: `with` merges the same runs'
 /// statistics made with the model plus `effect` (every run fitted to convergence with
-/// it), as explain refits a log in memory. The candidates are sorted again.
+/// it), as explain refits a log in memory. The candidates are ordered again (ranking.h order_ranked).
 void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& with, const DiscoveryOptions& options);
 
 }  // namespace resolver
