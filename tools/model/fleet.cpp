@@ -1,7 +1,5 @@
 #include "tools/model/fleet.h"
 
-#include "daemon/core/discovery/pool.h"
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -12,8 +10,6 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <new>
-#include <set>
 #include <sstream>
 #include <system_error>
 
@@ -24,7 +20,6 @@
 #include "tools/model/html_report.h"
 #include "tools/model/json_text.h"
 #include "tools/model/json_value.h"
-#include "tools/model/log_samples.h"
 
 namespace resolver {
 

@@ -222,8 +222,12 @@ def main(argv=None):
             cluster.close()
     # The merge and the summary, here: the manifest by its absolute path, so that its
     # relative logs resolve to the paths the workers were given.
-    proc = subprocess.run([resolver_model, "fleet", os.path.abspath(args.manifest), "--out", out_dir, "--merge-only",
-                           *extra], text=True, errors="replace")
+    try:
+        proc = subprocess.run([resolver_model, "fleet", os.path.abspath(args.manifest), "--out", out_dir,
+                               "--merge-only", *extra], text=True, errors="replace")
+    except OSError as e:  # resolver-model not found here: the statistics stay for a later --merge-only
+        print(f"resolver_bench.fleet: cannot run {resolver_model} fleet --merge-only: {e}", file=sys.stderr)
+        return EXIT_IO
     return proc.returncode
 
 
