@@ -1,7 +1,5 @@
 #include "tools/model/fleet.h"
 
-#include "daemon/core/discovery/pool.h"
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -12,18 +10,16 @@
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <new>
-#include <set>
 #include <sstream>
 #include <system_error>
 
 #include "daemon/service/program_errors.h"
 #include "daemon/service/table_file.h"
+#include "tools/model/fleet_merge.h"
 #include "tools/model/fleet_page.h"
 #include "tools/model/html_report.h"
 #include "tools/model/json_text.h"
 #include "tools/model/json_value.h"
-#include "tools/model/log_samples.h"
 
 namespace resolver {
 
@@ -43,167 +39,10 @@ bool safe_unit_name(const std::string& u) {
   return std::all_of(u.begin(), u.end(), [](unsigned char c) { return std::isalnum(c) || c == '_' || c == '-' || c == '.'; });
 }
 
-// ---- one log, one unit -------------------------------------------------------------
-
-struct LogResult {
-  std::string log;
-  std::string error;  ///< empty: fitted
-  int p_r = 0, p = 0;
-  Explanation ex;
-};
-
-LogResult explain_log(const std::string& log, const FleetOptions& o) {
-  LogResult r;
-  r.log = log;
-  try {
-    if (!fs::exists(log)) throw std::system_error(std::make_error_code(std::errc::no_such_file_or_directory), log);
-    LogSamples samples = read_log_samples(log, {}, o.config);
-    DiscoveryOptions options = o.discovery;
-    const FaultCounts faults = fault_counts(samples);
-    options.untrusted_input = lasting_faults(faults, samples.health_samples, kUntrustedFaultShare);
-    r.p_r = samples.input.p_r;
-    r.p = samples.input.p;
-    r.ex = explain_model(samples.input, o.effects, options);
-  } catch (const std::bad_alloc&) {
-    throw;  // out of memory is the whole run's problem (exit 4), not one unit's
-  } catch (const std::system_error& e) {
-    r.error = std::string("cannot read the log: ") + e.what();
-  } catch (const std::exception& e) {
-    r.error = e.what();
-  }
-  return r;
-}
-
-double ratio(const ModelFit& f) { return f.residual_rms_rad / f.noise_floor_rad; }
-
-std::string params_json(const std::vector<ModelParameter>& params) {
-  std::string o = "{";
-  for (std::size_t i = 0; i < params.size(); ++i) {
-    o += (i ? "," : "") + json::str(params[i].name) + ":{\"value\":" + json::num(params[i].value) +
-         ",\"stderr\":" + json::num(params[i].std_error) + ",\"unit\":" + json::str(params[i].unit) + "}";
-  }
-  return o + "}";
-}
-
 std::string strings_json(const std::vector<std::string>& v) {
   std::string o = "[";
   for (std::size_t i = 0; i < v.size(); ++i) o += (i ? "," : "") + json::str(v[i]);
   return o + "]";
-}
-
-std::string fit_fields(const Explanation& ex) {
-  const ModelFit& f = ex.fit;
-  std::vector<std::string> proposed;
-  for (const auto& c : ex.candidates) {
-    if (c.proposed) proposed.push_back(c.effect);
-  }
-  return fmt::format(
-      "\"verdict\":{},\"residual_rms_rad\":{},\"noise_floor_rad\":{},\"residual_over_floor\":{},\"effects\":{},"
-      "\"params\":{},\"proposed\":{}",
-      json::str(to_string(ex.verdict)), json::num(f.residual_rms_rad), json::num(f.noise_floor_rad),
-      json::num(ratio(f)), strings_json(f.effects), params_json(f.params), strings_json(proposed));
-}
-
-/// The unit's logs whose own fit disagrees with its other logs (pool.h's rule: the
-/// consensus of the logs that agree, beyond kPoolDisagreementZ standard errors).
-std::string disagreements_json(const std::vector<LogResult>& logs, std::vector<std::string>& names) {
-  std::vector<ModelFit> fits;
-  std::vector<std::string> log_names;
-  for (const LogResult& l : logs) {
-    fits.push_back(l.ex.fit);
-    log_names.push_back(l.log);
-  }
-  std::string o = "[";
-  if (fits.empty()) return o + "]";
-  for (const PoolDisagreement& d : compare_with_pool(fits.front(), fits, log_names)) {
-    if (!(std::abs(d.z) > kPoolDisagreementZ)) continue;
-    if (std::find(names.begin(), names.end(), d.parameter) == names.end()) names.push_back(d.parameter);
-    o += (o.size() > 1 ? "," : "") +
-         fmt::format("{{\"param\":{},\"log\":{},\"value\":{},\"others\":{},\"others_stderr\":{},\"z\":{}}}",
-                     json::str(d.parameter), json::str(d.log), json::num(d.value), json::num(d.others),
-                     json::num(d.others_std_error), json::num(d.z, 4));
-  }
-  return o + "]";
-}
-
-void write_failed_unit(const std::string& dir, const std::string& unit, const std::string& reason,
-                       std::size_t log_rows, const std::string& logs_json) {
-  write_text_file(dir + "/unit.json",
-                  fmt::format("{{\"unit\":{},\"status\":\"failed\",\"reason\":{},\"log_rows\":{},\"logs\":{}}}\n",
-                              json::str(unit), json::str(reason), log_rows, logs_json));
-}
-
-/// Returns false when the unit failed.
-bool run_unit(const std::string& unit, const std::vector<ManifestRow>& rows, const std::string& manifest,
-              const std::string& out_dir, const FleetOptions& o) {
-  const std::string dir = out_dir + "/" + unit;
-  fs::create_directories(dir);
-  for (const char* stale : {"unit.json", "calibration.csv", "calibration.json", "calibration.h"}) fs::remove(dir + "/" + stale);
-  std::vector<std::string> problems;
-  // The same log twice (however spelt): its fit would count twice.
-  std::map<std::string, std::uint64_t> seen;
-  for (const auto& r : rows) {
-    std::error_code ec;
-    const std::string key = fs::weakly_canonical(r.log, ec).string();
-    const auto [it, fresh] = seen.emplace(ec ? r.log : key, r.line);
-    if (!fresh) {
-      problems.push_back(fmt::format("{}:{}: log {} is listed twice for unit {} (also line {})", manifest, r.line,
-                                     r.log, unit, it->second));
-    }
-  }
-  std::vector<LogResult> logs;
-  std::string logs_json = "[";
-  if (problems.empty()) {
-    for (const auto& r : rows) {
-      logs.push_back(explain_log(r.log, o));
-      const LogResult& l = logs.back();
-      logs_json += (logs.size() > 1 ? "," : "") + std::string("{\"log\":") + json::str(l.log);
-      if (!l.error.empty()) {
-        problems.push_back(fmt::format("{} (manifest line {}): {}", l.log, r.line, l.error));
-        logs_json += ",\"status\":\"failed\",\"reason\":" + json::str(l.error) + "}";
-        continue;
-      }
-      logs_json += fmt::format(",\"status\":\"done\",\"p_r\":{},\"p\":{},{}}}", l.p_r, l.p, fit_fields(l.ex));
-    }
-    for (const auto& l : logs) {
-      if (l.error.empty() && !logs.empty() && logs.front().error.empty() && l.p_r != logs.front().p_r) {
-        problems.push_back(fmt::format("{} has p_r = {}, {} has p_r = {}", l.log, l.p_r,
-                                       logs.front().log, logs.front().p_r));
-      }
-    }
-  }
-  logs_json += "]";
-  if (!problems.empty()) {
-    const std::string reason = fmt::format("{}", fmt::join(problems, "; "));
-    std::cerr << "resolver-model fleet: unit " << unit << " failed: " << reason << "\n";
-    write_failed_unit(dir, unit, reason, rows.size(), logs_json);
-    return false;
-  }
-  // The unit's calibration: its log with the smallest residual against its floor.
-  const auto best = std::min_element(logs.begin(), logs.end(),
-                                     [](const LogResult& a, const LogResult& b) { return ratio(a.ex.fit) < ratio(b.ex.fit); });
-  const ModelFit& fit = best->ex.fit;
-  const CalibrationTable table = tabulate(fit.model, o.points);
-  write_text_file(dir + "/calibration.csv", calibration_text(table, best->log, "csv"));
-  write_text_file(dir + "/calibration.json", calibration_text(table, best->log, "json"));
-  write_text_file(dir + "/calibration.h", calibration_text(table, best->log, "c-header"));
-  std::vector<std::string> disagreeing;
-  const std::string disagreements = disagreements_json(logs, disagreeing);
-  std::string needed = "null";
-  if (best->ex.verdict == Verdict::kMissingEffect && !best->ex.candidates.empty()) {
-    needed = json::str(best->ex.candidates.front().effect);
-  }
-  write_text_file(dir + "/unit.json",
-                  fmt::format("{{\"unit\":{},\"status\":\"done\",\"calibration_log\":{},\"p_r\":{},\"p\":{},{},"
-                              "\"needed\":{},\"disagreeing\":{},\"disagreements\":{},\"log_rows\":{},"
-                              "\"files\":[\"calibration.csv\",\"calibration.json\",\"calibration.h\"],\"logs\":{}}}\n",
-                              json::str(unit), json::str(best->log), best->p_r, best->p, fit_fields(best->ex), needed,
-                              strings_json(disagreeing), disagreements, rows.size(), logs_json));
-  if (!disagreeing.empty()) {
-    std::cerr << "resolver-model fleet: unit " << unit << ": its logs disagree on " << fmt::format("{}", fmt::join(disagreeing, ", "))
-              << " (one log beyond 4 standard errors of the unit's other logs; unit.json: disagreements)\n";
-  }
-  return true;
 }
 
 // ---- the summary ------------------------------------------------------------------
@@ -494,7 +333,10 @@ int run_fleet_units(const std::vector<ManifestRow>& rows, const std::string& man
   for (const auto& r : rows) units[r.unit].push_back(r);
   int failed = 0;
   for (const auto& [unit, unit_rows] : units) {
-    if (!run_unit(unit, unit_rows, manifest, out_dir, options)) ++failed;
+    if (!options.merge_only) {
+      for (const ManifestRow& r : unit_rows) (void)write_row_statistics(r, out_dir, options);
+    }
+    if (!merge_unit(unit, unit_rows, manifest, out_dir, options)) ++failed;
   }
   return failed;
 }

@@ -1,13 +1,17 @@
 // resolver-model fleet (issue 24 parts 3-4): a production line's calibrations, one unit
 // per folder, and the fleet's summary.
 //
-//   MANIFEST (CSV "unit,log") ─► per unit: each log read and explained (the code explain
-//   runs) ─► DIR/UNIT/unit.json + the calibration of its best log (export's formats)
+//   MANIFEST (CSV "unit,log") ─► per row: the log's statistics (the code `stats` runs)
+//       ─► DIR/UNIT/stats/LINE.stats, or DIR/UNIT/stats/LINE.error with the reason
+//   per unit: its rows' statistics files merged (fleet_merge.h, merge's code)
+//       ─► DIR/UNIT/unit.json + the calibration of the merged parameters (export's formats)
 //   DIR/*/unit.json ─► summarize_fleet ─► DIR/fleet.json + a text table ─► DIR/fleet.html (fleet_page.h)
 //
-// The summary is computed from the unit.json files only, so a fleet run on one machine
-// and one whose units ran elsewhere (tools/python/resolver_bench, Dask) give the same
-// fleet.json by construction.
+// --merge-only skips the first step: the statistics were written elsewhere (Dask workers,
+// tools/python/resolver_bench/fleet.py; GNU parallel running `resolver-model stats`).
+// The merge reads the files in both cases and the summary reads only the unit.json
+// files, so a run on one machine and one whose logs ran elsewhere give the same
+// unit.json and fleet.json by construction.
 #pragma once
 
 #include <string>
@@ -37,11 +41,14 @@ struct FleetOptions {
   DaemonConfig config;
   DiscoveryOptions discovery;
   int points = 1024;                 ///< calibration table points
+  /// The rows' statistics files are already in DIR/UNIT/stats/: only merge and summarize.
+  bool merge_only = false;
 };
 
-/// Runs every unit of `rows` into out_dir/UNIT/ (unit.json + calibration.{csv,json,h});
-/// a unit that fails gets a unit.json saying why, and a line on stderr naming the unit
-/// and the file. Returns the number of units that failed.
+/// Runs every unit of `rows` into out_dir/UNIT/ (stats/ unless merge_only, then
+/// unit.json + calibration.{csv,json,h}); a unit that fails gets a unit.json saying why,
+/// and a line on stderr naming the unit, the manifest line and the file. Returns the
+/// number of units that failed.
 int run_fleet_units(const std::vector<ManifestRow>& rows, const std::string& manifest, const std::string& out_dir,
                     const FleetOptions& options);
 

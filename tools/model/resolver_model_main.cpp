@@ -192,15 +192,21 @@ constexpr const char* kFleetExamples = R"(Examples:
   # a richer model for every unit; only recompute fleet/fleet.json from fleet/*/unit.json
   resolver-model fleet units.csv --out fleet/ --effects amplitude_imbalance,quadrature
   resolver-model fleet --summarize fleet/
-  # the same units on a Dask cluster (one task per unit): python3 -m resolver_bench.fleet
-Writes OUT/UNIT/unit.json (verdict, residual vs floor, parameters with standard errors, each
-log's fit, parameters the unit's logs disagree on), OUT/UNIT/calibration.{csv,json,h} (export's
-formats, from the unit's log with the smallest residual/floor) and OUT/fleet.json (per parameter
+  # the statistics made elsewhere (one `resolver-model stats LOG --out fleet/UNIT/stats/LINE.stats`
+  # per manifest row, LINE its line in units.csv): merge each unit and summarize
+  resolver-model fleet units.csv --out fleet/ --merge-only
+  # the same on a Dask cluster (one task per log, the merge here): python3 -m resolver_bench.fleet
+Writes OUT/UNIT/stats/LINE.stats per manifest row (stats's file; LINE.error with the reason
+when the log fails), OUT/UNIT/unit.json (the merge of the unit's statistics: verdict, residual
+vs floor, parameters with standard errors, each log's own fit, parameters the unit's logs
+disagree on), OUT/UNIT/calibration.{csv,json,h} (export's formats, of the merged parameters)
+and OUT/fleet.json (per parameter
 median, robust spread = 1.4826 MAD and quantiles; proposed effects; outlier units, robust z > 4;
 failed units with the reason) with OUT/fleet.html, the same on one self-contained page (every
 parameter's strip plot with the outliers named, the effects the units need, every unit's row).
-A unit fails, and the others go on, when a log is missing,
-unreadable or has no usable data, is listed twice, or has another p_r than the fleet.
+A unit fails, and the others go on, when a log is missing, unreadable or has no usable
+data (or has no statistics file with --merge-only), is listed twice, or has another p_r
+than the fleet; unit.json names each such log with its manifest line and reason.
 Exit 0 when every unit is done, 1 when some unit failed (fleet.json says which and why).)";
 
 constexpr const char* kStatsExamples = R"(Examples:
@@ -227,10 +233,13 @@ std::string sub_footer(const char* examples) {
 
 /// `fleet`: every unit of MANIFEST into OUT, then OUT/fleet.json; or --summarize DIR alone.
 int run_fleet(const std::string& manifest, const std::string& out, const std::string& summarize_dir,
-              std::vector<std::string> effects, const std::string& config_path, int points) {
+              std::vector<std::string> effects, const std::string& config_path, int points, bool merge_only) {
   using resolver::Fault, resolver::InputError, resolver::Where;
   if (!summarize_dir.empty() && (!manifest.empty() || !out.empty())) {
     throw InputError(Fault::kUsage, "--summarize DIR takes no MANIFEST or --out", Where::at_option("fleet"));
+  }
+  if (!summarize_dir.empty() && merge_only) {
+    throw InputError(Fault::kUsage, "--merge-only needs MANIFEST --out DIR, not --summarize", Where::at_option("fleet"));
   }
   int failed = 0;
   if (!summarize_dir.empty()) {
@@ -257,6 +266,7 @@ int run_fleet(const std::string& manifest, const std::string& out, const std::st
   }
   options.effects = effects;
   options.points = points;
+  options.merge_only = merge_only;
   options.discovery.max_report_order = resolver::kOfflineReportOrder;
   options.discovery.harmonic_families = true;
   options.discovery.customs = options.config.model.customs.get();
@@ -292,6 +302,7 @@ struct Arguments {
   std::string export_format = "csv", export_out;  // export
   int export_points = 1024;  // export and fleet
   std::string manifest, fleet_out, summarize_dir;  // fleet
+  bool merge_only = false;                         // fleet
   std::string stats_out;                // stats
   double chunk_s = 0.0;                 // stats: one run per chunk of this many seconds
   std::vector<std::string> stats_files;  // merge
@@ -459,7 +470,10 @@ void add_calibration_subcommands(CLI::App& app, Arguments& a, Subcommands& subs)
   fleet->add_option("--out", a.fleet_out, "folder for OUT/UNIT/ and OUT/fleet.json (created)");
   fleet->add_option("--summarize", a.summarize_dir,
                     "only recompute DIR/fleet.json from DIR/*/unit.json (units run elsewhere, e.g. on Dask)");
-  fleet->add_option("--effects", a.effects_args, "the model every log is fitted with, as for explain");
+  fleet->add_flag("--merge-only", a.merge_only,
+                  "only merge the statistics already in OUT/UNIT/stats/LINE.stats (written by resolver-model stats "
+                  "elsewhere) and summarize");
+  fleet->add_option("--effects", a.effects_args, "the model every log is fitted with, as for stats");
   fleet->add_option("--points", a.export_points, "calibration table points per mechanical revolution (default 1024)")
       ->check(CLI::Range(8, 1 << 20));
   fleet->add_option("--config", a.config_path, "resolverd config (TOML), as for explain");
@@ -721,7 +735,7 @@ int run(int argc, char** argv) {
   if (!a.logs.empty()) a.log = a.logs.front();
   if (a.command == Command::kFleet) {
     return run_fleet(a.manifest, a.fleet_out, a.summarize_dir, split_effects(a.effects_args), a.config_path,
-                     a.export_points);
+                     a.export_points, a.merge_only);
   }
   if (a.command == Command::kMerge) {
     for (const std::string& f : a.stats_files) resolver::exit_code::require_readable("STATS", f);  // IoError: exit 3

@@ -1,18 +1,27 @@
 #!/usr/bin/env python3
 """Issue 24 parts 3-4 through the real programs: a production line of simulated units.
 
-  --part single   resolver-model fleet on 25 units (2 s logs from resolver-sim, seeds and
+  --part single   resolver-model fleet on 27 units (2 s logs from resolver-sim, seeds and
                   alpha varied per unit; one unit with a large quadrature, one with a far-off
-                  alpha, one with two logs): the two outliers are named with their parameter
-                  and nothing else is; a corrupt log, a missing log, a log listed twice and a
-                  p_r = 1 log fail their unit only, with the reason, and exit 1. The fleet's
+                  alpha, one with two logs that agree, one with two logs whose alpha differs):
+                  the two outliers are named with their parameter and nothing else is; the
+                  two logs that differ are named in their unit's disagreements (the merge's
+                  comparisons); a corrupt log, a missing log, a log listed twice and a
+                  p_r = 1 log fail their unit only, with the reason, and exit 1. Each row's
+                  statistics file (UNIT/stats/LINE.stats, or LINE.error with the reason) is
+                  the bytes `resolver-model stats` writes; fleet --merge-only on them gives
+                  the same unit.json files; a row without statistics fails its unit, named
+                  with its line; a one-log unit's calibration is `export`'s table. The fleet's
                   page (fleet.html) parses with html.parser, refers to nothing outside itself
                   (scripts inline; its links are the units' own files), and names every unit,
                   the outliers in its outlier table and the failed units with their reason.
-  --part dask     the same fleet through python3 -m resolver_bench.fleet --local 2: fleet.json
-                  equals the single-process one (the failed units' reasons name the manifest
-                  each run saw, so only their names are compared); then again with a worker
-                  killed (SIGKILL) while it runs a unit: every unit still completes.
+  --part dask     the same fleet through python3 -m resolver_bench.fleet --local 2 (one task
+                  per log running resolver-model stats, the merge on the client): every
+                  statistics file, unit.json, calibration file and fleet.json is byte-identical
+                  to the single-process run's, except the failed rows' reasons (resolver-model
+                  stats' message from another process) and the calibration files' date line;
+                  then again with a worker killed (SIGKILL) while it runs a log: every unit
+                  still completes with the same results.
                   Exit 77 (skipped) when Dask (python3-distributed) is not installed.
 
   test_fleet.py --bin build/bin --work build/integration_fleet --part single|dask
@@ -21,6 +30,7 @@ import argparse
 import json
 import os
 import random
+import re
 import shutil
 import signal
 import subprocess
@@ -75,6 +85,9 @@ def make_fleet():
             rows.append(("unit01", sim("unit01b.log", 301, f"amplitude_imbalance:alpha={alpha:.6f}")))
     rows.append(("quad", sim("quad.log", 201, "amplitude_imbalance:alpha=0.003", "quadrature:beta=0.01")))
     rows.append(("faralpha", sim("faralpha.log", 202, "amplitude_imbalance:alpha=0.03")))
+    # Two runs of one unit whose gains differ (0.0030 against 0.0033): the merge names them.
+    rows.append(("drift", sim("drift_a.log", 205, "amplitude_imbalance:alpha=0.0030")))
+    rows.append(("drift", sim("drift_b.log", 206, "amplitude_imbalance:alpha=0.0033")))
     rows.append(("pr1", sim("pr1.log", 203, "amplitude_imbalance:alpha=0.003", extra=("--p-r", "1"))))
     with open(os.path.join(logs, "unit01.log"), "rb") as f:
         head = f.read(4000)
@@ -90,6 +103,7 @@ def make_fleet():
 
 
 FAILED = {"corrupt", "missing", "twice", "pr1"}
+DONE = GOOD_UNITS + 3  # and quad, faralpha, drift
 
 
 def single_run(out):
@@ -99,16 +113,56 @@ def single_run(out):
     return proc, time.monotonic() - t0
 
 
+def rows_by_unit():
+    """{unit: [(manifest line, absolute log), ...]} of the test's manifest."""
+    units = {}
+    with open(make_fleet()) as f:
+        for n, line in enumerate(f, 1):
+            unit, log = line.strip().split(",")
+            if n > 1:
+                units.setdefault(unit, []).append((n, os.path.normpath(os.path.join(ARGS.work, log))))
+    return units
+
+
+def table_rows(path):
+    """A calibration CSV's numeric rows (its comment and header lines left out)."""
+    rows = []
+    with open(path) as f:
+        for line in f:
+            try:
+                rows.append([float(x) for x in line.strip().split(",")])
+            except ValueError:
+                continue
+    return rows
+
+
 def load(path):
     with open(path) as f:
         return json.load(f)
 
 
 def comparable(fleet):
-    """fleet.json without the failed units' reasons (they name the manifest each run read)."""
+    """fleet.json without the failed units' reasons (a worker's resolver-model stats message against the fleet's own)."""
     fleet = dict(fleet)
     fleet["failed"] = sorted(f["unit"] for f in fleet["failed"])
     return fleet
+
+
+def read_bytes(*parts):
+    with open(os.path.join(*parts), "rb") as f:
+        return f.read()
+
+
+def without_date(text):
+    """A calibration file without its date (ISO 8601 UTC, when it was written)."""
+    return re.sub(rb"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ", b"DATE", text)
+
+
+def without_reasons(unit):
+    """A failed unit.json without the reasons (a worker's message against the fleet's own)."""
+    unit = dict(unit, reason=None)
+    unit["logs"] = [dict(l, reason=None) for l in unit["logs"]]
+    return unit
 
 
 VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source", "track", "wbr"}
@@ -207,11 +261,11 @@ class SingleProcess(unittest.TestCase):
 
     def test_counts(self):
         f = self.fleet
-        self.assertEqual(f["units_total"], GOOD_UNITS + 2 + len(FAILED))
-        self.assertEqual(f["units_done"], GOOD_UNITS + 2)
+        self.assertEqual(f["units_total"], DONE + len(FAILED))
+        self.assertEqual(f["units_done"], DONE)
         self.assertEqual(f["units_failed"], len(FAILED))
         self.assertEqual(f["p_r"], 3)
-        self.assertIn(f"{GOOD_UNITS + 2} done, {len(FAILED)} failed", self.proc.stdout)
+        self.assertIn(f"{DONE} done, {len(FAILED)} failed", self.proc.stdout)
 
     def test_outliers_named_with_their_parameter(self):
         flagged = {(o["unit"], o["param"]) for o in self.fleet["outliers"]}
@@ -232,7 +286,7 @@ class SingleProcess(unittest.TestCase):
 
     def test_spread_statistics(self):
         alpha = self.fleet["params"]["amplitude_imbalance.alpha"]
-        self.assertEqual(alpha["units"], GOOD_UNITS + 2)
+        self.assertEqual(alpha["units"], DONE)
         self.assertAlmostEqual(alpha["median"], 0.003, delta=0.0004)
         self.assertLess(alpha["spread"], 0.0006)
         self.assertLessEqual(alpha["q05"], alpha["q25"])
@@ -271,6 +325,84 @@ class SingleProcess(unittest.TestCase):
         self.assertEqual(open(work("single", "fleet.json")).read(), before)
         self.assertEqual(open(work("single", "fleet.html"), encoding="utf-8").read(), page)
         self.assertIn("fleet.html", proc.stdout)
+
+    def test_logs_that_differ_are_named(self):
+        u = load(work("single", "drift", "unit.json"))
+        self.assertEqual(u["status"], "done")
+        self.assertEqual(u["merged_logs"], 2)
+        self.assertEqual(u["disagreeing"], ["amplitude_imbalance.alpha"])
+        named = {os.path.basename(d["log"]) for d in u["disagreements"]}
+        self.assertEqual(named, {"drift_a.log", "drift_b.log"})  # of two logs that differ, both
+        for d in u["disagreements"]:
+            self.assertGreater(abs(d["z"]), 4)
+        self.assertIn("unit drift: its logs disagree on amplitude_imbalance.alpha", self.proc.stderr)
+        # Each log's own fit is kept beside the merge's: the values the comparison used.
+        own = sorted(l["params"]["amplitude_imbalance.alpha"]["value"] for l in u["logs"])
+        self.assertAlmostEqual(own[0], 0.0030, delta=0.0001)
+        self.assertAlmostEqual(own[1], 0.0033, delta=0.0001)
+        self.assertLess(own[0], u["params"]["amplitude_imbalance.alpha"]["value"])
+        self.assertLess(u["params"]["amplitude_imbalance.alpha"]["value"], own[1])
+
+    def test_statistics_files_per_row(self):
+        manifest = rows_by_unit()
+        for unit, rows in manifest.items():
+            for line, _ in rows:
+                stats = work("single", unit, "stats", f"{line}.stats")
+                error = work("single", unit, "stats", f"{line}.error")
+                self.assertNotEqual(os.path.exists(stats), os.path.exists(error), (unit, line))  # exactly one
+        line, _ = manifest["corrupt"][0]
+        with open(work("single", "corrupt", "stats", f"{line}.error")) as f:
+            self.assertTrue(f.read().strip())
+        corrupt = load(work("single", "corrupt", "unit.json"))
+        self.assertEqual(corrupt["logs"][0]["line"], line)
+        self.assertEqual(corrupt["logs"][0]["status"], "failed")
+        self.assertIn(f"manifest line {line}", corrupt["reason"])
+        # The fleet's statistics are the bytes resolver-model stats writes for the log.
+        line, log = manifest["unit05"][0]
+        own = work("unit05_own.stats")
+        run([binary("resolver-model"), "stats", log, "--out", own, "--effects", EFFECTS])
+        with open(own, "rb") as a, open(work("single", "unit05", "stats", f"{line}.stats"), "rb") as b:
+            self.assertEqual(a.read(), b.read())
+
+    def test_one_log_calibration_is_exports_table(self):
+        _, log = rows_by_unit()["unit05"][0]
+        table = work("unit05_export.csv")
+        run([binary("resolver-model"), "export", log, "--effects", EFFECTS, "--out", table])
+        exported, merged = table_rows(table), table_rows(work("single", "unit05", "calibration.csv"))
+        self.assertEqual(len(exported), len(merged))
+        self.assertGreater(len(merged), 100)
+        for e, m in zip(exported, merged):
+            self.assertEqual(len(e), len(m))
+            for x, y in zip(e, m):
+                self.assertAlmostEqual(x, y, delta=1e-8)  # the same fit, rounded apart (3e-10 of 1.3e-3 rad seen)
+
+    def test_merge_only_gives_the_same_and_names_a_missing_row(self):
+        out = work("merge_only")
+        shutil.rmtree(out, ignore_errors=True)
+        shutil.copytree(work("single"), out)
+        for name in ("fleet.json", "fleet.html"):
+            os.remove(os.path.join(out, name))
+        for unit in os.listdir(out):
+            if os.path.exists(os.path.join(out, unit, "unit.json")):
+                os.remove(os.path.join(out, unit, "unit.json"))
+        run([binary("resolver-model"), "fleet", make_fleet(), "--out", out, "--merge-only", "--effects", EFFECTS],
+            expect_rc=1)
+        for unit in rows_by_unit():
+            with open(os.path.join(out, unit, "unit.json")) as a, open(work("single", unit, "unit.json")) as b:
+                self.assertEqual(a.read(), b.read(), unit)
+        with open(os.path.join(out, "fleet.json")) as a, open(work("single", "fleet.json")) as b:
+            self.assertEqual(a.read(), b.read())
+        # A row whose statistics are gone fails its unit, named with its line: never dropped.
+        line, _ = rows_by_unit()["unit07"][0]
+        os.remove(os.path.join(out, "unit07", "stats", f"{line}.stats"))
+        proc = run([binary("resolver-model"), "fleet", make_fleet(), "--out", out, "--merge-only", "--effects",
+                    EFFECTS], expect_rc=1)
+        u = load(os.path.join(out, "unit07", "unit.json"))
+        self.assertEqual(u["status"], "failed")
+        self.assertIn(f"manifest line {line}", u["reason"])
+        self.assertIn("no statistics", u["reason"])
+        self.assertIn("unit unit07", proc.stderr)
+        self.assertIn("unit07", {f["unit"] for f in load(os.path.join(out, "fleet.json"))["failed"]})
 
 
 class OutlierTolerance(unittest.TestCase):
@@ -369,7 +501,10 @@ class FleetPage(unittest.TestCase):
         self.assertIn("No such file", named["missing"])
         self.assertIn("listed twice", named["twice"])
         self.assertIn("p_r = 1", named["pr1"])
-        self.assertRegex(self.html, rf"{GOOD_UNITS + 2} explained.*0 missing_effect.*0 unexplained.*{len(FAILED)} failed")
+        verdicts = [u["verdict"] for u in self.fleet["units"]]
+        self.assertGreaterEqual(verdicts.count("explained"), GOOD_UNITS)
+        self.assertRegex(self.html, rf"{verdicts.count('explained')} explained.*{verdicts.count('missing_effect')} "
+                                    rf"missing_effect.*{verdicts.count('unexplained')} unexplained.*{len(FAILED)} failed")
 
     def test_strip_plots(self):
         data = [s for s in self.page.scripts if s["attrs"].get("id") == "report-data"]
@@ -398,7 +533,7 @@ class OnDask(unittest.TestCase):
         _, cls.single_seconds = single_run(work("single"))
         cls.single = load(work("single", "fleet.json"))
 
-    def test_same_fleet_json_as_single_process(self):
+    def test_same_files_as_single_process(self):
         out = work("dask")
         shutil.rmtree(out, ignore_errors=True)
         t0 = time.monotonic()
@@ -406,12 +541,35 @@ class OnDask(unittest.TestCase):
         seconds = time.monotonic() - t0
         print(f"\n{self.single['units_total']} units: single process {self.single_seconds:.2f} s, "
               f"Dask --local 2 {seconds:.2f} s (cluster start included)", file=sys.stderr)
-        self.assertEqual(comparable(load(os.path.join(out, "fleet.json"))), comparable(self.single))
-        self.assertIn("unit corrupt", proc.stderr)
-        _, page = parse_page(os.path.join(out, "fleet.html"))  # the page too, through --summarize
+        self.assertSameFiles(out)
+        self.assertRegex(proc.stderr, r"unit corrupt: .*corrupt.log \(manifest line \d+\)")
+        self.assertIn("unit corrupt failed", proc.stderr)  # and the merge says the unit failed
+        _, page = parse_page(os.path.join(out, "fleet.html"))  # the page too, through the merge's summary
         self.assertEqual(page.errors, [])
         self.assertIn(("quad", "quadrature.beta"), {(r[0], r[1]) for r in page.tables["params outliers"][1:]})
-        self.assertFalse(os.path.exists(os.path.join(out, ".tasks")))
+        for unit in rows_by_unit():  # no attempt's temporary file left behind
+            self.assertEqual([n for n in os.listdir(os.path.join(out, unit, "stats")) if n.startswith(".")], [])
+
+    def assertSameFiles(self, out):
+        """Every file of the single-process run, byte for byte, but for what legitimately differs:
+        a failed row's reason (resolver-model stats' message from the worker against the fleet's
+        in-process one) and the calibration files' date (when they were written)."""
+        single = work("single")
+        for unit, rows in rows_by_unit().items():
+            for line, _ in rows:
+                stats = os.path.join(unit, "stats", f"{line}.stats")
+                self.assertEqual(os.path.exists(os.path.join(out, stats)), os.path.exists(os.path.join(single, stats)))
+                if os.path.exists(os.path.join(single, stats)):
+                    self.assertEqual(read_bytes(out, stats), read_bytes(single, stats), stats)
+            mine, theirs = load(os.path.join(out, unit, "unit.json")), load(os.path.join(single, unit, "unit.json"))
+            if theirs["status"] == "done":
+                self.assertEqual(read_bytes(out, unit, "unit.json"), read_bytes(single, unit, "unit.json"), unit)
+                for name in ("calibration.csv", "calibration.json", "calibration.h"):
+                    self.assertEqual(without_date(read_bytes(out, unit, name)),
+                                     without_date(read_bytes(single, unit, name)), (unit, name))
+            else:
+                self.assertEqual(without_reasons(mine), without_reasons(theirs), unit)
+        self.assertEqual(comparable(load(os.path.join(out, "fleet.json"))), comparable(self.single))
 
     def test_a_worker_killed_mid_run(self):
         out = work("dask_kill")
@@ -419,11 +577,11 @@ class OnDask(unittest.TestCase):
         pids = work("worker_pids")
         if os.path.exists(pids):
             os.remove(pids)
-        # resolver-model, slowed down, noting the worker process that runs it (its parent)
+        # resolver-model stats, slowed down, noting the worker process that runs it (its parent)
         wrapper = work("slow-resolver-model")
         with open(wrapper, "w") as f:
             f.write(f"""#!/bin/sh
-if [ "$2" != "--summarize" ]; then echo $PPID >> '{pids}'; sleep 0.4; fi
+if [ "$1" = "stats" ]; then echo $PPID >> '{pids}'; sleep 0.4; fi
 exec '{binary("resolver-model")}' "$@"
 """)
         os.chmod(wrapper, 0o755)
@@ -444,10 +602,9 @@ exec '{binary("resolver-model")}' "$@"
         except subprocess.TimeoutExpired:
             client.kill()
             stdout, stderr = client.communicate()
-        self.assertIsNotNone(killed, "no worker was seen running a unit")
+        self.assertIsNotNone(killed, "no worker was seen running a log")
         self.assertEqual(client.returncode, 1, stdout[-2000:] + stderr[-3000:])
-        fleet = load(os.path.join(out, "fleet.json"))
-        self.assertEqual(comparable(fleet), comparable(self.single), stderr[-3000:])
+        self.assertSameFiles(out)
 
 
 def main():
