@@ -103,7 +103,8 @@ void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with,
         for (const NamedRun& r : f.runs) runs.push_back(r.run);
       }
       if (runs.size() != merged.runs.size()) {
-        throw std::invalid_argument(fmt::format("{} of the {} runs could be fitted with it", runs.size(), merged.runs.size()));
+        not_refitted(fmt::format("{} of the {} runs could be fitted with it", runs.size(), merged.runs.size()).c_str());
+        continue;
       }
       take_exact_refit(merged.fit, effect, merge_runs(runs, merged.names, effects, options), options);
     } catch (const std::invalid_argument& e) {

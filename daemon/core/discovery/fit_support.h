@@ -2,6 +2,7 @@
 // the columns of a design's model, residual rms per signal, the verdict test.
 #pragma once
 
+#include <array>
 #include <span>
 #include <string>
 #include <vector>
@@ -10,6 +11,9 @@
 #include "daemon/core/model/least_squares.h"
 
 namespace resolver {
+
+/// SignalResidual::signal of each group (least_squares.h Group).
+inline constexpr std::array<const char*, kGroups> kGroupSignals{"position_error", "sin_cos", "i_dq"};
 
 /// Why a mounting offset cannot be fitted against an unaligned reference.
 inline constexpr std::string_view kNeedsAlignedReference =

@@ -225,14 +225,14 @@ Eigen::MatrixXd parameter_covariance(const StepSolution& s, const ResidualPass& 
 std::vector<std::string> signal_residuals(const PreparedLog& log, const FitResult& fr, const ResidualPass& pass,
                                           const StepSolution& raw, const GroupFloors& floors,
                                           const std::vector<int>& cols, ModelFit& f) {
-  const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
+  const auto& names = kGroupSignals;
   std::vector<std::string> convergence_notes;
   const double gf[kGroups] = {floors.rd, floors.sc, floors.cur};
   const StepSolution& s = fr.last;
   for (int g = 0; g < kGroups; ++g) {
     if (!(gf[g] > 0.0) || s.n[g] == 0) continue;
     SignalResidual r;
-    r.signal = names[g];
+    r.signal = names[static_cast<std::size_t>(g)];
     // The residual with the prediction evaluated at the fitted values. The step's
     // own figure is linearised; where they differ the fit has not converged (a
     // nonlinear parameter at its bound, or out of passes) and the evaluated one is
@@ -243,7 +243,7 @@ std::vector<std::string> signal_residuals(const PreparedLog& log, const FitResul
       f.converged = false;
       convergence_notes.push_back(fmt::format("{}: the fit did not converge: evaluated residual {:.4g} against its linearised "
                                     "{:.4g} (a nonlinear parameter at its bound, or the passes ran out)",
-                                    names[g], r.rms, linearised));
+                                    names[static_cast<std::size_t>(g)], r.rms, linearised));
     }
     r.floor = gf[g];
     r.raw_rms = rms(raw.rss[g], raw.n[g]);

@@ -272,13 +272,13 @@ StepSolution raw_solution(const std::vector<RunStatistics>& runs, const GroupFlo
 std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const StepSolution& s, const StepSolution& raw,
                                            const GroupFloors& floors, const std::vector<int>& cols,
                                            const std::vector<RunStatistics>& runs) {
-  const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
+  const auto& names = kGroupSignals;
   std::vector<SignalResidual> out;
   for (int g = 0; g < kGroups; ++g) {
     const double f = floors.of(static_cast<Group>(g));
     if (!(f > 0.0) || s.n[g] == 0) continue;
     SignalResidual r;
-    r.signal = names[g];
+    r.signal = names[static_cast<std::size_t>(g)];
     r.rms = rms(s.rss[g], s.n[g]);
     r.floor = f;
     r.raw_rms = raw.ok ? rms(raw.rss[g], raw.n[g]) : kNaN;
@@ -422,11 +422,11 @@ std::string nonlinear_note(const Design& d, const std::vector<RunStatistics>& ru
 /// The outlier rows of the run's fit per group, and what they carry at its solution.
 void take_outliers(const ModelFit& fit, RunStatistics& out) {
   for (const OutlierSignal& o : fit.outliers) out.outlier_samples += o.count;
-  const char* names[kGroups] = {"position_error", "sin_cos", "i_dq"};
+  const auto& names = kGroupSignals;
   for (const SignalResidual& r : fit.signals) {
     for (int g = 0; g < kGroups; ++g) {
       // Without an R/D angle the fit's "position_error" is the sin/cos angle's, not group 0.
-      if (r.signal != names[g] || (g == 0 && !out.layout.rd)) continue;
+      if (r.signal != names[static_cast<std::size_t>(g)] || (g == 0 && !out.layout.rd)) continue;
       const auto gi = static_cast<std::size_t>(g);
       out.outlier_rows[gi] = std::max<std::int64_t>(0, r.rows_with_outliers - r.rows);
       out.outlier_rss[gi] = std::max(0.0, r.rms_with_outliers * r.rms_with_outliers * static_cast<double>(r.rows_with_outliers) -
@@ -597,11 +597,9 @@ void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& 
   const ModelSpec one = ModelSpec::parse(std::vector<std::string>{effect}, options.customs);
   const ModelTerm& term = one.terms.front();
   c.params.clear();
-  for (int p : term.params) {
-    const std::string name =
-        std::string(term.effect->name()) + "." + std::string(term.effect->params()[static_cast<std::size_t>(p)].name);
+  for (std::size_t k = 0; k < term.params.size(); ++k) {
     for (const ModelParameter& q : with.params) {
-      if (q.name == name) c.params.push_back(q);
+      if (q.name == term.param_name(k)) c.params.push_back(q);
     }
   }
   c.reason = reason_of(term, c.params);
