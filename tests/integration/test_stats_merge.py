@@ -232,6 +232,17 @@ def main():
     c.check(r.returncode == 1 and "no chunk of the log could be fitted" in r.stderr and "4 bins" in r.stderr,
             f"a one-turn sweep in 5 s chunks: exit 1, each chunk's missing angle range named ({r.returncode})")
 
+    # What the reader counted travels with the statistics: a log with a 0.5 s gap (frames
+    # cut out) says so in its file and in the merge's notes, as explain says it.
+    lines = a.read_text().splitlines()
+    t0 = float(lines[0][1:lines[0].index(")")])
+    gap = w / "gap.log"
+    gap.write_text("\n".join(l for l in lines if not 2.8 <= float(l[1:l.index(")")]) - t0 < 3.3) + "\n")
+    counted = [n for n in json.loads(stats(model, gap, w / "gap.stats").read_text())["input"] if "input problems" in n]
+    merged_gap = merge(model, [w / "gap.stats"])
+    c.check(bool(counted) and any(counted[0] in n for n in merged_gap["notes"]),
+            f"a log with a gap: its counted input problems are in the statistics file and the merge's notes ({counted})")
+
     # 6. bad input
     text = sa.read_text()
     bad = {"v1.stats": text.replace('"version":2', '"version":1', 1), "cut.stats": text[: len(text) // 2],

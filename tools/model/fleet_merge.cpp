@@ -39,6 +39,7 @@ StatsFile log_statistics(const std::string& log, const FleetOptions& o) {
   StatsFile file = stats_file_header(log, o.config);
   add_run(file, log, samples.input, o.effects, options);
   mark_untrusted(file, options.untrusted_input);
+  file.input = input_notes(samples);
   return file;
 }
 
@@ -204,15 +205,16 @@ CalibrationTable merged_table(const MergedFit& m, const PoolLayout& layout, cons
 }
 
 /// The unit's runs, each named by its row's log (a chunked file's runs by log and span,
-/// as merge names them).
+/// as merge names them); `notes` gets what the statistics left out and the reader counted.
 void collect_runs(const std::vector<RowResult>& rows, std::vector<RunStatistics>& runs,
-                  std::vector<std::string>& names, std::vector<std::string>& left_out) {
+                  std::vector<std::string>& names, std::vector<std::string>& notes) {
   for (const RowResult& r : rows) {
     for (const NamedRun& n : r.file.runs) {
       names.push_back(r.file.runs.size() == 1 ? r.row->log : r.row->log + ": " + n.name.substr(n.name.rfind(" [") + 1));
       runs.push_back(n.run);
     }
-    for (const std::string& l : r.file.left_out) left_out.push_back("left out when the statistics were made: " + l);
+    for (const std::string& l : r.file.left_out) notes.push_back("left out when the statistics were made: " + l);
+    for (const std::string& n : r.file.input) notes.push_back(r.row->log + ": " + n);
   }
 }
 
@@ -300,10 +302,10 @@ bool merge_unit(const std::string& unit, const std::vector<ManifestRow>& rows, c
     }
   }
   std::vector<RunStatistics> runs;
-  std::vector<std::string> names, left_out;
+  std::vector<std::string> names, file_notes;
   MergedFit merged;
   if (problems.empty()) {
-    collect_runs(results, runs, names, left_out);
+    collect_runs(results, runs, names, file_notes);
     try {
       merged = merge_runs(runs, names, o.effects, o.discovery);
     } catch (const std::invalid_argument& e) {
@@ -316,7 +318,7 @@ bool merge_unit(const std::string& unit, const std::vector<ManifestRow>& rows, c
     write_failed_unit(dir, unit, reason, rows.size(), logs_json(results));
     return false;
   }
-  merged.notes.insert(merged.notes.end(), left_out.begin(), left_out.end());
+  merged.notes.insert(merged.notes.end(), file_notes.begin(), file_notes.end());
   write_done_unit(dir, unit, results, merged, runs.front().layout, o);
   return true;
 }

@@ -235,4 +235,11 @@ FaultCounts fault_counts(const LogSamples& log) {
   return c;
 }
 
+std::vector<std::string> input_notes(const LogSamples& samples) {
+  std::vector<std::string> notes = samples.notes;
+  if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
+  if (samples.problems > 0) notes.push_back(std::to_string(samples.problems) + " input problems counted (by reason above: a gap is counted, not skipped)");
+  return notes;
+}
+
 }  // namespace resolver

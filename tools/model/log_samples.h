@@ -22,6 +22,13 @@
 
 namespace resolver {
 
+struct LogSamples;
+
+/// What the reader said and counted, in the report's words: its notes, the malformed
+/// lines skipped, the input problems counted (every program prints these, and a
+/// statistics file keeps them).
+[[nodiscard]] std::vector<std::string> input_notes(const LogSamples& samples);
+
 struct LogSamples {
   DiscoveryInput input;
   std::int64_t frames = 0;         ///< frames (or CSV rows) read

@@ -600,12 +600,7 @@ resolver::Explanation fit_or_explain(const resolver::LogSamples& samples, const 
 }
 
 /// The report's notes: the reader's, then what it skipped and counted.
-std::vector<std::string> report_notes(const resolver::LogSamples& samples) {
-  std::vector<std::string> notes = samples.notes;
-  if (samples.bad_lines > 0) notes.push_back(std::to_string(samples.bad_lines) + " malformed log lines skipped");
-  if (samples.problems > 0) notes.push_back(std::to_string(samples.problems) + " input problems counted (by reason above: a gap is counted, not skipped)");
-  return notes;
-}
+std::vector<std::string> report_notes(const resolver::LogSamples& samples) { return resolver::input_notes(samples); }
 
 /// fit or explain of two or more logs together.
 int run_on_logs(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown) {
@@ -655,6 +650,7 @@ resolver::StatsFile statistics_of_log(const Arguments& a, const Model& model, co
                                resolver::Where::at_file(a.log));
   }
   resolver::mark_untrusted(file, options.untrusted_input);
+  file.input = resolver::input_notes(samples);
   return file;
 }
 

@@ -263,9 +263,10 @@ std::string format_stats_file(const StatsFile& file) {
     runs += (i > 0 ? ",\n" : "\n") + format_run(file.runs[i].name, file.runs[i].run);
   }
   return fmt::format("{{\"format\":{},\"version\":{},\"tool\":{},\"log\":{},\n"
-                     "\"layout\":{{\"id\":{},\"description\":{}}},\n\"left_out\":{},\n\"runs\":[{}]}}\n",
+                     "\"layout\":{{\"id\":{},\"description\":{}}},\n\"left_out\":{},\n\"input\":{},\n\"runs\":[{}]}}\n",
                      json::str(kFormat), kStatsFileVersion, json::str(file.tool), json::str(file.log),
-                     json::str(file.layout_id), json::str(file.layout_description), strings(file.left_out), runs);
+                     json::str(file.layout_id), json::str(file.layout_description), strings(file.left_out),
+                     strings(file.input), runs);
 }
 
 StatsFile parse_stats_file(const std::string& text, const std::string& path) {
@@ -292,6 +293,7 @@ StatsFile parse_stats_file(const std::string& text, const std::string& path) {
   out.layout_id = r.text(r.at(root, "layout"), "id");
   out.layout_description = r.text(r.at(root, "layout"), "description");
   out.left_out = r.strings(root, "left_out");
+  out.input = r.strings(root, "input");
   for (const json::Json& j : r.items(root, "runs")) {
     NamedRun run;
     run.name = r.text(j, "name");

@@ -3,7 +3,7 @@
 // reads back exactly (every double with 17 significant digits).
 //
 //   {"format": "resolver-model stats", "version": 2, "tool": "resolver-model ...",
-//    "log": ..., "layout": {"id", "description"},
+//    "log": ..., "layout": {"id", "description"}, "left_out": [...], "input": [...],
 //    "runs": [{"name": ..., "bench": {"p_r", "p"}, "signals": {...}, "effects": [...],
 //              "params": [...], "values": [[...]], "frame_shift": ..., "columns": [...],
 //              "candidate_sets": ["harmonics(k5)", ...],
@@ -46,6 +46,9 @@ struct StatsFile {
   std::string tool;                ///< the version line of the program that wrote it
   /// Chunks of the log no fit could be made of, each with its time span and reason.
   std::vector<std::string> left_out;
+  /// What the reader said and counted (log_samples.h input_notes): malformed lines,
+  /// input problems, what the log lacks; a merge prints them.
+  std::vector<std::string> input;
 };
 
 /// The file's text.

@@ -57,6 +57,7 @@ void write_stats_file(const StatsFile& file, const std::string& out) {
                            file.runs.size() == 1 ? "" : "s", fmt::join(r.effects, ","), r.columns.size(),
                            r.columns.size() - static_cast<std::size_t>(r.nuisance_columns + r.model_columns));
   for (const std::string& l : file.left_out) std::cout << "left out: " << l << "\n";
+  for (const std::string& n : file.input) std::cout << "note: " << n << "\n";
 }
 
 int run_merge(const std::vector<std::string>& paths, std::span<const std::string> effects, bool json,
@@ -86,6 +87,7 @@ MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<s
   }
   for (const StatsFile& f : files) {
     for (const std::string& l : f.left_out) out.fit.notes.push_back("left out when the statistics were made: " + l);
+    for (const std::string& n : f.input) out.fit.notes.push_back(f.log + ": " + n);
   }
   return out;
 }
