@@ -627,9 +627,10 @@ int run_on_logs(const Arguments& a, const Model& model, const resolver::Progress
 
 /// The log's statistics, whole or one run per chunk (--chunk S).
 resolver::StatsFile statistics_of_log(const Arguments& a, const Model& model, const resolver::ProgressMeter::Options& shown,
-                                      bool candidates = true) {
+                                      bool candidates = true, const resolver::FitStartValues& start = {}) {
   resolver::DiscoveryOptions options = discovery_options(a, model.config);
   options.statistics_candidates = candidates;
+  options.start = start;
   resolver::StatsFile file = resolver::stats_file_header(a.log, model.config);
   std::function<void(resolver::DiscoveryInput&&)> on_chunk;
   if (a.chunk_s > 0.0) {
@@ -663,19 +664,20 @@ int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMe
   }
   const std::vector<std::string> logs = a.logs.empty() ? std::vector<std::string>{a.log} : a.logs;
   // The first pass keeps every candidate's columns; a refit's only the model's.
-  const auto statistics_with = [&](const std::vector<std::string>& effects, bool candidates) {
+  const auto statistics_with = [&](const std::vector<std::string>& effects, bool candidates,
+                                    const resolver::FitStartValues& start) {
     Model with = model;
     with.effects = effects;
     std::vector<resolver::StatsFile> files;
     for (const std::string& log : logs) {
       Arguments one = a;
       one.log = log;
-      files.push_back(statistics_of_log(one, with, shown, candidates));
+      files.push_back(statistics_of_log(one, with, shown, candidates, start));
     }
     return files;
   };
   const resolver::DiscoveryOptions options = discovery_options(a, model.config);
-  resolver::MergedFiles merged = resolver::merge_files(statistics_with(model.effects, true), logs, {}, options);
+  resolver::MergedFiles merged = resolver::merge_files(statistics_with(model.effects, true, {}), logs, {}, options);
   if (a.command == Command::kExplain) {
     // As explain in memory: a candidate whose linearised step is not its fit is refitted,
     // here by a further pass over the logs (they are files: read again).
@@ -685,7 +687,11 @@ int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMe
     });
     if (readable_again) {
       resolver::refit_from_logs(
-          merged, [&](const std::vector<std::string>& effects) { return statistics_with(effects, false); }, options);
+          merged,
+          [&](const std::vector<std::string>& effects, const resolver::FitStartValues& start) {
+            return statistics_with(effects, false, start);
+          },
+          options);
     } else if (!resolver::candidates_to_refit(merged.fit, options).empty()) {
       merged.fit.notes.emplace_back("the candidates are not refitted: a log is not a regular file and cannot be read "
                                     "a second time (their scores are one linearised step)");

@@ -92,6 +92,22 @@ MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<s
   return out;
 }
 
+namespace {
+
+/// Where the runs' refits with `effect` start: the merged model settled, the candidate at
+/// its merged linearised step.
+FitStartValues merged_start(const MergedFit& fit, const std::string& effect) {
+  FitStartValues start;
+  start.values = fit.params;
+  start.settled = fit.effects;
+  for (const Candidate& c : fit.candidates) {
+    if (c.effect == effect) start.values.insert(start.values.end(), c.params.begin(), c.params.end());
+  }
+  return start;
+}
+
+}  // namespace
+
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
   for (const std::string& effect : candidates_to_refit(merged.fit, options)) {
     const auto not_refitted = [&](const char* why) {
@@ -101,7 +117,7 @@ void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with,
     effects.push_back(effect);
     try {
       std::vector<RunStatistics> runs;
-      for (const StatsFile& f : statistics_with(effects)) {
+      for (const StatsFile& f : statistics_with(effects, merged_start(merged.fit, effect))) {
         for (const NamedRun& r : f.runs) runs.push_back(r.run);
       }
       if (runs.size() != merged.runs.size()) {

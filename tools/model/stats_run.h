@@ -47,14 +47,18 @@ struct MergedFiles {
 [[nodiscard]] MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
                                       std::span<const std::string> effects, const DiscoveryOptions& options);
 
-/// The same logs' statistics made again with the model `effects` (one file per log, the
-/// runs in the same order): a second pass over the logs.
-using StatisticsWith = std::function<std::vector<StatsFile>(const std::vector<std::string>& effects)>;
+/// The same logs' statistics made again with the model `effects`, each run's fit started
+/// at `start` (one file per log, the runs in the same order): a second pass over the logs.
+using StatisticsWith =
+    std::function<std::vector<StatsFile>(const std::vector<std::string>& effects, const FitStartValues& start)>;
 
 /// explain on statistics, as on a log in memory: each candidate whose linearised step is
 /// not its fit (candidates_to_refit) is refitted to convergence by making the statistics
-/// again with it in the model, and scored by that merge (take_exact_refit). A refit that
-/// fails leaves the candidate linearised, with a note saying why.
+/// again with it in the model, and scored by that merge (take_exact_refit). Each run's
+/// refit starts at the merged fit: the model's values settled, the candidate's from its
+/// merged linearised step (with its own other starts), as the in-memory refit starts at
+/// the model's converged fit. A refit that fails leaves the candidate linearised, with a
+/// note saying why.
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options);
 
 /// Prints `merged` as text or JSON on stdout.

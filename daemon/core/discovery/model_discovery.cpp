@@ -305,6 +305,22 @@ bool at_floor(const ModelFit& f, double explained_ratio) {
   return ok;
 }
 
+/// Sets the model's parameters named in `start` and returns which terms are settled
+/// (fit_design's flags, in the model's term order).
+std::vector<bool> start_at(const FitStartValues& start, Model& model) {
+  const std::vector<ModelParameter> own = model.parameters();
+  for (const ModelParameter& p : start.values) {
+    const bool known = std::any_of(own.begin(), own.end(), [&](const ModelParameter& o) { return o.name == p.name; });
+    if (known && std::isfinite(p.value)) model.set(p.name, p.value);
+  }
+  const std::vector<std::string> refs = model.spec().references();
+  std::vector<bool> settled(refs.size(), false);
+  for (std::size_t i = 0; i < refs.size(); ++i) {
+    settled[i] = std::find(start.settled.begin(), start.settled.end(), refs[i]) != start.settled.end();
+  }
+  return settled;
+}
+
 }  // namespace
 
 ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effects, const DiscoveryOptions& options) {
@@ -314,10 +330,14 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   ModelFit f;
   f.model = Model(spec, log.p_r, log.p);
   f.effects = spec.references();
+  const std::vector<bool> settled = start_at(options.start, f.model);
   Design d = design_for(f.model, log);
-  const FitResult fr = fit_design(d, log.rows, floors, 12, [&] {
-    if (options.progress) options.progress(0.1);
-  });
+  const FitResult fr = fit_design(
+      d, log.rows, floors, 12,
+      [&] {
+        if (options.progress) options.progress(0.1);
+      },
+      settled);
   if (!fr.ok) {
     throw_if_custom_term_not_finite(f.effects, log, options);
     throw std::invalid_argument(fmt::format(

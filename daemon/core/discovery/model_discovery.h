@@ -38,6 +38,17 @@ class CustomEffects;
 /// catalog's highest winding harmonic (k20).
 inline constexpr int kOfflineReportOrder = 20;
 
+/// Where a fit starts instead of the effects' defaults (issue 23: a chunk's exact refit
+/// started from the merged fit of the whole log, as the in-memory refit starts from
+/// the model's converged fit).
+struct FitStartValues {
+  /// Start values by parameter name ("quadrature.beta"); names the model lacks are ignored.
+  std::vector<ModelParameter> values;
+  /// Effect references whose start values are a converged fit: fitted from that start
+  /// only (least_squares.h fit_design `settled`).
+  std::vector<std::string> settled;
+};
+
 struct DiscoveryOptions {
   /// A signal is explained when its residual rms <= explained_ratio x its noise floor (issue 4: 1.5).
   double explained_ratio = 1.5;
@@ -68,6 +79,8 @@ struct DiscoveryOptions {
   /// A run's statistics keep every candidate's columns (run_statistics.h); without, only
   /// the model's: a candidate's exact refit needs no others.
   bool statistics_candidates = true;
+  /// Start values of the fit (fit_prepared); empty = the effects' defaults.
+  FitStartValues start;
   /// Slicing of the log's samples (direction, moving only).
   PrepareOptions prepare;
   /// The config's [[model.custom]] effects (may be null): usable in models and ranked as candidates.

@@ -300,7 +300,11 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     with.add(term);
     Design dm(with, fit.model.values(), nuisances_for(log));
     dm.set_parts(log.part_count());
-    const FitResult fr = fit_design(dm, log.rows, floors);
+    // The model's terms start at its converged fit (their valleys chosen there, with
+    // their other starts); only the candidate's own parameters are started again.
+    std::vector<bool> settled(dm.terms().size(), true);
+    settled.back() = false;
+    const FitResult fr = fit_design(dm, log.rows, floors, 12, {}, settled);
     out.passes += fr.passes;
     if (!fr.ok) continue;
     score_candidate(c, fr.last, log.rd, base, floors, options);

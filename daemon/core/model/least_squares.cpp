@@ -354,14 +354,14 @@ std::vector<double> other_starts(const ParamInfo& p, double start) {
 }  // namespace
 
 FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
-                     const std::function<void()>& progress) {
+                     const std::function<void()>& progress, const std::vector<bool>& settled) {
   const Design start = design;
   FitResult best = fit_from_start(design, rows, floors, max_passes, progress);
   // Several starts for the parameters whose cost is multimodal: keep the lowest cost
   // among the fits that ended (issue 21: a single start diverged into a far valley).
   for (std::size_t i = 0; i < start.terms().size(); ++i) {
     const DesignTerm& t = start.terms()[i];
-    if (t.candidate) continue;
+    if (t.candidate || (i < settled.size() && settled[i])) continue;
     for (int p : t.params) {
       const ParamInfo& info = t.effect->params()[static_cast<std::size_t>(p)];
       if (!info.nonlinear || info.polar != Polar::kNone) continue;

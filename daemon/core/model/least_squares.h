@@ -78,8 +78,13 @@ struct FitResult {
 /// Fits the design's model parameters (candidates are not moved): Gauss-Newton,
 /// with Levenberg-Marquardt damping when a nonlinear step does not lower the
 /// cost; one pass for a linear design, at most `max_passes`. `progress` (may be
-/// empty) is called after each pass.
+/// empty) is called after each pass. A nonlinear parameter whose cost has several
+/// valleys is fitted from other starts too, unless its term is `settled` (one flag per
+/// design term; empty = none): its values are already a converged fit, whose valley
+/// was chosen then (the model's terms when one more effect is refitted with them, a
+/// chunk started from the merged fit of the log).
 [[nodiscard]] FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors,
-                                   int max_passes = 12, const std::function<void()>& progress = {});
+                                   int max_passes = 12, const std::function<void()>& progress = {},
+                                   const std::vector<bool>& settled = {});
 
 }  // namespace resolver
