@@ -204,11 +204,6 @@ XFAIL = [
     #
     # The streaming path (run_hidden_effect.py --streaming: explain --chunk against explain
     # in memory), issue 23, still open:
-    (["*/mechanical_harmonics/angle1:stream_*"],
-     "not yet diagnosed: p_r = 1 with only the R/D and reference angles; explain in memory names "
-     "harmonics(k3_q) (a twin of mechanical_harmonics(b2)) at the floor, the merge of the two "
-     "chunks (one direction each) ranks quadrature first, above the floor: unexplained "
-     "(run_hidden_effect.py --streaming --generator sim --profile angle1 mechanical_harmonics)"),
     (["*/backlash/*:stream_named", "*/envelope_drift/*:stream_value", "*/eccentricity/steps:stream_value",
       "*/mounting_offset/reversals:stream_value"],
      "each chunk is a run with its own constants (its reference zero; its sin/cos normalised by "

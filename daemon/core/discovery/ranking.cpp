@@ -244,6 +244,29 @@ bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options) {
   return nonlinear;
 }
 
+StepSolution solve_candidate(const std::vector<NormalEquations>& groups, const GroupFloors& floors,
+                             const std::vector<int>& base_cols, std::span<const int> term_cols, ModelTerm& t) {
+  std::vector<int> cols = base_cols;
+  cols.insert(cols.end(), term_cols.begin(), term_cols.end());
+  StepSolution s = solve_step(groups, floors, cols);
+  if (s.ok || t.params.size() <= 1) return s;
+  StepSolution best_part;
+  std::size_t best_k = 0;
+  for (std::size_t k = 0; k < term_cols.size(); ++k) {
+    if (t.effect->params()[static_cast<std::size_t>(t.params[k])].polar != Polar::kNone) continue;
+    std::vector<int> one = base_cols;
+    one.push_back(term_cols[k]);
+    const StepSolution part = solve_step(groups, floors, one);
+    if (part.ok && (!best_part.ok || part.rss_w < best_part.rss_w)) {
+      best_part = part;
+      best_k = k;
+    }
+  }
+  if (!best_part.ok) return s;
+  t = ModelTerm{t.effect, {t.params[best_k]}};
+  return best_part;
+}
+
 std::vector<std::string> exact_refits(const std::vector<Candidate>& ranked, const DiscoveryOptions& options) {
   std::vector<std::string> out;
   for (const Candidate& c : ranked) {
@@ -256,33 +279,6 @@ std::vector<std::string> exact_refits(const std::vector<Candidate>& ranked, cons
 
 namespace {
 
-/// The linearised step of candidate `term` (design `d`) on the model's columns.
-/// Part of a multi-parameter candidate may be the model's already (a 2 theta_m
-/// order at p_r = 1 without sin/cos: its sin part is alpha's): then each parameter
-/// alone is tried and the best the log separates kept (`t` narrowed to it).
-StepSolution solve_candidate(const Design& d, std::size_t term, ModelTerm& t, const PassStatistics& stats,
-                             const GroupFloors& floors, const std::vector<int>& base_cols) {
-  const std::vector<int> tcols = term_columns(d, term);
-  std::vector<int> cols = base_cols;
-  cols.insert(cols.end(), tcols.begin(), tcols.end());
-  StepSolution s = solve_step(stats.all, floors, cols);
-  if (s.ok || t.params.size() <= 1) return s;
-  StepSolution best_part;
-  std::size_t best_k = 0;
-  for (std::size_t k = 0; k < tcols.size(); ++k) {
-    if (t.effect->params()[static_cast<std::size_t>(t.params[k])].polar != Polar::kNone) continue;
-    std::vector<int> one = base_cols;
-    one.push_back(tcols[k]);
-    const StepSolution part = solve_step(stats.all, floors, one);
-    if (part.ok && (!best_part.ok || part.rss_w < best_part.rss_w)) {
-      best_part = part;
-      best_k = k;
-    }
-  }
-  if (!best_part.ok) return s;
-  t = ModelTerm{t.effect, {t.params[best_k]}};
-  return best_part;
-}
 
 /// Nonlinear candidates: the linearised step is only the start; the best proposed
 /// ones are refitted to convergence with the model. Envelope effects enter through
@@ -417,7 +413,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   const StepSolution base = solve_step(stats.all, floors, base_cols);
   for (std::size_t i = 0; i < terms.size(); ++i) {
     const std::size_t term = first_candidate + i;
-    const StepSolution s = solve_candidate(d, term, terms[i], stats, floors, base_cols);
+    const StepSolution s = solve_candidate(stats.all, floors, base_cols, term_columns(d, term), terms[i]);
     if (!s.ok) {
       out.not_evaluated.push_back(terms[i].reference() + ": not separable from the model with the signals in this log" +
                                   (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));

@@ -10,6 +10,7 @@
 // collinear here, e.g. K_2 and offsets without sin/cos) are listed together.
 #pragma once
 
+#include <span>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,15 @@ struct Ranking {
 /// residual it removes, whether it is proposed and reaches the floor.
 void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSolution& base, const GroupFloors& floors,
                      const DiscoveryOptions& options);
+
+/// The linearised step of a candidate with parameters `t` (columns `term_cols`, one per
+/// parameter) on the model's columns `base_cols`. Part of a multi-parameter candidate
+/// may be the model's already (a 2 theta_m order at p_r = 1 without sin/cos: its sin
+/// part is alpha's): then each parameter alone is tried and the best the statistics
+/// separate kept (`t` narrowed to it). The same rule on a log and on merged statistics.
+[[nodiscard]] StepSolution solve_candidate(const std::vector<NormalEquations>& groups, const GroupFloors& floors,
+                                           const std::vector<int>& base_cols, std::span<const int> term_cols,
+                                           ModelTerm& t);
 
 /// Whether a candidate's linearised score is not its fit: an envelope effect (through
 /// atan2) whose step does not already reach the floor, or one with a nonlinear parameter

@@ -322,22 +322,24 @@ std::vector<std::string> linearised_from_zero(const Design& d, const std::vector
   return out;
 }
 
-/// One candidate scored from the merged statistics: `set` (a subset of candidate term
-/// `i`'s parameters) with the model's columns.
-void score_merged(const Design& d, std::size_t i, const ModelTerm& set, const MergedStatistics& stats,
+/// One candidate scored from the merged statistics: `asked` (a subset of candidate term
+/// `i`'s parameters) with the model's columns; narrowed to the one parameter the merged
+/// runs separate when the whole set is not (ranking.h solve_candidate, as explain).
+void score_merged(const Design& d, std::size_t i, const ModelTerm& asked, const MergedStatistics& stats,
                   const StepSolution& base, const GroupFloors& floors, bool rd, const DiscoveryOptions& options,
                   MergedFit& out) {
-  std::vector<int> cols = model_columns(d);
   const DesignTerm& t = d.terms()[i];
-  for (int p : set.params) {
+  std::vector<int> set_cols;
+  for (int p : asked.params) {
     const auto k = std::find(t.params.begin(), t.params.end(), p);
     if (k == t.params.end()) {
-      out.not_evaluated.push_back(set.reference() + ": not in every run's statistics");
+      out.not_evaluated.push_back(asked.reference() + ": not in every run's statistics");
       return;
     }
-    cols.push_back(d.term_column(i) + static_cast<int>(k - t.params.begin()));
+    set_cols.push_back(d.term_column(i) + static_cast<int>(k - t.params.begin()));
   }
-  const StepSolution s = solve_step(stats.all, floors, cols);
+  ModelTerm set = asked;
+  const StepSolution s = solve_candidate(stats.all, floors, model_columns(d), set_cols, set);
   if (!s.ok) {
     out.not_evaluated.push_back(set.reference() + ": not separable from the model with the merged runs");
     return;
