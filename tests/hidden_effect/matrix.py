@@ -204,12 +204,17 @@ XFAIL = [
     #
     # The streaming path (run_hidden_effect.py --streaming: explain --chunk against explain
     # in memory), issue 23, still open:
-    (["*/backlash/*:stream_named", "*/envelope_drift/*:stream_value", "*/eccentricity/steps:stream_value",
+    (["*/backlash/oab3:stream_value", "*/backlash/oab1:stream_value", "*/backlash/angle1:stream_value"],
+     "a play's state at a chunk's start is unknown to the chunk: it starts with the play taken up in "
+     "the direction of its first motion, so when a chunk begins just after a reversal the take-up's "
+     "rows are mismatched (h 0.13 % low, 5e-6 rad: 7-23 formal se; about 3 rows of a 4 mrad take-up carry "
+     "that bias). The chunks now share the log's "
+     "reference zero (backlash is named first, as in memory)"),
+    (["*/envelope_drift/*:stream_value", "*/eccentricity/steps:stream_value",
       "*/mounting_offset/reversals:stream_value"],
-     "each chunk is a run with its own constants (its reference zero; its sin/cos normalised by "
-     "its own amplitude), so what is a constant within a chunk is taken by them: a play split "
-     "at the reversal (one direction per chunk), a drift of the envelopes over time, part of a "
-     "mounting offset or an eccentricity's phase at one speed per chunk. Sharing the log's "
-     "constants across its chunks needs each chunk's amplitude normalisation in the statistics "
-     "(tried: sharing them without it was 0.2 se off; run_statistics_test.cpp)"),
+     "each chunk keeps its own amplitude and operating point (its sin/cos normalised by its own "
+     "amplitude when prepared): a drift of the envelopes over time is partly taken by the chunks' "
+     "gains; the eccentricity's phase at one speed per chunk and a mounting offset across reversals "
+     "are 3-21 se apart, not yet diagnosed further (the reference zero is shared across a log's "
+     "chunks since it was found to carry a play; these cases are analysed with the reference aligned)"),
 ]

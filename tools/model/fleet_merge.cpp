@@ -206,12 +206,13 @@ CalibrationTable merged_table(const MergedFit& m, const PoolLayout& layout, cons
 
 /// The unit's runs, each named by its row's log (a chunked file's runs by log and span,
 /// as merge names them); `notes` gets what the statistics left out and the reader counted.
-void collect_runs(const std::vector<RowResult>& rows, std::vector<RunStatistics>& runs,
-                  std::vector<std::string>& names, std::vector<std::string>& notes) {
+void collect_runs(const std::vector<RowResult>& rows, std::vector<RunStatistics>& runs, std::vector<std::string>& names,
+                  std::vector<int>& log_of, std::vector<std::string>& notes) {
   for (const RowResult& r : rows) {
     for (const NamedRun& n : r.file.runs) {
       names.push_back(r.file.runs.size() == 1 ? r.row->log : r.row->log + ": " + n.name.substr(n.name.rfind(" [") + 1));
       runs.push_back(n.run);
+      log_of.push_back(static_cast<int>(&r - rows.data()));  // a file's runs are one log's chunks
     }
     for (const std::string& l : r.file.left_out) notes.push_back("left out when the statistics were made: " + l);
     for (const std::string& n : r.file.input) notes.push_back(r.row->log + ": " + n);
@@ -303,11 +304,12 @@ bool merge_unit(const std::string& unit, const std::vector<ManifestRow>& rows, c
   }
   std::vector<RunStatistics> runs;
   std::vector<std::string> names, file_notes;
+  std::vector<int> log_of;
   MergedFit merged;
   if (problems.empty()) {
-    collect_runs(results, runs, names, file_notes);
+    collect_runs(results, runs, names, log_of, file_notes);
     try {
-      merged = merge_runs(runs, names, o.effects, o.discovery);
+      merged = merge_runs(runs, names, o.effects, o.discovery, log_of);
     } catch (const std::invalid_argument& e) {
       problems.push_back(std::string("its logs' statistics do not merge: ") + e.what());
     }

@@ -222,7 +222,8 @@ constexpr const char* kMergeExamples = R"(Examples:
   resolver-model merge mon.stats tue.stats wed.stats
   # another model from the same statistics (its effects must be each file's model or candidates)
   resolver-model merge mon.stats tue.stats --effects amplitude_imbalance,quadrature --json
-Each run keeps its own reference zero, amplitude and operating point, as in fit A.log B.log;
+Each run keeps its own reference zero, amplitude and operating point, as in fit A.log B.log
+(the chunks of one log, stats --chunk, share its reference zero);
 linear parameters merge exactly, nonlinear ones to second order in how far the runs' own
 fits lie apart (a note says how far). Files of another version or layout are refused (exit 2).)";
 
@@ -431,9 +432,9 @@ void add_statistics_subcommands(CLI::App& app, Arguments& a, Subcommands& subs) 
   stats->add_option("--effects", a.effects_args, "the model, as for fit (default amplitude_imbalance)");
   stats->add_option("--out", a.stats_out, "statistics file to write (JSON)")->required();
   stats->add_option("--chunk", a.chunk_s,
-                    "read the log in chunks of this many seconds, each a run of its own (its own reference zero, "
-                    "amplitude and operating point): a log of any length in the memory of two chunks; a last piece "
-                    "shorter than half a chunk joins the one before")
+                    "read the log in chunks of this many seconds, each a run of its own (its own amplitude and "
+                    "operating point; the log's reference zero shared when merged): a log of any length in the "
+                    "memory of two chunks; a last piece shorter than half a chunk joins the one before")
       ->check(CLI::PositiveNumber);
   add_config_options(stats, a);
   add_slicing_options(stats, a);

@@ -13,7 +13,8 @@
 //              "outliers": {"samples", "rows": [per group], "rss": [per group]},
 //              "groups": {"rd": {"all": {"n", "yy", "b", "m_upper"}, "fold_a": {...}}, "sc": ..., "cur": ...}}]}
 // One run per log, or one per chunk of a long log (stats --chunk): each chunk is a run
-// with its own constants, so a log of any length is read in bounded memory.
+// with its own constants, so a log of any length is read in bounded memory; a merge
+// shares the log's reference zero across the runs of one file (run_statistics.h).
 //
 // A file of another format or version, or one that does not parse, is refused naming
 // the file (InputError, usage: exit 2); so are files of different layouts in one merge.

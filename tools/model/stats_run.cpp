@@ -1,5 +1,7 @@
 #include "tools/model/stats_run.h"
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <stdexcept>
 
@@ -78,10 +80,11 @@ MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<s
       out.names.push_back(files[i].runs.size() == 1 ? paths[i]
                                                     : paths[i] + ": " + r.name.substr(r.name.rfind(" [") + 1));
       out.runs.push_back(r.run);
+      out.log_of.push_back(static_cast<int>(i));  // a file's runs are one log's chunks: one reference zero
     }
   }
   try {
-    out.fit = merge_runs(out.runs, out.names, effects, options);
+    out.fit = merge_runs(out.runs, out.names, effects, options, out.log_of);
   } catch (const std::invalid_argument& e) {
     throw InputError(Fault::kData, e.what());
   }
@@ -106,25 +109,67 @@ FitStartValues merged_start(const MergedFit& fit, const std::string& effect) {
   return start;
 }
 
+/// Runs that hold the candidate (their rows alone cannot separate it) make the refit
+/// Gauss-Newton over passes: each pass takes the statistics at the last merged value.
+/// Converged when a pass moves each of its parameters by less than kConvergedSe of its
+/// standard error; at most kMaxHeldPasses passes (each reads the logs again).
+constexpr int kMaxHeldPasses = 6;
+constexpr double kConvergedSe = 0.05;
+
+/// The largest move of `effect`'s parameters from `start` to `with`, in standard errors.
+double largest_step(const MergedFit& with, const FitStartValues& start, const std::string& effect,
+                    const DiscoveryOptions& options) {
+  const ModelTerm term = ModelSpec::parse(std::vector<std::string>{effect}, options.customs).terms.front();
+  double widest = 0.0;
+  for (std::size_t k = 0; k < term.params.size(); ++k) {
+    const std::string name = term.param_name(k);
+    const auto at = [&](const std::vector<ModelParameter>& ps) {
+      return std::find_if(ps.begin(), ps.end(), [&](const ModelParameter& p) { return p.name == name; });
+    };
+    const auto now = at(with.params), before = at(start.values);
+    if (now == with.params.end() || before == start.values.end() || !(now->std_error > 0.0)) continue;
+    widest = std::max(widest, std::abs(now->value - before->value) / now->std_error);
+  }
+  return widest;
+}
+
 }  // namespace
 
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
   for (const std::string& effect : candidates_to_refit(merged.fit, options)) {
-    const auto not_refitted = [&](const char* why) {
+    const auto not_refitted = [&](const std::string& why) {
       merged.fit.notes.push_back(fmt::format("{} not refitted (its score stays one linearised step): {}", effect, why));
     };
     std::vector<std::string> effects = merged.fit.effects;
     effects.push_back(effect);
+    FitStartValues start = merged_start(merged.fit, effect);
+    start.held = {effect};
     try {
-      std::vector<RunStatistics> runs;
-      for (const StatsFile& f : statistics_with(effects, merged_start(merged.fit, effect))) {
-        for (const NamedRun& r : f.runs) runs.push_back(r.run);
+      for (int pass = 1;; ++pass) {
+        std::vector<RunStatistics> runs;
+        for (const StatsFile& f : statistics_with(effects, start)) {
+          for (const NamedRun& r : f.runs) runs.push_back(r.run);
+        }
+        if (runs.size() != merged.runs.size()) {
+          not_refitted(fmt::format("{} of the {} runs could be fitted with it", runs.size(), merged.runs.size()));
+          break;
+        }
+        MergedFit with = merge_runs(runs, merged.names, effects, options, merged.log_of);
+        const bool held = std::any_of(runs.begin(), runs.end(), [](const RunStatistics& r) { return !r.held.empty(); });
+        const double step = held ? largest_step(with, start, effect, options) : 0.0;
+        if (held && step >= kConvergedSe && pass < kMaxHeldPasses) {
+          start.values = with.params;
+          continue;
+        }
+        if (held) {
+          merged.fit.notes.push_back(fmt::format(
+              "{}: some runs' rows alone cannot separate it (held at the merged value there): fitted by Gauss-Newton "
+              "over {} pass{} of the logs, the last step {:.2g} standard errors{}",
+              effect, pass, pass == 1 ? "" : "es", step, step < kConvergedSe ? "" : " (not converged: its value is approximate)"));
+        }
+        take_exact_refit(merged.fit, effect, with, options);
+        break;
       }
-      if (runs.size() != merged.runs.size()) {
-        not_refitted(fmt::format("{} of the {} runs could be fitted with it", runs.size(), merged.runs.size()).c_str());
-        continue;
-      }
-      take_exact_refit(merged.fit, effect, merge_runs(runs, merged.names, effects, options), options);
     } catch (const std::invalid_argument& e) {
       not_refitted(e.what());
     } catch (const InputError& e) {

@@ -38,6 +38,7 @@ void write_stats_file(const StatsFile& file, const std::string& out);
 struct MergedFiles {
   std::vector<RunStatistics> runs;
   std::vector<std::string> names;  ///< a file's path; a chunk's with its span
+  std::vector<int> log_of;         ///< each run's file: the runs of one file are one log's chunks
   MergedFit fit;
 };
 

@@ -305,9 +305,10 @@ bool at_floor(const ModelFit& f, double explained_ratio) {
   return ok;
 }
 
-/// Sets the model's parameters named in `start` and returns which terms are settled
-/// (fit_design's flags, in the model's term order).
-std::vector<bool> start_at(const FitStartValues& start, Model& model) {
+
+}  // namespace
+
+std::vector<bool> apply_start_values(const FitStartValues& start, Model& model) {
   const std::vector<ModelParameter> own = model.parameters();
   for (const ModelParameter& p : start.values) {
     const bool known = std::any_of(own.begin(), own.end(), [&](const ModelParameter& o) { return o.name == p.name; });
@@ -321,8 +322,6 @@ std::vector<bool> start_at(const FitStartValues& start, Model& model) {
   return settled;
 }
 
-}  // namespace
-
 ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effects, const DiscoveryOptions& options) {
   const ModelSpec spec = ModelSpec::parse(effects, options.customs);
   check_model_against_log(spec, log);
@@ -330,7 +329,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   ModelFit f;
   f.model = Model(spec, log.p_r, log.p);
   f.effects = spec.references();
-  const std::vector<bool> settled = start_at(options.start, f.model);
+  const std::vector<bool> settled = apply_start_values(options.start, f.model);
   Design d = design_for(f.model, log);
   const FitResult fr = fit_design(
       d, log.rows, floors, 12,

@@ -47,6 +47,9 @@ struct FitStartValues {
   /// Effect references whose start values are a converged fit: fitted from that start
   /// only (least_squares.h fit_design `settled`).
   std::vector<std::string> settled;
+  /// Effect references a run may hold at their start values when its own rows cannot
+  /// separate them (a play in a chunk that turns one way): run_statistics.h.
+  std::vector<std::string> held;
 };
 
 struct DiscoveryOptions {
@@ -282,6 +285,10 @@ struct Explanation {
 /// fit_model plus the ranked candidates and the verdict. Throws like fit_model.
 [[nodiscard]] Explanation explain_model(const DiscoveryInput& input, std::span<const std::string> effects,
                                         const DiscoveryOptions& options = {});
+
+/// Sets `model`'s parameters named in `start` (names it lacks ignored) and returns which
+/// of its terms are settled (least_squares.h fit_design's flags, in term order).
+std::vector<bool> apply_start_values(const FitStartValues& start, Model& model);
 
 /// The same on rows already prepared (the live window, several passes of the discovery loop).
 [[nodiscard]] ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effects,

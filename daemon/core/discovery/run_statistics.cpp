@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "daemon/core/discovery/fit_support.h"
+#include "daemon/core/discovery/merged_statistics.h"
 #include "daemon/core/discovery/outliers.h"
 #include "daemon/core/discovery/pool.h"
 #include "daemon/core/discovery/ranking.h"
@@ -41,6 +42,8 @@ void add_candidate_columns(Design& d, const ModelFit& fit, const PreparedLog& lo
   std::vector<const Effect*> answered;
   const std::vector<ModelTerm> terms = residual_candidate_terms(fit, options, &answered);
   for (const Effect* e : effect_registry()) {
+    // A term held in the design (RunStatistics::held) is the model's, not a candidate.
+    if (std::any_of(d.terms().begin(), d.terms().end(), [&](const DesignTerm& t) { return t.effect == e; })) continue;
     if (std::find(answered.begin(), answered.end(), e) == answered.end()) {
       if (candidate_for(*e, fit.model.spec(), log)) d.add_candidate(ModelTerm{e, default_params(*e)});
       continue;
@@ -58,11 +61,6 @@ void add_candidate_columns(Design& d, const ModelFit& fit, const PreparedLog& lo
   }
 }
 
-/// Position of `name` in `names`, or -1.
-int index_of(const std::vector<std::string>& names, const std::string& name) {
-  const auto it = std::find(names.begin(), names.end(), name);
-  return it == names.end() ? -1 : static_cast<int>(it - names.begin());
-}
 
 /// The run with the most fitted rows (ties: the first name): every run is moved to
 /// its point, so the merge does not depend on the order the runs are given in.
@@ -98,8 +96,8 @@ Design merged_design(const ModelSpec& spec, const std::vector<RunStatistics>& ru
   std::vector<const Effect*> order;
   for (int c = runs[ref].nuisance_columns; c < static_cast<int>(runs[ref].columns.size()); ++c) {
     const std::string& name = runs[ref].columns[static_cast<std::size_t>(c)];
-    if (index_of(have, name) >= 0) continue;
-    const bool everywhere = std::all_of(runs.begin(), runs.end(), [&](const RunStatistics& r) { return index_of(r.columns, name) >= 0; });
+    if (column_index(have, name) >= 0) continue;
+    const bool everywhere = std::all_of(runs.begin(), runs.end(), [&](const RunStatistics& r) { return column_index(r.columns, name) >= 0; });
     const std::size_t dot = name.find('.');
     const Effect* e = find_effect(name.substr(0, dot));
     if (!everywhere || e == nullptr) continue;
@@ -116,157 +114,10 @@ Design merged_design(const ModelSpec& spec, const std::vector<RunStatistics>& ru
   return d;
 }
 
-/// Where a run's columns go in the merged design and how far each is moved: its own
-/// constants (the first columns) are profiled out, the design's columns kept, the rest
-/// held at their neutral value.
-struct RunColumns {
-  std::vector<int> to;    ///< run column -> design column, -1: a constant or held
-  Eigen::VectorXd shift;  ///< z_r - target (0 for the constants)
-};
-
-RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::VectorXd& z0) {
-  const std::vector<std::string> names = d.column_names();
-  RunColumns rc{std::vector<int>(run.columns.size(), -1), run.point};
-  for (std::size_t c = 0; c < run.columns.size(); ++c) {
-    const auto i = static_cast<Eigen::Index>(c);
-    if (static_cast<int>(c) < run.nuisance_columns) {
-      rc.shift[i] = 0.0;
-      continue;
-    }
-    const int at = index_of(names, run.columns[c]);
-    if (at < 0) continue;  // held at neutral: shifted there, then left out
-    rc.to[c] = at;
-    rc.shift[i] = run.point[i] - z0[at];
-  }
-  return rc;
-}
-
-/// Statistics linearised at a point moved to another `shift` = (point - other point)
-/// away: b + M d and yy + 2 d'b + d'M d (the header), in the same columns.
-NormalEquations moved(const NormalEquations& ne, const Eigen::VectorXd& shift) {
-  NormalEquations out;
-  out.set(ne.m(), ne.b() + ne.m() * shift, ne.yy() + 2.0 * shift.dot(ne.b()) + shift.dot(ne.m() * shift), ne.n());
-  return out;
-}
-
-/// The reference zero's constants (the position errors'), which a run holds in its
-/// own fit's frame (frame_shift) rather than at zero.
-bool frame_constant(const std::string& column) {
-  return column == nuisance_name(Nuisance::kRdConstant) || column == nuisance_name(Nuisance::kSaConstant);
-}
-
-/// The run's constants of one group: those its rows carry (a constant of another
-/// group's signal has an empty column here).
-std::vector<Eigen::Index> constants_in(const NormalEquations& ne, int nuisance_columns) {
-  std::vector<Eigen::Index> out;
-  for (Eigen::Index j = 0; j < nuisance_columns; ++j) {
-    if (ne.m()(j, j) > 0.0) out.push_back(j);
-  }
-  return out;
-}
-
-/// One group's statistics of a run moved to the design's point (b + M d, yy + 2 d'b +
-/// d'M d: header) and with the run's constants profiled out (the Schur complement
-/// M_ss - M_sn M_nn^-1 M_ns): over the design's columns. Exact: a constant enters one
-/// group's signal only, so profiling group by group is profiling the weighted sum.
-NormalEquations reduce_run(const NormalEquations& ne, const RunColumns& rc, int nuisance_columns, int k_design) {
-  const NormalEquations at = moved(ne, rc.shift);
-  const Eigen::VectorXd& b = at.b();
-  double yy = at.yy();
-  std::vector<Eigen::Index> kept;
-  for (std::size_t c = 0; c < rc.to.size(); ++c) {
-    if (rc.to[c] >= 0) kept.push_back(static_cast<Eigen::Index>(c));
-  }
-  const std::vector<Eigen::Index> own = constants_in(ne, nuisance_columns);
-  Eigen::MatrixXd m = ne.m()(kept, kept);
-  Eigen::VectorXd bk = b(kept);
-  if (!own.empty()) {
-    const Eigen::LDLT<Eigen::MatrixXd> nn(ne.m()(own, own));
-    const Eigen::VectorXd bn = b(own);
-    yy -= bn.dot(nn.solve(bn));
-    if (!kept.empty()) {  // Eigen's triangular solve reads element 0 of an empty right-hand side
-      const Eigen::MatrixXd ns = ne.m()(own, kept);
-      m -= ns.transpose() * nn.solve(ns);
-      bk -= ns.transpose() * nn.solve(bn);
-    }
-  }
-  Eigen::MatrixXd mo = Eigen::MatrixXd::Zero(k_design, k_design);
-  Eigen::VectorXd bo = Eigen::VectorXd::Zero(k_design);
-  for (std::size_t i = 0; i < kept.size(); ++i) {
-    const int ti = rc.to[static_cast<std::size_t>(kept[i])];
-    bo[ti] = bk[static_cast<Eigen::Index>(i)];
-    for (std::size_t j = 0; j < kept.size(); ++j) {
-      mo(ti, rc.to[static_cast<std::size_t>(kept[j])]) = m(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j));
-    }
-  }
-  NormalEquations out;
-  out.set(std::move(mo), std::move(bo), std::max(0.0, yy), ne.n());
-  return out;
-}
-
-/// Every run reduced to the design's columns and added: all rows, and each fold apart
-/// (a fold's constants are its own: profiling is not linear in the rows).
-struct MergedStatistics {
-  std::vector<NormalEquations> all, fold_a, fold_b;  ///< by Group
-};
-
-MergedStatistics assemble(const Design& d, const std::vector<RunStatistics>& runs) {
-  const Eigen::VectorXd z0 = d.z();
-  MergedStatistics out;
-  for (int g = 0; g < kGroups; ++g) {
-    out.all.emplace_back(d.columns());
-    out.fold_a.emplace_back(d.columns());
-    out.fold_b.emplace_back(d.columns());
-  }
-  for (const RunStatistics& run : runs) {
-    const RunColumns rc = run_columns(run, d, z0);
-    for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
-      const NormalEquations fold_b = run.stats.fold_b(static_cast<Group>(g));
-      out.all[g].merge(reduce_run(run.stats.all[g], rc, run.nuisance_columns, d.columns()));
-      out.fold_a[g].merge(reduce_run(run.stats.fold_a[g], rc, run.nuisance_columns, d.columns()));
-      out.fold_b[g].merge(reduce_run(fold_b, rc, run.nuisance_columns, d.columns()));
-    }
-  }
-  return out;
-}
-
-/// Each run's constants at the solution `s` (profiled: M_nn^-1 (b_n - M_ns ds) of the
-/// group that carries each), named "...[run]"; the position errors' constants in the
-/// log's frame (the frame shift taken off, as nuisance_at_solution).
-std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s, const std::vector<RunStatistics>& runs,
-                                         const std::vector<std::string>& names) {
-  const Eigen::VectorXd z0 = d.z();
-  std::vector<ModelParameter> out;
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    const RunStatistics& run = runs[r];
-    const RunColumns rc = run_columns(run, d, z0);
-    Eigen::VectorXd ds = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(run.columns.size()));
-    for (std::size_t c = 0; c < rc.to.size(); ++c) {
-      if (rc.to[c] >= 0) ds[static_cast<Eigen::Index>(c)] = s.dz[rc.to[c]];
-    }
-    Eigen::VectorXd value = Eigen::VectorXd::Constant(run.nuisance_columns, kNaN);
-    for (const NormalEquations& ne : run.stats.all) {
-      const std::vector<Eigen::Index> own = constants_in(ne, run.nuisance_columns);
-      if (own.empty()) continue;
-      // b of the moved statistics minus what the shared step explains, over the constants.
-      const Eigen::VectorXd b = ne.b() + ne.m() * rc.shift - ne.m() * ds;
-      const Eigen::VectorXd dn = ne.m()(own, own).ldlt().solve(Eigen::VectorXd(b(own)));
-      for (std::size_t i = 0; i < own.size(); ++i) value[own[i]] = dn[static_cast<Eigen::Index>(i)];
-    }
-    for (int j = 0; j < run.nuisance_columns; ++j) {
-      const std::string& column = run.columns[static_cast<std::size_t>(j)];
-      double v = value[j];
-      if (frame_constant(column)) v -= run.frame_shift;
-      out.push_back({column + "[" + names[r] + "]", v, kNaN, ""});
-    }
-  }
-  return out;
-}
-
 /// The residual with only each run's constants fitted ("before": every model column
 /// moved to its neutral value, linearised).
-StepSolution raw_solution(const std::vector<RunStatistics>& runs, const GroupFloors& floors) {
-  return solve_step(assemble(Design(ModelSpec{}, {}, {}), runs).all, floors);
+StepSolution raw_solution(const std::vector<RunStatistics>& runs, const RunsByLog& logs, const GroupFloors& floors) {
+  return solve_step(assemble(Design(ModelSpec{}, {}, {}), runs, logs).all, floors);
 }
 
 std::vector<SignalResidual> merged_signals(const MergedStatistics& stats, const StepSolution& s, const StepSolution& raw,
@@ -312,7 +163,7 @@ std::vector<std::string> linearised_from_zero(const Design& d, const std::vector
     if (t.candidate || !nonlinear) continue;
     const auto candidate_in = [&](const RunStatistics& r) {
       for (int c : term_columns(d, i)) {
-        const int at = index_of(r.columns, names[static_cast<std::size_t>(c)]);
+        const int at = column_index(r.columns, names[static_cast<std::size_t>(c)]);
         if (at >= r.nuisance_columns + r.model_columns) return true;
       }
       return false;
@@ -362,12 +213,23 @@ void score_merged(const Design& d, std::size_t i, const ModelTerm& asked, const 
 /// Every candidate term of `d` (after the model's) scored against `base`: an effect's
 /// sets as the reference run's fit asked for them (RunStatistics::candidate_sets), else
 /// its whole term. What the runs' motion together lacks for candidates (motion_missing):
-/// every run's speeds and reversals.
+/// every run's speeds and reversals, and a log's between its chunks.
 void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolution& base, const GroupFloors& floors,
-                 const std::vector<RunStatistics>& runs, std::size_t ref, const DiscoveryOptions& options,
-                 MergedFit& out) {
+                 const std::vector<RunStatistics>& runs, const RunsByLog& logs, std::size_t ref,
+                 const DiscoveryOptions& options, MergedFit& out) {
   MotionSummary motion;
   for (std::size_t r = 0; r < runs.size(); ++r) add_motion(motion, runs[r].motion, r == 0);
+  // A log's chunks share its reference zero: a log that went both ways, one direction per
+  // chunk, reversed at a chunk boundary (a play is then no constant of the merge).
+  for (const std::vector<std::size_t>& members : logs) {
+    std::int64_t forward = 0, backward = 0, reversals = 0;
+    for (const std::size_t r : members) {
+      forward += runs[r].motion.forward;
+      backward += runs[r].motion.backward;
+      reversals += runs[r].motion.reversals;
+    }
+    if (members.size() > 1 && forward > 0 && backward > 0 && reversals == 0) ++motion.reversals;
+  }
   const bool rd = runs.front().layout.rd;
   for (std::size_t i = 0; i < d.terms().size(); ++i) {
     if (!d.terms()[i].candidate) continue;
@@ -404,7 +266,7 @@ std::string nonlinear_note(const Design& d, const std::vector<RunStatistics>& ru
       const int col = d.term_column(i) + static_cast<int>(k);
       const double se = std::sqrt(std::max(0.0, s2 * s.inverse(col, col)));
       for (const RunStatistics& r : runs) {
-        const int at = index_of(r.columns, names[static_cast<std::size_t>(col)]);
+        const int at = column_index(r.columns, names[static_cast<std::size_t>(col)]);
         if (at < 0 || !(se > 0.0)) continue;
         const double z = std::abs(r.point[at] - (z0[col] + s.dz[col])) / se;
         if (z > widest) {
@@ -437,17 +299,51 @@ void take_outliers(const ModelFit& fit, RunStatistics& out) {
   }
 }
 
+/// The run's fit of `effects`, or, where its rows cannot separate them and some are in
+/// options.start.held, the fit of the others (`held` gets the rest).
+ModelFit fit_or_hold(const PreparedLog& log, std::span<const std::string> effects, const DiscoveryOptions& options,
+                     std::vector<std::string>& held) {
+  const std::vector<std::string>& holdable = options.start.held;
+  const auto can_hold = [&](const std::string& e) { return std::find(holdable.begin(), holdable.end(), e) != holdable.end(); };
+  if (std::none_of(effects.begin(), effects.end(), can_hold)) return fit_prepared(log, effects, options);
+  try {
+    return fit_prepared(log, effects, options);
+  } catch (const std::invalid_argument&) {
+    std::vector<std::string> free;
+    for (const std::string& e : effects) (can_hold(e) ? held : free).push_back(e);
+    return fit_prepared(log, free, options);
+  }
+}
+
+/// The run's fitted model with the `held` effects added at their start values, in the
+/// fit's frame: the point the run's statistics are taken at.
+Model model_with_held(const ModelFit& fit, const PreparedLog& log, const std::vector<std::string>& held,
+                      const DiscoveryOptions& options) {
+  if (held.empty()) return fit.model;
+  ModelSpec spec = fit.model.spec();
+  for (const ModelTerm& t : ModelSpec::parse(held, options.customs).terms) spec.add(t);
+  Model at(spec, log.p_r, log.p);
+  for (const ModelParameter& p : fit.model.parameters()) at.set(p.name, p.value);
+  (void)apply_start_values(options.start, at);
+  Design d = design_for(at, log);
+  const Design fitted = design_for(fit.model, log);
+  for (int part = 0; part < d.parts(); ++part) d.set_frame_shift(part, fitted.frame_shift(part));
+  at.take_values(d);
+  return at;
+}
+
 }  // namespace
 
 RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string> effects,
                              const DiscoveryOptions& options) {
-  const ModelFit fit = fit_prepared(log, effects, options);
   RunStatistics out;
+  const ModelFit fit = fit_or_hold(log, effects, options, out.held);
   out.layout = pool_layout(log);
-  out.effects = fit.model.spec().references();
   out.params = fit.params;
-  out.values = fit.model.values();
-  Design d = design_for(fit.model, log);
+  const Model model = model_with_held(fit, log, out.held, options);
+  out.effects = model.spec().references();
+  out.values = model.values();
+  Design d = design_for(model, log);
   out.frame_shift = d.frame_shift(0);
   out.nuisance_columns = d.nuisance_columns();
   out.model_columns = d.columns() - d.nuisance_columns();
@@ -463,13 +359,16 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
   out.electrical_revolutions = log.electrical_revolutions();
   out.motion = log.motion;
   out.notes = fit.notes;
+  for (const std::string& h : out.held) {
+    out.notes.push_back(h + " held at its start value: this run's rows alone cannot separate it (the merge steps it)");
+  }
   out.untrusted = options.untrusted_input;
   take_outliers(fit, out);
   return out;
 }
 
 MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names,
-                     std::span<const std::string> effects, const DiscoveryOptions& options) {
+                     std::span<const std::string> effects, const DiscoveryOptions& options, std::span<const int> log_of) {
   if (runs.empty()) throw std::invalid_argument("nothing to merge: no statistics given");
   if (names.size() != runs.size()) throw std::invalid_argument("merge: one name per run");
   for (std::size_t r = 1; r < runs.size(); ++r) {
@@ -484,7 +383,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   const std::vector<std::string> columns = d.column_names();
   for (std::size_t r = 0; r < runs.size(); ++r) {
     for (int c = 0; c < d.columns(); ++c) {
-      if (index_of(runs[r].columns, columns[static_cast<std::size_t>(c)]) >= 0) continue;
+      if (column_index(runs[r].columns, columns[static_cast<std::size_t>(c)]) >= 0) continue;
       throw std::invalid_argument(fmt::format("{} has no column {} (its model: {}; its candidates are the catalog "
                                               "effects its signals allow): make its statistics with --effects {}",
                                               names[r], columns[static_cast<std::size_t>(c)],
@@ -501,7 +400,8 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   out.floors = pool_floor_reports(floors, rows);
   const GroupFloors gf = out.floors.floors();
   const Eigen::VectorXd z0 = d.z();
-  const MergedStatistics stats = assemble(d, runs);
+  const RunsByLog logs = runs_by_log(runs.size(), log_of);
+  const MergedStatistics stats = assemble(d, runs, logs);
   const std::vector<int> cols = model_columns(d);
   const StepSolution s = solve_step(stats.all, gf, cols);
   if (!s.ok) {
@@ -515,8 +415,8 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   out.rd = runs.front().layout.rd;
   out.bic = bic_of(s);
   out.weighted_rss = s.rss_w;
-  out.nuisance = constants_at(d, s, runs, names);
-  out.signals = merged_signals(stats, s, raw_solution(runs, gf), gf, cols, runs);
+  out.nuisance = constants_at(d, s, runs, names, logs);
+  out.signals = merged_signals(stats, s, raw_solution(runs, logs, gf), gf, cols, runs);
   for (const RunStatistics& r : runs) out.outlier_samples += r.outlier_samples;
   out.explained = !out.signals.empty();
   for (const SignalResidual& r : out.signals) {
@@ -541,7 +441,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
                                       names[r], u));
     }
   }
-  rank_merged(d, stats, s, gf, runs, ref, options, out);
+  rank_merged(d, stats, s, gf, runs, logs, ref, options, out);
   for (const Candidate& c : out.candidates) {
     if (needs_exact_refit(c, options)) out.stepped.push_back(c.effect);
   }

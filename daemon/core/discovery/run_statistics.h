@@ -72,12 +72,19 @@ struct RunStatistics {
   /// Signal faults that held for a large part of the run (DiscoveryOptions::untrusted_input):
   /// a merge with any is never "explained".
   std::vector<std::string> untrusted;
+  /// Model effects the run held at their start values (FitStartValues::held: its rows
+  /// alone cannot separate them): its statistics are at that point, and the merge's
+  /// value of them is one Gauss-Newton step from there. Only in a refit pass's memory;
+  /// a statistics file never has any.
+  std::vector<std::string> held;
 };
 
 /// Fits `effects` to the prepared run to convergence and takes one more pass there
 /// with every candidate the run's layout allows (a fittable catalog effect not in the
 /// model, default parameters; one that needs a reference, an aligned reference or
-/// currents the run lacks is left out). Throws std::invalid_argument as fit_prepared.
+/// currents the run lacks is left out). Throws std::invalid_argument as fit_prepared,
+/// unless the effects it cannot separate are in options.start.held: then the others are
+/// fitted and those held at their start values (RunStatistics::held).
 [[nodiscard]] RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string> effects,
                                            const DiscoveryOptions& options);
 
@@ -118,8 +125,13 @@ struct MergedFit {
 /// differs (pole pairs, signals, model, a missing column) or when fewer than one run
 /// or the columns are not separable. The result does not depend on the runs' order
 /// (beyond rounding): they are moved to the point of the run with the most rows.
+/// `log_of` (empty: every run a log of its own) gives each run's log: the runs of one
+/// log (its chunks, stats --chunk) share its reference zero, as the log's fit in memory
+/// has one; each run keeps its own amplitude and operating point (its sin/cos are
+/// normalised by its own amplitude when prepared).
 [[nodiscard]] MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names,
-                                   std::span<const std::string> effects, const DiscoveryOptions& options);
+                                   std::span<const std::string> effects, const DiscoveryOptions& options,
+                                   std::span<const int> log_of = {});
 
 /// The candidates of `m` whose linearised step is not their fit (ranking.h exact_refits:
 /// envelope effects at real magnitudes, nonlinear parameters), to be refitted from

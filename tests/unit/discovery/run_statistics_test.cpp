@@ -129,7 +129,7 @@ TEST(RunStatistics, AMissingEffectIsRankedFromTheMergedStatistics) {
   for (const std::string& e : candidates_to_refit(ranked, kAligned)) EXPECT_NE(e, "quadrature") << "refitted twice";
 }
 
-// Chunks of one log (--chunk) are runs of their own, each with its own constants (a
+// Chunks of one log (--chunk) are runs of their own; merged here each with its own constants (a
 // chunk's sin/cos are normalised by its own amplitude when prepared): merged, they give
 // the whole log's fit. Here a reference zero of 2.5 rad (not aligned: fitted), chunked
 // in the middle of a ramp from 200 to 450 r/min (a ramp, not a step: a step kicks the
@@ -162,6 +162,69 @@ TEST(RunStatistics, ChunksOfOneLogMergedGiveTheWholeLogsFit) {
   }
   EXPECT_TRUE(merged.explained);
   EXPECT_EQ(merged.rows, chunks[0].fitted_rows + chunks[1].fitted_rows);
+}
+
+// The chunks of one log share its reference zero (merge_runs' log_of), as the log's fit
+// in memory has one. An out-and-back cut at the reversal, a play of 4 mrad, the
+// reference's zero at 2.5 rad (fitted): with a zero of its own each chunk takes the play
+// as its constant (+-h/2) and the merge cannot see it; with the log's zero shared the
+// merge names backlash, fitted from the chunks held at its start (refit_from_logs).
+TEST(RunStatistics, ChunksOfOneLogShareItsReferenceZero) {
+  DiscoveryInput whole = simulate({"amplitude_imbalance:alpha=0.003", "backlash:h=0.004"},
+                                  {{2.0, 150.0, 150.0}, {0.5, 0.0, 0.0}, {2.0, -150.0, -150.0}});
+  for (Sample& x : whole.samples) x.theta_m_ref = std::fmod(x.theta_m_ref + 2.5, kTwoPi);
+  const DiscoveryOptions options;  // the reference's zero is fitted
+  const std::vector<std::string> model{"amplitude_imbalance"};
+  std::vector<RunStatistics> chunks;
+  for (const auto& [t0, t1] : {std::pair{0.0, 2.25}, std::pair{2.25, 1e9}}) {
+    DiscoveryInput part = whole;
+    part.samples.clear();
+    for (const Sample& x : whole.samples) {
+      if (x.t >= t0 && x.t < t1) part.samples.push_back(x);
+    }
+    chunks.push_back(run_statistics(prepare_log(part, options.prepare), model, options));
+  }
+  const std::vector<std::string> names{"log [0-2.25 s]", "log [2.25-4.5 s]"};
+  const auto named = [](const MergedFit& m) {
+    return std::any_of(m.candidates.begin(), m.candidates.end(), [](const Candidate& c) { return c.effect == "backlash"; });
+  };
+  const MergedFit apart = merge_runs(chunks, names, {}, options);
+  EXPECT_FALSE(named(apart)) << "each chunk's own zero takes the play: nothing left to see";
+  const std::vector<int> one_log{0, 0};
+  const MergedFit shared = merge_runs(chunks, names, {}, options, one_log);
+  // Proposed (beside delay: at one speed each way a delay is the same offset until refitted).
+  const auto backlash = std::find_if(shared.candidates.begin(), shared.candidates.end(),
+                                     [](const Candidate& c) { return c.effect == "backlash"; });
+  ASSERT_NE(backlash, shared.candidates.end());
+  EXPECT_TRUE(backlash->proposed);
+  // One zero, shown under both chunks' names.
+  EXPECT_DOUBLE_EQ(param(shared.nuisance, "nuisance.rd_constant[log [0-2.25 s]]").value,
+                   param(shared.nuisance, "nuisance.rd_constant[log [2.25-4.5 s]]").value);
+  // A chunk turns one way: its rows alone cannot separate the play from its zero. Held at
+  // the merged value, the merge of the chunks steps it to the whole log's fit.
+  DiscoveryOptions held = options;
+  held.start.values = backlash->params;
+  held.start.held = {"backlash"};
+  held.statistics_candidates = false;  // as refit_from_logs: the model's columns only
+  const std::vector<std::string> with{"amplitude_imbalance", "backlash"};
+  std::vector<RunStatistics> again;
+  for (const auto& [t0, t1] : {std::pair{0.0, 2.25}, std::pair{2.25, 1e9}}) {
+    DiscoveryInput part = whole;
+    part.samples.clear();
+    for (const Sample& x : whole.samples) {
+      if (x.t >= t0 && x.t < t1) part.samples.push_back(x);
+    }
+    again.push_back(run_statistics(prepare_log(part, held.prepare), with, held));
+    EXPECT_EQ(again.back().held, std::vector<std::string>{"backlash"});
+  }
+  const MergedFit exact = merge_runs(again, names, with, options, one_log);
+  const ModelFit fit = fit_prepared(prepare_log(whole, options.prepare), with, options);
+  const ModelParameter& m = param(exact.params, "backlash.h");
+  const ModelParameter& p = param(fit.params, "backlash.h");
+  // The play's take-up at the second chunk's start is unknown to it (matrix.XFAIL): a few
+  // rows, measured 0.1 % of h here (4e-6 rad, 20 formal se); 1 % bounds that, while
+  // chunks with zeros of their own leave no play at all.
+  EXPECT_NEAR(m.value, p.value, 0.01 * p.value) << "merged " << m.value << " whole " << p.value << " +- " << p.std_error;
 }
 
 TEST(RunStatistics, RunsOfAnotherBenchOrWithoutAColumnAreRefusedByName) {
