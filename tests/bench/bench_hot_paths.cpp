@@ -26,6 +26,12 @@
 //   BM_PipelineModelFit     the same with the live model fit         [frames/s]
 //   BM_PipelineLcmFile      Pipeline::feed into LCM file:// (what    [frames/s]
 //                           `resolverd --replay --lcm file://` does, minus log reading)
+//   BM_DesignPass/0         one pass of the exact model over a       [rows/s]
+//                           prepared log's rows into its normal equations (least_squares.h
+//                           accumulate): the model amplitude_imbalance and its nuisances
+//   BM_DesignPass/1         the same with every candidate's columns  [rows/s]
+//                           (a statistics pass, the candidates' ranking). Every Gauss-
+//                           Newton pass of discovery costs one such pass (issue 23's floor)
 //
 // Run: build/bin/bench_hot_paths --benchmark_repetitions=5
 //        --benchmark_report_aggregates_only=true
@@ -55,6 +61,10 @@
 #include "daemon/app/output_sink.h"
 #include "daemon/app/pipeline.h"
 #include "daemon/core/angles.h"
+#include "daemon/core/discovery/fit_support.h"
+#include "daemon/core/discovery/prepare.h"
+#include "daemon/core/effects/registry.h"
+#include "daemon/core/model/least_squares.h"
 #include "daemon/core/estimation/dq_transform.h"
 #include "daemon/core/estimation/angle_error_fourier.h"
 #include "daemon/core/estimation/hwang_integral.h"
@@ -541,6 +551,54 @@ void BM_PipelineLcmFile(benchmark::State& state) {
   std::remove(path.c_str());
 }
 BENCHMARK(BM_PipelineLcmFile);
+
+/// The bench stream as discovery's prepared rows (every signal: R/D, sin/cos, reference, currents).
+const resolver::PreparedLog& prepared_bench() {
+  static const resolver::PreparedLog log = [] {
+    resolver::DiscoveryInput in;
+    in.p_r = kPr;
+    in.p = kP;
+    for (std::size_t k = 0; k < kPeriods; ++k) {
+      const TruthSample s = truth_at(k);
+      resolver::Sample x;
+      x.t = static_cast<double>(k) * kDt;
+      x.has_rd = true;
+      x.theta_rd = s.theta_rd;
+      x.has_sincos = true;
+      x.sin = s.sin;
+      x.cos = s.cos;
+      x.has_ref = true;
+      x.theta_m_ref = s.theta_m;
+      x.has_currents = true;
+      x.i_a = s.i_a;
+      x.i_b = s.i_b;
+      x.i_c = s.i_c;
+      in.samples.push_back(x);
+    }
+    return resolver::prepare_log(in, {});
+  }();
+  return log;
+}
+
+void BM_DesignPass(benchmark::State& state) {
+  const resolver::PreparedLog& log = prepared_bench();
+  const resolver::Model model(resolver::ModelSpec::parse(std::vector<std::string>{"amplitude_imbalance"}), log.p_r, log.p);
+  resolver::Design d = resolver::design_for(model, log);
+  if (state.range(0) == 1) {
+    for (const resolver::Effect* e : resolver::effect_registry()) {
+      if (e->fittable() && model.spec().find(*e) == nullptr) d.add_candidate({e, resolver::default_params(*e)});
+    }
+  }
+  const resolver::GroupFloors floors = log.floors.floors();
+  for (auto _ : state) {
+    resolver::PassStatistics stats(d.columns());
+    resolver::accumulate(d, log.rows, floors, stats);
+    benchmark::DoNotOptimize(stats);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(log.rows.size()));
+  state.counters["columns"] = d.columns();
+}
+BENCHMARK(BM_DesignPass)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

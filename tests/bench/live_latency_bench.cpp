@@ -71,6 +71,7 @@ struct Options {
   std::string iface;  // empty: socket pair on the host
   std::string json;
   std::string config;    // resolverd config file; "" = the built-in defaults
+  std::vector<std::string> effects;  // resolver-sim specs added to the stream (FrameFeed)
   int sender_fifo = 50;  // SCHED_FIFO priority of the sending thread; 0 = normal
   int reader_fifo = 0;   // of the reading thread (resolverd's unit sets none)
   bool read_only = false;  // the floor: read every frame, no pipeline, no publish
@@ -183,7 +184,7 @@ RunResult run_once(const Options& o) {
   TimingSink sink(lcm);
   resolver::Pipeline pipeline(config, sink, std::cerr);
   Endpoints ends = open_endpoints(o);
-  FrameFeed feed(o.rate);
+  FrameFeed feed(o.rate, o.effects);
 
   RunResult r;
   const auto expected = static_cast<std::size_t>(o.rate * o.seconds * 1.05) + 64;
@@ -324,6 +325,9 @@ int run(int argc, char** argv) {
   app.add_option("--iface", o.iface, "read a real SocketCAN interface (vcan0) instead of a socket pair");
   app.add_option("--json", o.json, "also write the results as JSON to this file");
   app.add_option("--config", o.config, "resolverd config (TOML) for the pipeline, e.g. decimation or [model] enabled = false");
+  app.add_option("--effect", o.effects,
+                 "resolver-sim effect spec added to the stream (repeatable), e.g. quadrature:beta=0.01: one the "
+                 "default model lacks, so every live window ranks its candidates");
   app.add_option("--sender-fifo", o.sender_fifo,
                  "SCHED_FIFO priority of the sending thread, so host load does not bunch the frames; 0 = normal");
   app.add_option("--reader-fifo", o.reader_fifo,
@@ -353,8 +357,9 @@ int run(int argc, char** argv) {
     std::cerr << "live_latency_bench: " << e.what() << "\n";
     return 2;
   }
-  const std::string split =
+  std::string split =
       o.wake_ids.empty() ? "" : "; split: only " + resolver::WakePlanner::describe(o.wake_ids) + " wake the reader";
+  for (const std::string& e : o.effects) split += "; stream + " + e;
   const resolver::bench_live::Setup setup{(o.iface.empty() ? "socketpair(AF_UNIX, SOCK_SEQPACKET) -> SocketCanSource::adopt"
                                                            : o.iface + " (CAN_RAW) -> SocketCanSource::open") + split,
                                           o.read_only ? std::string("none (--read-only: read path only)")

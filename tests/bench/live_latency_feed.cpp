@@ -21,11 +21,12 @@ constexpr double kBenchInfoHz = 10.0;     // BENCH_INFO rate (docs/ARCHITECTURE.
 constexpr double kFramesPerSample = 3.0;  // sample + currents + reference
 constexpr std::int64_t kNsPerS = 1'000'000'000;
 
-SimConfig sim_config(double sample_rate_hz, double rpm, int samples) {
+SimConfig sim_config(double sample_rate_hz, double rpm, int samples, const std::vector<std::string>& effects) {
   SimConfig c;
   c.sample_rate_hz = sample_rate_hz;
   c.profile = {{static_cast<double>(samples) / sample_rate_hz, rpm, rpm}};
   c.chain.set("amplitude_imbalance", "alpha", 0.003);
+  for (const std::string& spec : effects) c.chain.apply_spec(spec);  // throws naming a bad spec
   return c;
 }
 
@@ -56,12 +57,12 @@ CanFrame error_frame() {
 
 }  // namespace
 
-FrameFeed::FrameFeed(double frames_per_s) {
+FrameFeed::FrameFeed(double frames_per_s, const std::vector<std::string>& effects) {
   // Whole Hz (BENCH_INFO carries a u16): 8000 frames/s -> 2663 Hz -> 7999 frames/s.
   sample_rate_hz_ = std::max(1.0, std::round((frames_per_s - kBenchInfoHz) / kFramesPerSample));
   rpm_ = sample_rate_hz_ * 60.0 / kSamplesPerRevolution;
   const int samples = kSamplesPerRevolution * kLoopRevolutions;
-  BenchSimulator sim(sim_config(sample_rate_hz_, rpm_, samples));
+  BenchSimulator sim(sim_config(sample_rate_hz_, rpm_, samples, effects));
   frames_.reserve(static_cast<std::size_t>(samples) * 4);
   SimSample s{};
   while (sim.next(s)) sim.append_frames(s, frames_);

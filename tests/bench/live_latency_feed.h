@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "drivers/can_frame.h"
@@ -30,7 +31,9 @@ class FrameFeed {
   static constexpr int kSamplesPerRevolution = 768;
   static constexpr int kLoopRevolutions = 4;
 
-  explicit FrameFeed(double frames_per_s);
+  /// `effects`: resolver-sim specs on top of alpha = 0.003 ("quadrature:beta=0.01"), e.g.
+  /// one the daemon's model lacks, so that every live window ranks its candidates.
+  explicit FrameFeed(double frames_per_s, const std::vector<std::string>& effects = {});
   /// The next frame in bus order (endless).
   const CanFrame& next() {
     const CanFrame& f = frames_[at_];
