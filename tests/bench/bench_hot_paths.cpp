@@ -192,27 +192,31 @@ const CandumpText& bench_lines() {
   return log;
 }
 
-/// SampleInput per control period (the input of SampleProcessor), without t.
+/// Control period k as a joined sample with every signal (t from the period).
+resolver::Sample sample_at(std::size_t k) {
+  const TruthSample s = truth_at(k);
+  resolver::Sample x;
+  x.t = static_cast<double>(k) * kDt;
+  x.has_rd = true;
+  x.theta_rd = s.theta_rd;
+  x.has_sincos = true;
+  x.sin = s.sin;
+  x.cos = s.cos;
+  x.has_currents = true;
+  x.i_a = s.i_a;
+  x.i_b = s.i_b;
+  x.i_c = s.i_c;
+  x.has_ref = true;
+  x.theta_m_ref = s.theta_m;
+  return x;
+}
+
+/// SampleInput per control period (the input of SampleProcessor).
 const std::vector<resolver::SampleInput>& bench_inputs() {
   static const std::vector<resolver::SampleInput> inputs = [] {
     std::vector<resolver::SampleInput> out;
     out.reserve(kSamplesPerMechRev);
-    for (std::size_t k = 0; k < kSamplesPerMechRev; ++k) {
-      const TruthSample s = truth_at(k);
-      resolver::SampleInput in;
-      in.has_rd = true;
-      in.theta_rd = s.theta_rd;
-      in.has_sincos = true;
-      in.sin = s.sin;
-      in.cos = s.cos;
-      in.has_currents = true;
-      in.i_a = s.i_a;
-      in.i_b = s.i_b;
-      in.i_c = s.i_c;
-      in.has_ref = true;
-      in.theta_m_ref = s.theta_m;
-      out.push_back(in);
-    }
+    for (std::size_t k = 0; k < kSamplesPerMechRev; ++k) out.push_back(sample_at(k));
     return out;
   }();
   return inputs;
@@ -558,23 +562,7 @@ const resolver::PreparedLog& prepared_bench() {
     resolver::DiscoveryInput in;
     in.p_r = kPr;
     in.p = kP;
-    for (std::size_t k = 0; k < kPeriods; ++k) {
-      const TruthSample s = truth_at(k);
-      resolver::Sample x;
-      x.t = static_cast<double>(k) * kDt;
-      x.has_rd = true;
-      x.theta_rd = s.theta_rd;
-      x.has_sincos = true;
-      x.sin = s.sin;
-      x.cos = s.cos;
-      x.has_ref = true;
-      x.theta_m_ref = s.theta_m;
-      x.has_currents = true;
-      x.i_a = s.i_a;
-      x.i_b = s.i_b;
-      x.i_c = s.i_c;
-      in.samples.push_back(x);
-    }
+    for (std::size_t k = 0; k < kPeriods; ++k) in.samples.push_back(sample_at(k));
     return resolver::prepare_log(in, {});
   }();
   return log;

@@ -129,6 +129,21 @@ TEST(RunStatistics, AMissingEffectIsRankedFromTheMergedStatistics) {
   for (const std::string& e : candidates_to_refit(ranked, kAligned)) EXPECT_NE(e, "quadrature") << "refitted twice";
 }
 
+/// `whole` cut at `cut_s` into two chunks, each a run's statistics of `model`.
+std::vector<RunStatistics> two_chunks(const DiscoveryInput& whole, double cut_s, const std::vector<std::string>& model,
+                                      const DiscoveryOptions& options) {
+  std::vector<RunStatistics> out;
+  for (const auto& [t0, t1] : {std::pair{0.0, cut_s}, std::pair{cut_s, 1e9}}) {
+    DiscoveryInput part = whole;
+    part.samples.clear();
+    for (const Sample& x : whole.samples) {
+      if (x.t >= t0 && x.t < t1) part.samples.push_back(x);
+    }
+    out.push_back(run_statistics(prepare_log(part, options.prepare), model, options));
+  }
+  return out;
+}
+
 // Chunks of one log (--chunk) are runs of their own; merged here each with its own constants (a
 // chunk's sin/cos are normalised by its own amplitude when prepared): merged, they give
 // the whole log's fit. Here a reference zero of 2.5 rad (not aligned: fitted), chunked
@@ -139,15 +154,7 @@ TEST(RunStatistics, ChunksOfOneLogMergedGiveTheWholeLogsFit) {
                                   {{2.0, 200.0, 200.0}, {1.0, 200.0, 450.0}, {2.0, 450.0, 450.0}});
   for (Sample& x : whole.samples) x.theta_m_ref = std::fmod(x.theta_m_ref + 2.5, kTwoPi);
   const DiscoveryOptions options;  // the reference's zero is fitted
-  std::vector<RunStatistics> chunks;
-  for (const auto& [t0, t1] : {std::pair{0.0, 2.5}, std::pair{2.5, 1e9}}) {
-    DiscoveryInput part = whole;
-    part.samples.clear();
-    for (const Sample& x : whole.samples) {
-      if (x.t >= t0 && x.t < t1) part.samples.push_back(x);
-    }
-    chunks.push_back(run_statistics(prepare_log(part, options.prepare), kModel, options));
-  }
+  const std::vector<RunStatistics> chunks = two_chunks(whole, 2.5, kModel, options);
   const MergedFit merged = merge_runs(chunks, {"log [0-2.5 s]", "log [2.5-5 s]"}, {}, options);
   const ModelFit fit = fit_prepared(prepare_log(whole, options.prepare), kModel, options);
   for (const char* name : {"amplitude_imbalance.alpha", "quadrature.beta", "tracking_loop.omega_n"}) {
@@ -175,15 +182,7 @@ TEST(RunStatistics, ChunksOfOneLogShareItsReferenceZero) {
   for (Sample& x : whole.samples) x.theta_m_ref = std::fmod(x.theta_m_ref + 2.5, kTwoPi);
   const DiscoveryOptions options;  // the reference's zero is fitted
   const std::vector<std::string> model{"amplitude_imbalance"};
-  std::vector<RunStatistics> chunks;
-  for (const auto& [t0, t1] : {std::pair{0.0, 2.25}, std::pair{2.25, 1e9}}) {
-    DiscoveryInput part = whole;
-    part.samples.clear();
-    for (const Sample& x : whole.samples) {
-      if (x.t >= t0 && x.t < t1) part.samples.push_back(x);
-    }
-    chunks.push_back(run_statistics(prepare_log(part, options.prepare), model, options));
-  }
+  const std::vector<RunStatistics> chunks = two_chunks(whole, 2.25, model, options);
   const std::vector<std::string> names{"log [0-2.25 s]", "log [2.25-4.5 s]"};
   const auto named = [](const MergedFit& m) {
     return std::any_of(m.candidates.begin(), m.candidates.end(), [](const Candidate& c) { return c.effect == "backlash"; });
@@ -207,16 +206,8 @@ TEST(RunStatistics, ChunksOfOneLogShareItsReferenceZero) {
   held.start.held = {"backlash"};
   held.statistics_candidates = false;  // as refit_from_logs: the model's columns only
   const std::vector<std::string> with{"amplitude_imbalance", "backlash"};
-  std::vector<RunStatistics> again;
-  for (const auto& [t0, t1] : {std::pair{0.0, 2.25}, std::pair{2.25, 1e9}}) {
-    DiscoveryInput part = whole;
-    part.samples.clear();
-    for (const Sample& x : whole.samples) {
-      if (x.t >= t0 && x.t < t1) part.samples.push_back(x);
-    }
-    again.push_back(run_statistics(prepare_log(part, held.prepare), with, held));
-    EXPECT_EQ(again.back().held, std::vector<std::string>{"backlash"});
-  }
+  const std::vector<RunStatistics> again = two_chunks(whole, 2.25, with, held);
+  for (const RunStatistics& r : again) EXPECT_EQ(r.held, std::vector<std::string>{"backlash"});
   const MergedFit exact = merge_runs(again, names, with, options, one_log);
   const ModelFit fit = fit_prepared(prepare_log(whole, options.prepare), with, options);
   const ModelParameter& m = param(exact.params, "backlash.h");
