@@ -70,12 +70,16 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
   if (best != nullptr && (best->reaches_floor || removes_most_excess(m.signals, rows, m.rd, best->weighted_rss))) {
     const bool exact = std::find(m.refitted.begin(), m.refitted.end(), best->effect) != m.refitted.end();
     const bool linear = std::find(m.stepped.begin(), m.stepped.end(), best->effect) == m.stepped.end();
+    const bool held = std::find(m.held.begin(), m.held.end(), best->effect) != m.held.end();
     return {"missing_effect",
             "adding " + best->effect +
                 (best->reaches_floor ? " brings every signal to within " + ratio + "x its floor: "
                                      : " removes most of the residual above the floor: ") +
                 best->reason +
-                (exact    ? " Fitted to convergence on every run (the statistics made again with it in the model)."
+                (exact && held ? " Fitted to convergence by Gauss-Newton over passes of the logs (the statistics made "
+                                 "again with it in the model; runs whose rows alone cannot separate it hold it at the "
+                                 "merged value)."
+                 : exact  ? " Fitted to convergence on every run (the statistics made again with it in the model)."
                  : linear ? " Its parameters enter linearly: the step from the statistics is its fit."
                           : " Its value is one step linearised from zero: make the statistics again with it in "
                             "--effects (or fit the logs) for the exact fit.")};

@@ -417,7 +417,12 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   out.weighted_rss = s.rss_w;
   out.nuisance = constants_at(d, s, runs, names, logs);
   out.signals = merged_signals(stats, s, raw_solution(runs, logs, gf), gf, cols, runs);
-  for (const RunStatistics& r : runs) out.outlier_samples += r.outlier_samples;
+  for (const RunStatistics& r : runs) {
+    out.outlier_samples += r.outlier_samples;
+    for (const std::string& h : r.held) {
+      if (std::find(out.held.begin(), out.held.end(), h) == out.held.end()) out.held.push_back(h);
+    }
+  }
   out.explained = !out.signals.empty();
   for (const SignalResidual& r : out.signals) {
     if (r.rms > options.explained_ratio * r.floor) out.explained = false;
@@ -506,6 +511,7 @@ void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& 
   }
   c.reason = reason_of(term, c.params);
   m.refitted.push_back(effect);
+  if (std::find(with.held.begin(), with.held.end(), effect) != with.held.end()) m.held.push_back(effect);
   std::erase(m.stepped, effect);
   order_ranked(m.candidates, options);
 }

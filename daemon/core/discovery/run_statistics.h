@@ -108,6 +108,10 @@ struct MergedFit {
   /// Candidates whose score is their exact fit: statistics made again with each in the
   /// model and merged (take_exact_refit), not the one linearised step from zero.
   std::vector<std::string> refitted;
+  /// Model effects some run held at their start values (RunStatistics::held), and of the
+  /// refitted candidates those: fitted by Gauss-Newton steps of merges over passes, not
+  /// to convergence on each run.
+  std::vector<std::string> held;
   /// Candidates whose score is still one linearised step although their fit is not
   /// (ranking.h needs_exact_refit): their value and residual are approximate.
   std::vector<std::string> stepped;
