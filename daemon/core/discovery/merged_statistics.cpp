@@ -47,7 +47,7 @@ struct RunColumns {
   Eigen::VectorXd shift;  ///< z_r - target (0 for the constants)
 };
 
-RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::VectorXd& z0, bool share_zero = false) {
+RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::VectorXd& z0, bool share_zero) {
   const std::vector<std::string> names = d.column_names();
   RunColumns rc{std::vector<int>(run.columns.size(), -1), run.point};
   for (std::size_t c = 0; c < run.columns.size(); ++c) {
@@ -150,11 +150,14 @@ std::vector<double> shared_zeros_at(const Design& d, const Eigen::VectorXd& dz, 
   const Eigen::VectorXd z0 = d.z();
   const int k = d.columns();
   std::vector<double> out(kSharedZeros, kNaN);
+  std::vector<RunColumns> columns;
+  columns.reserve(members.size());
+  for (const std::size_t r : members) columns.push_back(run_columns(runs[r], d, z0, true));
   for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
     NormalEquations sum(k + kSharedZeros);
-    for (const std::size_t r : members) {
-      sum.merge(reduce_run(runs[r].stats.all[g], run_columns(runs[r], d, z0, true), runs[r].nuisance_columns,
-                           k + kSharedZeros));
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const RunStatistics& run = runs[members[i]];
+      sum.merge(reduce_run(run.stats.all[g], columns[i], run.nuisance_columns, k + kSharedZeros));
     }
     std::vector<Eigen::Index> own;
     for (Eigen::Index j = k; j < k + kSharedZeros; ++j) {

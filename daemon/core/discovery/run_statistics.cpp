@@ -303,14 +303,15 @@ void take_outliers(const ModelFit& fit, RunStatistics& out) {
 /// options.start.held, the fit of the others (`held` gets the rest).
 ModelFit fit_or_hold(const PreparedLog& log, std::span<const std::string> effects, const DiscoveryOptions& options,
                      std::vector<std::string>& held) {
-  const std::vector<std::string>& holdable = options.start.held;
-  const auto can_hold = [&](const std::string& e) { return std::find(holdable.begin(), holdable.end(), e) != holdable.end(); };
-  if (std::none_of(effects.begin(), effects.end(), can_hold)) return fit_prepared(log, effects, options);
   try {
     return fit_prepared(log, effects, options);
   } catch (const std::invalid_argument&) {
+    const std::vector<std::string>& holdable = options.start.held;
     std::vector<std::string> free;
-    for (const std::string& e : effects) (can_hold(e) ? held : free).push_back(e);
+    for (const std::string& e : effects) {
+      (std::find(holdable.begin(), holdable.end(), e) != holdable.end() ? held : free).push_back(e);
+    }
+    if (held.empty()) throw;
     return fit_prepared(log, free, options);
   }
 }
@@ -325,11 +326,27 @@ Model model_with_held(const ModelFit& fit, const PreparedLog& log, const std::ve
   Model at(spec, log.p_r, log.p);
   for (const ModelParameter& p : fit.model.parameters()) at.set(p.name, p.value);
   (void)apply_start_values(options.start, at);
-  Design d = design_for(at, log);
-  const Design fitted = design_for(fit.model, log);
-  for (int part = 0; part < d.parts(); ++part) d.set_frame_shift(part, fitted.frame_shift(part));
+  Design d = design_for(at, log);  // the fit's frame, which a new Model does not have
+  const std::vector<double>& shifts = fit.model.frame_shifts();
+  for (int part = 0; part < d.parts(); ++part) d.set_frame_shift(part, shifts[static_cast<std::size_t>(part)]);
   at.take_values(d);
   return at;
+}
+
+/// What the runs say of themselves: the effects some held (RunStatistics::held), and
+/// faulty signals (never explained then).
+void take_run_flags(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names, MergedFit& out) {
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    for (const std::string& h : runs[r].held) {
+      if (std::find(out.held.begin(), out.held.end(), h) == out.held.end()) out.held.push_back(h);
+    }
+    for (const std::string& u : runs[r].untrusted) {
+      out.explained = false;
+      out.untrusted = true;
+      out.notes.push_back(fmt::format("{}: signal health: {} (a fit on faulty signals is no evidence: not explained)",
+                                      names[r], u));
+    }
+  }
 }
 
 }  // namespace
@@ -417,12 +434,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   out.weighted_rss = s.rss_w;
   out.nuisance = constants_at(d, s, runs, names, logs);
   out.signals = merged_signals(stats, s, raw_solution(runs, logs, gf), gf, cols, runs);
-  for (const RunStatistics& r : runs) {
-    out.outlier_samples += r.outlier_samples;
-    for (const std::string& h : r.held) {
-      if (std::find(out.held.begin(), out.held.end(), h) == out.held.end()) out.held.push_back(h);
-    }
-  }
+  for (const RunStatistics& r : runs) out.outlier_samples += r.outlier_samples;
   out.explained = !out.signals.empty();
   for (const SignalResidual& r : out.signals) {
     if (r.rms > options.explained_ratio * r.floor) out.explained = false;
@@ -438,14 +450,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
                                     "does not say explained; make the statistics with it in --effects",
                                     fmt::join(stepped, ", "), stepped.size() == 1 ? "is" : "are"));
   }
-  for (std::size_t r = 0; r < runs.size(); ++r) {
-    for (const std::string& u : runs[r].untrusted) {
-      out.explained = false;
-      out.untrusted = true;
-      out.notes.push_back(fmt::format("{}: signal health: {} (a fit on faulty signals is no evidence: not explained)",
-                                      names[r], u));
-    }
-  }
+  take_run_flags(runs, names, out);
   rank_merged(d, stats, s, gf, runs, logs, ref, options, out);
   for (const Candidate& c : out.candidates) {
     if (needs_exact_refit(c, options)) out.stepped.push_back(c.effect);
