@@ -15,6 +15,24 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint32_t kPollEvery = 64;
 /// The fit needs two revolutions (model_discovery.h); a shorter tail is not fitted.
 constexpr double kMinTailRevolutions = 2.0;
+/// Every this many windows one starts cold (header): a speed step moves the valleys of a
+/// loop's omega_n and a delay's phase; a warm start may stay in the old one this long.
+constexpr std::int64_t kColdEvery = 8;
+
+/// Where the next window's fit starts: this one's converged model and the candidates
+/// it refitted to convergence, all settled. Linearised candidates are one step from
+/// neutral, not a fit: they start again from their defaults.
+FitStartValues start_after(const Explanation& ex) {
+  FitStartValues s;
+  s.values = ex.fit.model.parameters();
+  s.settled = ex.fit.effects;
+  for (const Candidate& c : ex.candidates) {
+    if (!c.refitted) continue;
+    s.values.insert(s.values.end(), c.params.begin(), c.params.end());
+    s.settled.push_back(c.effect);
+  }
+  return s;
+}
 
 }  // namespace
 
@@ -116,7 +134,9 @@ void LiveModelFit::finish() {
 
 void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp, std::vector<std::string> untrusted) {
   const ModelFitOptions opt = options_;
-  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window), untrusted = std::move(untrusted)]() {
+  FitStartValues from = windows_started_++ % kColdEvery == 0 ? FitStartValues{} : warm_start_;
+  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window), untrusted = std::move(untrusted),
+                                             from = std::move(from)]() {
     Result r;
     model_fit_t& m = r.message;
     try {
@@ -125,9 +145,11 @@ void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp, std::vector<
       dopt.prepare.reference_aligned = opt.reference_aligned;
       dopt.rank_when_explained = false;  // see DiscoveryOptions: the costly part, moot while explained
       dopt.untrusted_input = untrusted;
+      dopt.start = from;
       Explanation ex;
       if (opt.candidates) ex = explain_model(w, opt.effects, dopt);
       else ex.fit = fit_model(w, opt.effects, dopt);
+      r.next_start = start_after(ex);
       m = make_model_fit_message(&ex, opt.candidates, opt.effects);
       r.fitted = FittedModel{ex.fit.model, ex.fit.account.fitted, ex.fit.account.revolutions_electrical,
                              std_error_basis(ex.fit)};
@@ -161,6 +183,7 @@ void LiveModelFit::publish_ready(bool wait) {
     }
   }
   last_error_ = r.error;
+  warm_start_ = std::move(r.next_start);  // a window that could not be fitted leaves the next one cold
   if (r.fitted) pending_model_ = std::move(r.fitted);
   sink_.publish(r.message);
   last_ = std::move(r.message);

@@ -11,6 +11,10 @@
 //    so every window is fitted and the output is the same on every run.
 //  - Live (`realtime = true`): the reader never waits; a window that completes
 //    while the previous fit still runs is dropped and counted (windows_skipped).
+// A window's fit starts where the last one converged (its model and the candidates it
+// refitted exactly, settled: no other starts), which takes most of the passes off a
+// window whose operating point has not moved; every kColdEvery-th window starts cold
+// (the effects' defaults, every start), so a valley that moved is found again.
 #pragma once
 
 #include <cstdint>
@@ -88,6 +92,7 @@ class LiveModelFit {
     model_fit_t message;
     std::string error;  ///< why the window could not be fitted ("" = fitted)
     std::optional<FittedModel> fitted;
+    FitStartValues next_start;  ///< where the next window's fit starts (empty: cold)
   };
   void start(DiscoveryInput window, const Stamp& stamp, std::vector<std::string> untrusted);
   void publish_ready(bool wait);
@@ -109,6 +114,8 @@ class LiveModelFit {
   Counters counters_;
   std::string taken_std_error_basis_;
   std::optional<FittedModel> pending_model_;
+  FitStartValues warm_start_;        ///< the last fitted window's (Result::next_start)
+  std::int64_t windows_started_ = 0;
 };
 
 }  // namespace resolver

@@ -244,6 +244,9 @@ struct Candidate {
   /// A harmonic family (every significant order at once): named first only when no
   /// smaller candidate reaches the floor (the simplest explanation first).
   bool family = false;
+  /// Fitted to convergence with the model (ranking.h exact refits), not one linearised
+  /// step: its params are a fit a later window may start from.
+  bool refitted = false;
 };
 
 /// Whether a candidate that leaves `weighted_rss_after` (a row at its floor weighs 1)

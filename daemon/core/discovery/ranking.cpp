@@ -294,15 +294,23 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     const ModelTerm& term = one.terms.front();
     ModelSpec with = fit.model.spec();
     with.add(term);
-    Design dm(with, fit.model.values(), nuisances_for(log));
-    dm.set_parts(log.part_count());
     // The model's terms start at its converged fit (their valleys chosen there, with
-    // their other starts); only the candidate's own parameters are started again.
+    // their other starts); the candidate's own parameters are started again, unless
+    // the options settle it (a live window's refit starts where the last window's
+    // converged: live_model_fit.h).
+    Model candidate_start(one, log.p_r, log.p);
+    const bool warm = apply_start_values(options.start, candidate_start).front();
+    std::vector<std::vector<double>> values = fit.model.values();
+    values.resize(with.terms.size() - 1);
+    values.push_back(warm ? candidate_start.values().front() : std::vector<double>{});
+    Design dm(with, values, nuisances_for(log));
+    dm.set_parts(log.part_count());
     std::vector<bool> settled(dm.terms().size(), true);
-    settled.back() = false;
+    settled.back() = warm;
     const FitResult fr = fit_design(dm, log.rows, floors, 12, {}, settled);
     out.passes += fr.passes;
     if (!fr.ok) continue;
+    c.refitted = true;
     score_candidate(c, fr.last, log.rd, base, floors, options);
     c.params = term_params(dm, dm.terms().size() - 1, fr.last, false);
     c.reason = reason_of(term, c.params);

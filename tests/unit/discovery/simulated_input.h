@@ -3,6 +3,7 @@
 // the given effect specs ("amplitude_imbalance:alpha=0.003") and speed profile.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,8 +16,9 @@
 namespace resolver {
 
 inline DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<SpeedSegment> profile = {{5.0, 200.0, 200.0}},
-                        double alpha_drift_per_s = 0.0) {
+                        double alpha_drift_per_s = 0.0, std::uint64_t seed = 1) {
   SimConfig cfg;
+  cfg.seed = seed;
   cfg.profile = std::move(profile);
   cfg.alpha_drift_per_s = alpha_drift_per_s;
   for (const auto& s : specs) {
