@@ -64,8 +64,8 @@ STANDSTILL_EDGE_SAMPLES = 10
 # failure (net angle 0 for out-and-back, 161x for noise counted as revolutions).
 TRAVEL_TOLERANCE = 0.01
 # --streaming: a candidate's parameters from two chunks merged against the whole log.
-# Each chunk is a run with its own amplitude, operating point and noise floor (the weights;
-# the log's reference zero is shared), so the two
+# Each chunk is a run with its own operating point and noise floor (the weights; the log's
+# reference zero, envelope gain and clock are shared), so the two
 # fits are of the same rows with slightly different nuisances: measured 0.01-0.03
 # standard errors on 6 s logs (integration_stats_merge); one standard error is a margin
 # far below any decision, and far above rounding.

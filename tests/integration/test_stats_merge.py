@@ -93,7 +93,7 @@ def check_merge_is_pooled_fit(model, work, a, b):
                 for n, v in merged["params"].items()),
             "merge b a gives merge a b's parameters (to the 9 digits printed)")
     head = json.loads(sa.read_text())
-    c.check(head["format"] == "resolver-model stats" and head["version"] == 2 and head["tool"].startswith("resolver-model")
+    c.check(head["format"] == "resolver-model stats" and head["version"] == 3 and head["tool"].startswith("resolver-model")
             and len(head["runs"]) == 1 and head["runs"][0]["bench"] == {"p_r": 3, "p": 3} and head["layout"]["id"]
             and head["log"] == str(a), "the statistics file says what it is: format, version, tool, layout, log, bench")
     return sa, sb
@@ -245,11 +245,11 @@ def main():
 
     # 6. bad input
     text = sa.read_text()
-    bad = {"v1.stats": text.replace('"version":2', '"version":1', 1), "cut.stats": text[: len(text) // 2],
+    bad = {"v1.stats": text.replace('"version":3', '"version":2', 1), "cut.stats": text[: len(text) // 2],
            "layout.stats": json.dumps(dict(json.loads(text), layout={"id": "other", "description": "a CSV layout"}))}
     for name, body in bad.items():
         (w / name).write_text(body)
-    refused(model, [sa, w / "v1.stats"], 2, ["v1.stats", "version 1"], "a file of another version")
+    refused(model, [sa, w / "v1.stats"], 2, ["v1.stats", "version 2"], "a file of another version")
     refused(model, [sa, w / "cut.stats"], 2, ["cut.stats", "not a statistics file"], "a truncated file")
     refused(model, [sa, a], 2, [str(a), "not a statistics file"], "a log given as statistics")
     refused(model, [sa, w / "layout.stats"], 2, ["layout.stats", "another layout"], "statistics of another layout")

@@ -23,6 +23,7 @@
 // (candidate_sets): a version 1 file lacks them, so it is made again.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,7 +31,9 @@
 
 namespace resolver {
 
-inline constexpr int kStatsFileVersion = 2;
+/// 3: a log's chunks are normalised by its first chunk's amplitude and timed from its origin
+/// (a merge shares their gain and clock): version 2 chunks had their own.
+inline constexpr int kStatsFileVersion = 3;
 
 /// One run of a file: its name (the log, or "LOG [t0-t1 s]" for a chunk) and statistics.
 struct NamedRun {
@@ -50,6 +53,11 @@ struct StatsFile {
   /// What the reader said and counted (log_samples.h input_notes): malformed lines,
   /// input problems, what the log lacks; a merge prints them.
   std::vector<std::string> input;
+  /// [counts] the first run's envelope amplitude: a later chunk is normalised by it
+  /// (PrepareOptions::amplitude; not written: a pass over the log finds it again).
+  double amplitude = 0.0;
+  /// [s] the first run's time origin (PrepareOptions::time_origin), likewise.
+  double time_origin = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// The file's text.

@@ -30,14 +30,19 @@ void add_run(StatsFile& file, const std::string& name, const DiscoveryInput& inp
              const DiscoveryOptions& options) {
   const PreparedLog prepared = prepare_log(input, options.prepare);
   file.runs.push_back({name, run_statistics(prepared, effects, options)});
+  if (!(file.amplitude > 0.0) && prepared.sincos) file.amplitude = prepared.amplitude;
+  if (!std::isfinite(file.time_origin)) file.time_origin = prepared.time_origin;
 }
 
 void add_chunk(StatsFile& file, const DiscoveryInput& chunk, std::span<const std::string> effects,
                const DiscoveryOptions& options) {
   const double t0 = chunk.samples.front().t, t1 = chunk.samples.back().t;
   const std::string name = fmt::format("{} [{:.6g}-{:.6g} s]", file.log, t0, t1);
+  DiscoveryOptions scaled = options;
+  scaled.prepare.amplitude = file.amplitude;  // the first chunk's: one scale, one gain for the log
+  scaled.prepare.time_origin = file.time_origin;  // and one time axis (a drift is one line)
   try {
-    add_run(file, name, chunk, effects, options);
+    add_run(file, name, chunk, effects, scaled);
   } catch (const std::invalid_argument& e) {
     file.left_out.push_back(fmt::format("{}: {} samples left out: {}", name, chunk.samples.size(), e.what()));
   }

@@ -26,37 +26,40 @@ bool frame_constant(const std::string& column) {
   return column == nuisance_name(Nuisance::kRdConstant) || column == nuisance_name(Nuisance::kSaConstant);
 }
 
-/// The chunks of one log share its reference zero: one constant per position error
-/// (the R/D's, the sin/cos angle's), held after the design's columns while the log's
-/// runs are added, then profiled out (profile_shared).
-constexpr int kSharedZeros = 2;
+/// The chunks of one log share its reference zero (one constant per position error: the
+/// R/D's, the sin/cos angle's) and its envelopes' gain (the chunks are normalised by one
+/// amplitude, PrepareOptions::amplitude; a gain per chunk would take a drift of the
+/// envelopes over time as steps between chunks). They are held after the design's
+/// columns while the log's runs are added, then profiled out (profile_shared).
+constexpr int kSharedConstants = 3;
 
-int shared_zero_slot(const std::string& column) {
+int shared_slot(const std::string& column) {
   if (column == nuisance_name(Nuisance::kRdConstant)) return 0;
   if (column == nuisance_name(Nuisance::kSaConstant)) return 1;
+  if (column == nuisance_name(Nuisance::kScGain)) return 2;
   return -1;
 }
 
 /// Where a run's columns go in the merged design and how far each is moved: its own
 /// constants (the first columns) are profiled out, the design's columns kept, the rest
-/// held at their neutral value. With `share_zero` its reference zero goes to the log's
-/// shared column instead, moved by the run's frame shift: the run holds it at zero in
-/// its own fit's frame, the log's is in the log's frame (constants_at).
+/// held at their neutral value. With `share` its reference zero and gain go to the log's
+/// shared columns instead, the zero moved by the run's frame shift: the run holds it at
+/// zero in its own fit's frame, the log's is in the log's frame (constants_at).
 struct RunColumns {
   std::vector<int> to;    ///< run column -> design column, -1: a constant or held
   Eigen::VectorXd shift;  ///< z_r - target (0 for the constants)
 };
 
-RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::VectorXd& z0, bool share_zero) {
+RunColumns run_columns(const RunStatistics& run, const Design& d, const Eigen::VectorXd& z0, bool share) {
   const std::vector<std::string> names = d.column_names();
   RunColumns rc{std::vector<int>(run.columns.size(), -1), run.point};
   for (std::size_t c = 0; c < run.columns.size(); ++c) {
     const auto i = static_cast<Eigen::Index>(c);
     if (static_cast<int>(c) < run.nuisance_columns) {
       rc.shift[i] = 0.0;
-      if (const int slot = shared_zero_slot(run.columns[c]); share_zero && slot >= 0) {
+      if (const int slot = shared_slot(run.columns[c]); share && slot >= 0) {
         rc.to[c] = d.columns() + slot;
-        rc.shift[i] = -run.frame_shift;
+        if (frame_constant(run.columns[c])) rc.shift[i] = -run.frame_shift;
       }
       continue;
     }
@@ -110,7 +113,7 @@ std::vector<Eigen::Index> constants_in(const NormalEquations& ne, int nuisance_c
 
 /// One group's statistics of a run moved to the design's point (b + M d, yy + 2 d'b +
 /// d'M d: header) and with the run's own constants profiled out: over `k_out` columns
-/// (the design's, then the log's shared zeros). Exact: a constant enters one group's
+/// (the design's, then the log's shared constants). Exact: a constant enters one group's
 /// signal only, so profiling group by group is profiling the weighted sum.
 NormalEquations reduce_run(const NormalEquations& ne, const RunColumns& rc, int nuisance_columns, int k_out) {
   std::vector<Eigen::Index> kept;
@@ -132,7 +135,7 @@ NormalEquations reduce_run(const NormalEquations& ne, const RunColumns& rc, int 
   return out;
 }
 
-/// A log's summed statistics with its shared zeros (the columns from `k_design` on that
+/// A log's summed statistics with its shared constants (the columns from `k_design` on that
 /// its rows carry) profiled out: over the design's columns.
 NormalEquations profile_shared(const NormalEquations& ne, int k_design) {
   std::vector<Eigen::Index> own, kept;
@@ -143,24 +146,24 @@ NormalEquations profile_shared(const NormalEquations& ne, int k_design) {
   return profiled(ne, own, kept);
 }
 
-/// The shared zeros of a log's runs at the solution (M_ss^-1 (b_s - M_sk ds) of the group
+/// The shared constants of a log's runs at the solution (M_ss^-1 (b_s - M_sk ds) of the group
 /// that carries each, in the log's frame): NaN where none.
-std::vector<double> shared_zeros_at(const Design& d, const Eigen::VectorXd& dz, const std::vector<RunStatistics>& runs,
+std::vector<double> shared_constants_at(const Design& d, const Eigen::VectorXd& dz, const std::vector<RunStatistics>& runs,
                                     const std::vector<std::size_t>& members) {
   const Eigen::VectorXd z0 = d.z();
   const int k = d.columns();
-  std::vector<double> out(kSharedZeros, kNaN);
+  std::vector<double> out(kSharedConstants, kNaN);
   std::vector<RunColumns> columns;
   columns.reserve(members.size());
   for (const std::size_t r : members) columns.push_back(run_columns(runs[r], d, z0, true));
   for (std::size_t g = 0; g < static_cast<std::size_t>(kGroups); ++g) {
-    NormalEquations sum(k + kSharedZeros);
+    NormalEquations sum(k + kSharedConstants);
     for (std::size_t i = 0; i < members.size(); ++i) {
       const RunStatistics& run = runs[members[i]];
-      sum.merge(reduce_run(run.stats.all[g], columns[i], run.nuisance_columns, k + kSharedZeros));
+      sum.merge(reduce_run(run.stats.all[g], columns[i], run.nuisance_columns, k + kSharedConstants));
     }
     std::vector<Eigen::Index> own;
-    for (Eigen::Index j = k; j < k + kSharedZeros; ++j) {
+    for (Eigen::Index j = k; j < k + kSharedConstants; ++j) {
       if (sum.m()(j, j) > 0.0) own.push_back(j);
     }
     if (own.empty()) continue;
@@ -192,7 +195,7 @@ MergedStatistics assemble(const Design& d, const std::vector<RunStatistics>& run
   MergedStatistics out(d.columns());
   for (const std::vector<std::size_t>& members : logs) {
     const bool share = members.size() > 1;
-    const int k_out = d.columns() + (share ? kSharedZeros : 0);
+    const int k_out = d.columns() + (share ? kSharedConstants : 0);
     MergedStatistics log(k_out);
     for (const std::size_t r : members) {
       const RunStatistics& run = runs[r];
@@ -215,14 +218,14 @@ MergedStatistics assemble(const Design& d, const std::vector<RunStatistics>& run
 /// Each run's constants at the solution `s` (profiled: M_nn^-1 (b_n - M_ns ds) of the
 /// group that carries each), named "...[run]"; the position errors' constants in the
 /// log's frame (the frame shift taken off, as nuisance_at_solution). A log's chunks
-/// show its shared zero.
+/// show its shared constants.
 std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s, const std::vector<RunStatistics>& runs,
                                          const std::vector<std::string>& names, const RunsByLog& logs) {
   const Eigen::VectorXd z0 = d.z();
   std::vector<ModelParameter> out;
   for (const std::vector<std::size_t>& members : logs) {
     const bool share = members.size() > 1;
-    const std::vector<double> zeros = share ? shared_zeros_at(d, s.dz, runs, members) : std::vector<double>{};
+    const std::vector<double> zeros = share ? shared_constants_at(d, s.dz, runs, members) : std::vector<double>{};
     for (const std::size_t r : members) {
       const RunStatistics& run = runs[r];
       const RunColumns rc = run_columns(run, d, z0, share);
@@ -242,7 +245,7 @@ std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s,
       for (int j = 0; j < run.nuisance_columns; ++j) {
         const std::string& column = run.columns[static_cast<std::size_t>(j)];
         double v = value[j];
-        if (const int slot = shared_zero_slot(column); share && slot >= 0) {
+        if (const int slot = shared_slot(column); share && slot >= 0) {
           v = zeros[static_cast<std::size_t>(slot)];
         } else if (frame_constant(column)) {
           v -= run.frame_shift;

@@ -1,6 +1,6 @@
 // Runs' statistics merged (run_statistics.h): each run moved to one point and its own
 // constants profiled out, group by group and fold by fold; the chunks of one log share
-// its reference zero. The algebra is run_statistics.h's header. Internal to discovery.
+// its reference zero and envelope gain. The algebra is run_statistics.h's header. Internal to discovery.
 #pragma once
 
 #include <cstddef>
@@ -32,7 +32,7 @@ struct MergedStatistics {
   }
 };
 
-/// The runs merged as logs: each log's runs (its chunks share its reference zero; a log
+/// The runs merged as logs: each log's runs (its chunks share its reference zero and gain; a log
 /// of one run has only its own constants).
 using RunsByLog = std::vector<std::vector<std::size_t>>;
 
@@ -43,7 +43,7 @@ using RunsByLog = std::vector<std::vector<std::size_t>>;
 [[nodiscard]] MergedStatistics assemble(const Design& d, const std::vector<RunStatistics>& runs, const RunsByLog& logs);
 
 /// Each run's constants at the solution `s`, named "...[run]"; the position errors' in
-/// the log's frame; a log's chunks show its shared zero.
+/// the log's frame; a log's chunks show its shared constants.
 [[nodiscard]] std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s,
                                                        const std::vector<RunStatistics>& runs,
                                                        const std::vector<std::string>& names, const RunsByLog& logs);

@@ -226,18 +226,20 @@ std::vector<const Sample*> usable_samples(const DiscoveryInput& in, PreparedLog&
 }
 
 /// [s] each sample's time from the first; sets the median sample period.
-std::vector<double> sample_times(const std::vector<const Sample*>& s, PreparedLog& p) {
+std::vector<double> sample_times(const std::vector<const Sample*>& s, const PrepareOptions& opt, PreparedLog& p) {
   const std::size_t n = s.size();
   std::vector<double> t(n), dts;
-  for (std::size_t i = 0; i < n; ++i) t[i] = s[i]->t - s.front()->t;
+  p.time_origin = std::isfinite(opt.time_origin) ? opt.time_origin : s.front()->t;
+  for (std::size_t i = 0; i < n; ++i) t[i] = s[i]->t - p.time_origin;
   dts.reserve(n);
   for (std::size_t i = 1; i < n; ++i) dts.push_back(t[i] - t[i - 1]);
   p.sample_period = std::max(median(dts), 1e-9);
   return t;
 }
 
-/// Envelope amplitude [counts]: the median radius (robust to outliers and clipping).
-void measure_amplitude(const std::vector<const Sample*>& s, PreparedLog& p) {
+/// Envelope amplitude [counts]: the median radius (robust to outliers and clipping), or
+/// the one the options give (a later chunk of a log: PrepareOptions::amplitude).
+void measure_amplitude(const std::vector<const Sample*>& s, const PrepareOptions& opt, PreparedLog& p) {
   std::vector<double> radius;
   radius.reserve(s.size());
   for (const Sample* x : s) {
@@ -247,6 +249,8 @@ void measure_amplitude(const std::vector<const Sample*>& s, PreparedLog& p) {
   if (!(p.amplitude > 0.0)) {
     p.sincos = false;
     p.notes.emplace_back("sin/cos envelopes are zero: loss of signal; the sin/cos rows are not fitted");
+  } else if (opt.amplitude > 0.0) {
+    p.amplitude = opt.amplitude;
   }
 }
 
@@ -500,8 +504,8 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   p.samples_in = static_cast<std::int64_t>(in.samples.size());
   const bool currents = detect_signals(in, opt, p);
   const std::vector<const Sample*> s = usable_samples(in, p);
-  const std::vector<double> t = sample_times(s, p);
-  if (p.sincos) measure_amplitude(s, p);
+  const std::vector<double> t = sample_times(s, opt, p);
+  if (p.sincos) measure_amplitude(s, opt, p);
   const TrueAngles angles = true_angles(s, t, p);
   build_rows(in, s, t, angles, currents, opt, p);
   set_current_operating_point(p);

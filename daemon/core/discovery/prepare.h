@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,14 @@ struct PrepareOptions {
   /// constant position error is then the mounting offset. Otherwise it is the
   /// reference's own zero, a free constant (a nuisance) of every fit.
   bool reference_aligned = false;
+  /// [counts] the envelopes' amplitude the radius is normalised by; 0 = the median
+  /// radius of these samples. A later chunk of a long log takes its first chunk's, so
+  /// the chunks share one scale (and the merge one gain: merged_statistics.h).
+  double amplitude = 0.0;
+  /// [s] the sample time that is the rows' t = 0; NaN = the first usable sample's. A
+  /// later chunk of a long log takes its first chunk's: a drift over time is then one
+  /// line across the chunks, as in the whole log.
+  double time_origin = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct PreparedLog {
@@ -54,6 +63,7 @@ struct PreparedLog {
   bool currents = false;   ///< dq rows (needs the reference)
   double amplitude = 0.0;      ///< [counts] median sin/cos radius
   double sample_period = 0.0;  ///< [s] median
+  double time_origin = 0.0;    ///< [s] the sample time of the rows' t = 0 (PrepareOptions)
   std::vector<FitRow> rows;
   /// Of each row, its sample: rows[i] came from DiscoveryInput::samples[sample_of_row[i]]
   /// (the raw signals behind a row, e.g. for resolver-model export-data).
