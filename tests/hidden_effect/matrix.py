@@ -210,11 +210,16 @@ XFAIL = [
      "rows are mismatched (h 0.13 % low, 5e-6 rad: 7-23 formal se; about 3 rows of a 4 mrad take-up carry "
      "that bias). The chunks now share the log's "
      "reference zero (backlash is named first, as in memory)"),
-    (["*/envelope_drift/steps:stream_value", "*/envelope_drift/reversals:stream_value",
-      "*/eccentricity/steps:stream_value", "*/mounting_offset/reversals:stream_value"],
+    (["*/envelope_drift/steps:stream_value", "*/envelope_drift/reversals:stream_value"],
      "not yet diagnosed: the chunks of a log share its reference zero, envelope gain and clock "
      "(the drift's const, oab3, oab1 and ramps profiles pass since: 0.5-0.6 se, from 2.7-3.0), but "
      "keep their own noise floors (the rows' weights), outlier flags and operating point; the "
-     "drift's steps and reversals profiles are 1.7 and 2.3 se apart, the eccentricity's phase at "
-     "speed steps and a mounting offset across reversals 3-21 se (analysed with the reference aligned)"),
+     "drift's steps and reversals profiles are 1.7 and 2.3 se apart"),
+    (["*/mounting_offset/reversals:stream_value"],
+     "the chunks' own fits of the model lie far apart (alpha -0.0067 +- 0.0097 and 0.0127 +- 0.01: "
+     "a 50 mrad offset turns the dq currents, which the default model cannot follow) and the merge "
+     "moves each run's statistics linearly to the merged point: theta_0 2.7 urad (11 se) from the "
+     "fit in memory. Relinearising every run at the merged point (Gauss-Newton over passes for the "
+     "model, as for a held candidate) is the fix; not built. (The eccentricity's phase at speed "
+     "steps was a candidate's phase standard error read as the Cartesian one: fixed.)"),
 ]

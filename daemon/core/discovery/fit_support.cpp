@@ -110,4 +110,16 @@ std::string num(double v, const char* format) {
   return buf;
 }
 
+double polar_std_error(const DesignTerm& t, std::size_t p, const Eigen::Matrix2d& cov_xy) {
+  const auto ps = t.effect->params();
+  const bool amplitude = ps[p].polar == Polar::kAmplitude;
+  const std::size_t amp = amplitude ? p : p - 1;
+  const double e = t.values[amp], ph = t.values[amp + 1];
+  const double x = e * std::cos(ph), y = e * std::sin(ph);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector2d j = amplitude ? Eigen::Vector2d(e > 0 ? x / e : 1.0, e > 0 ? y / e : 0.0)
+                                      : Eigen::Vector2d(e > 0 ? -y / (e * e) : nan, e > 0 ? x / (e * e) : nan);
+  return std::sqrt(std::max(0.0, j.dot(cov_xy * j)));
+}
+
 }  // namespace resolver

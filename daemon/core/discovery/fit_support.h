@@ -59,4 +59,10 @@ void check_model_against_log(const ModelSpec& spec, const PreparedLog& log);
 /// "%.3g" formatting for messages.
 [[nodiscard]] std::string num(double v, const char* format = "%.3g");
 
+/// Standard error of a polar pair's amplitude or phase (parameter `p` of `t`: Polar::
+/// kAmplitude or kPhase; the design fits their Cartesian x and y) from the covariance
+/// `cov_xy` of x and y, at the term's values: the Jacobian of (x, y) -> (e, phase). The
+/// phase's is the Cartesian one over e (NaN at e = 0: no phase to speak of).
+[[nodiscard]] double polar_std_error(const DesignTerm& t, std::size_t p, const Eigen::Matrix2d& cov_xy);
+
 }  // namespace resolver

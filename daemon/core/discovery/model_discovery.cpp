@@ -59,15 +59,8 @@ void fill_params(ModelFit& f, const Design& d, const Eigen::MatrixXd& cov) {
       const int col = d.term_column(i) + static_cast<int>(k);
       double se = std::sqrt(std::max(0.0, cov(col, col)));
       if (ps[p].polar == Polar::kAmplitude || ps[p].polar == Polar::kPhase) {
-        // (e, phase) from (x, y): the Jacobian of the polar map.
-        const std::size_t amp = ps[p].polar == Polar::kAmplitude ? p : p - 1;
         const int cx = ps[p].polar == Polar::kAmplitude ? col : col - 1;
-        const double e = t.values[amp], ph = t.values[amp + 1];
-        const double x = e * std::cos(ph), y = e * std::sin(ph);
-        Eigen::Vector2d j = ps[p].polar == Polar::kAmplitude
-                                ? Eigen::Vector2d(e > 0 ? x / e : 1.0, e > 0 ? y / e : 0.0)
-                                : Eigen::Vector2d(e > 0 ? -y / (e * e) : kNaN, e > 0 ? x / (e * e) : kNaN);
-        se = std::sqrt(std::max(0.0, j.dot(cov.block(cx, cx, 2, 2) * j)));
+        se = polar_std_error(t, p, cov.block(cx, cx, 2, 2));
       } else if (ps[p].nonlinear && ps[p].scale == FitScale::kInverseSquare) {
         const double z = to_internal(ps[p], t.values[p]);
         se = z > 0.0 ? se * 0.5 * std::pow(z, -1.5) : kNaN;

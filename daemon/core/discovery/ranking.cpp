@@ -193,10 +193,16 @@ std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& par
 
 namespace {
 
-/// Standard error of one parameter in value coordinates from a solution's inverse
-/// (column `col`, internal coordinate `z` for the inverse-square scale).
-double value_std_error(const ParamInfo& info, const StepSolution& s, int col, double z) {
+/// Standard error of parameter `p` of `t` (column `col`, internal coordinate `z` for the
+/// inverse-square scale) in value coordinates from a solution's inverse: a polar pair's
+/// amplitude and phase through the polar map (fit_support.h).
+double value_std_error(const DesignTerm& t, std::size_t p, const StepSolution& s, int col, double z) {
+  const ParamInfo& info = t.effect->params()[p];
   const double s2 = s.rss_w / std::max(1.0, static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k));
+  if (info.polar == Polar::kAmplitude || info.polar == Polar::kPhase) {
+    const int cx = info.polar == Polar::kAmplitude ? col : col - 1;
+    return polar_std_error(t, p, s2 * Eigen::Matrix2d(s.inverse.block(cx, cx, 2, 2)));
+  }
   double se = std::sqrt(std::max(0.0, s2 * s.inverse(col, col)));
   if (info.nonlinear && info.scale == FitScale::kInverseSquare) se *= 0.5 * std::pow(std::max(z, 1e-300), -1.5);
   return se;
@@ -217,7 +223,7 @@ std::vector<ModelParameter> term_params(const Design& design, std::size_t term, 
     const int col = design.term_column(term) + static_cast<int>(k);
     const double z = z_at[col] + (step ? s.dz[col] : 0.0);
     out.push_back({std::string(dt.effect->name()) + "." + std::string(info.name), dt.values[p],
-                   value_std_error(info, s, col, z), std::string(info.unit)});
+                   value_std_error(dt, p, s, col, z), std::string(info.unit)});
   }
   return out;
 }

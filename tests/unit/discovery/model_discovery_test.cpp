@@ -104,6 +104,30 @@ TEST(ModelDiscovery, AWindowStartedWhereTheLastConvergedEndsWhereAColdFitDoes) {
   EXPECT_LT(warm_fit.fit.passes, cold_fit.fit.passes);
 }
 
+// A candidate's polar pair (eccentricity's e and phase: the design fits their Cartesian
+// x and y) reports its standard errors through the polar map, as the model's fit does:
+// the phase's is the Cartesian one over e. It once reported the Cartesian one for both,
+// 1/e = 2000x too small, and a streaming check read 0.2 urad as 7 standard errors.
+TEST(ModelDiscovery, ACandidatesPhaseHasItsOwnStandardError) {
+  const auto in = simulate({"amplitude_imbalance:alpha=0.003", "eccentricity:e=5e-4,phase=1"});
+  const Explanation ex = explain_model(in, kDefault, kAligned);
+  const auto c = std::find_if(ex.candidates.begin(), ex.candidates.end(),
+                              [](const Candidate& x) { return x.effect == "eccentricity"; });
+  ASSERT_NE(c, ex.candidates.end());
+  const auto named = [](const std::vector<ModelParameter>& ps, const std::string& n) {
+    return *std::find_if(ps.begin(), ps.end(), [&](const ModelParameter& p) { return p.name == n; });
+  };
+  const ModelParameter e = named(c->params, "eccentricity.e"), phase = named(c->params, "eccentricity.phase");
+  EXPECT_NEAR(phase.std_error, e.std_error / e.value, 0.2 * e.std_error / e.value);
+  // Of the order of the model's fit with it added (its errors robust, the candidate's
+  // formal: measured 1.75x apart, where the Cartesian error was 1/2000 of it).
+  const std::vector<std::string> model{"amplitude_imbalance", "eccentricity"};
+  const Explanation with = explain_model(in, model, kAligned);
+  const double fitted = named(with.fit.params, "eccentricity.phase").std_error;
+  EXPECT_GT(phase.std_error, fitted / 3.0);
+  EXPECT_LT(phase.std_error, fitted * 3.0);
+}
+
 TEST(ModelDiscovery, HiddenOffsetsAreNamedFirst) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "offsets:o_s=0.001,o_c=-0.0015"});
   const Explanation ex = explain_model(in, kDefault, kAligned);
