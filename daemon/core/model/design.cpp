@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 namespace resolver {
@@ -278,8 +279,8 @@ BasisTransform Design::transform(const SignatureRow& row, int part, std::size_t 
 }
 
 SignalValues Design::predict_with(const SignatureRow& row, int part, AngleBasis& basis, std::size_t override_term,
-                                  const std::vector<double>* override_values) const {
-  basis.set(row, transform(row, part, override_term, override_values));
+                                  const std::vector<double>* override_values, const BasisTransform* tr) const {
+  basis.set(row, tr != nullptr ? *tr : transform(row, part, override_term, override_values));
   SignalValues pred;
   const bool envelope_override = override_values != nullptr && override_term < terms_.size() &&
                                  terms_[override_term].effect->envelope_only();
@@ -362,6 +363,29 @@ void Design::evaluate(std::span<const FitRow> rows, std::size_t i, AngleBasis& b
   evaluate_row(row, rows[i].part, basis, prediction, jac);
 }
 
+namespace {
+
+/// [rad] the shift step of Design::shift_slope: as fd_step's for a parameter of range 1.
+constexpr double kShiftStep = 1e-7;
+
+SignalValues difference(const SignalValues& a, const SignalValues& b, double h) {
+  return SignalValues{.rd = (a.rd - b.rd) / h, .sa = (a.sa - b.sa) / h, .sr = (a.sr - b.sr) / h, .d = (a.d - b.d) / h,
+                      .q = (a.q - b.q) / h};
+}
+
+/// Whether two transforms differ in their shift only (the same loop and delay).
+bool only_shift_differs(const BasisTransform& a, const BasisTransform& b) {
+  return a.delay == b.delay && a.loop["omega_n"] == b.loop["omega_n"] && a.loop["zeta"] == b.loop["zeta"];
+}
+
+}  // namespace
+
+SignalValues Design::shift_slope(const SignatureRow& row, int part, const SignalValues& prediction) const {
+  BasisTransform moved = transform(row, part, terms_.size(), nullptr);
+  moved.shift += kShiftStep;
+  return difference(predict_with(row, part, shifted_, terms_.size(), nullptr, &moved), prediction, kShiftStep);
+}
+
 void Design::evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, SignalValues& prediction,
                           RowJacobian& jac) const {
   if (jac.rd.size() != columns_) jac.resize(columns_);
@@ -383,6 +407,7 @@ void Design::evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, 
   }
   col = nuisance_columns();
   AngleBasis& shifted = shifted_;  // numeric derivatives move the basis; `basis` stays at the model's
+  std::optional<SignalValues> slope;  // shift_slope, once per row when needed
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const auto ps = t.effect->params();
@@ -410,10 +435,21 @@ void Design::evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, 
         const double z = ps[p].polar != Polar::kNone ? 0.0 : to_internal(ps[p], t.values[p]);
         const double h = fd_step(ps[p], z);
         const std::vector<double> moved = values_with(i, static_cast<int>(k), h);
-        const SignalValues shifted_pred = predict_with(row, part, shifted, i, &moved);
-        c = SignalValues{.rd = (shifted_pred.rd - prediction.rd) / h, .sa = (shifted_pred.sa - prediction.sa) / h,
-                         .sr = (shifted_pred.sr - prediction.sr) / h, .d = (shifted_pred.d - prediction.d) / h,
-                         .q = (shifted_pred.q - prediction.q) / h};
+        BasisTransform at, to;  // this candidate's own action on the basis, before and moved
+        t.effect->configure_basis(row, t.values, at);
+        t.effect->configure_basis(row, moved, to);
+        if (t.candidate && only_shift_differs(at, to)) {
+          // A candidate that moves the seen angle only (eccentricity, mechanical harmonics,
+          // mounting offset, backlash): the model's change is its slope in the shift times
+          // the shift's, plus the candidate's own column (its signature, above); the same
+          // first-order derivative without a whole prediction per column.
+          if (!slope) slope = shift_slope(row, part, prediction);
+          const double ds = (to.shift - at.shift) / h;
+          c = SignalValues{.rd = c.rd + slope->rd * ds, .sa = c.sa + slope->sa * ds, .sr = c.sr + slope->sr * ds,
+                           .d = c.d + slope->d * ds, .q = c.q + slope->q * ds};
+        } else {
+          c = difference(predict_with(row, part, shifted, i, &moved), prediction, h);
+        }
       }
       jac.rd[col] = c.rd;
       jac.sa[col] = c.sa;

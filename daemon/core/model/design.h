@@ -138,8 +138,13 @@ class Design {
  private:
   [[nodiscard]] BasisTransform transform(const SignatureRow& row, int part, std::size_t extra_term,
                                          const std::vector<double>* extra_values) const;
+  /// `tr`: the basis transform to use instead of the terms' (a shift moved: evaluate_row).
   [[nodiscard]] SignalValues predict_with(const SignatureRow& row, int part, AngleBasis& basis, std::size_t override_term,
-                                          const std::vector<double>* override_values) const;
+                                          const std::vector<double>* override_values,
+                                          const BasisTransform* tr = nullptr) const;
+  /// d(prediction)/d(shift) of the model at a row (the seen angle's shift, BasisTransform):
+  /// numerically, one prediction with the shift moved.
+  [[nodiscard]] SignalValues shift_slope(const SignatureRow& row, int part, const SignalValues& prediction) const;
   void rebuild();
   /// The envelope terms' joint series and every envelope column's derivative series
   /// at the current values (computed on first use after a change).
