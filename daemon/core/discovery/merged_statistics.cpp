@@ -225,7 +225,7 @@ std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s,
   std::vector<ModelParameter> out;
   for (const std::vector<std::size_t>& members : logs) {
     const bool share = members.size() > 1;
-    const std::vector<double> zeros = share ? shared_constants_at(d, s.dz, runs, members) : std::vector<double>{};
+    const std::vector<double> shared = share ? shared_constants_at(d, s.dz, runs, members) : std::vector<double>{};
     for (const std::size_t r : members) {
       const RunStatistics& run = runs[r];
       const RunColumns rc = run_columns(run, d, z0, share);
@@ -246,7 +246,7 @@ std::vector<ModelParameter> constants_at(const Design& d, const StepSolution& s,
         const std::string& column = run.columns[static_cast<std::size_t>(j)];
         double v = value[j];
         if (const int slot = shared_slot(column); share && slot >= 0) {
-          v = zeros[static_cast<std::size_t>(slot)];
+          v = shared[static_cast<std::size_t>(slot)];
         } else if (frame_constant(column)) {
           v -= run.frame_shift;
         }

@@ -225,7 +225,8 @@ std::vector<const Sample*> usable_samples(const DiscoveryInput& in, PreparedLog&
   return s;
 }
 
-/// [s] each sample's time from the first; sets the median sample period.
+/// [s] each sample's time from the origin (the first sample's, or PrepareOptions::
+/// time_origin for a later chunk of a log); sets the origin and the median sample period.
 std::vector<double> sample_times(const std::vector<const Sample*>& s, const PrepareOptions& opt, PreparedLog& p) {
   const std::size_t n = s.size();
   std::vector<double> t(n), dts;

@@ -307,7 +307,6 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     Model candidate_start(one, log.p_r, log.p);
     const bool warm = apply_start_values(options.start, candidate_start).front();
     std::vector<std::vector<double>> values = fit.model.values();
-    values.resize(with.terms.size() - 1);
     values.push_back(warm ? candidate_start.values().front() : std::vector<double>{});
     Design dm(with, values, nuisances_for(log));
     dm.set_parts(log.part_count());

@@ -435,9 +435,11 @@ void Design::evaluate_row(const SignatureRow& row, int part, AngleBasis& basis, 
         const double z = ps[p].polar != Polar::kNone ? 0.0 : to_internal(ps[p], t.values[p]);
         const double h = fd_step(ps[p], z);
         const std::vector<double> moved = values_with(i, static_cast<int>(k), h);
-        BasisTransform at, to;  // this candidate's own action on the basis, before and moved
-        t.effect->configure_basis(row, t.values, at);
-        t.effect->configure_basis(row, moved, to);
+        BasisTransform at, to;  // a candidate's own action on the basis, before and moved
+        if (t.candidate) {
+          t.effect->configure_basis(row, t.values, at);
+          t.effect->configure_basis(row, moved, to);
+        }
         if (t.candidate && only_shift_differs(at, to)) {
           // A candidate that moves the seen angle only (eccentricity, mechanical harmonics,
           // mounting offset, backlash): the model's change is its slope in the shift times
