@@ -215,11 +215,4 @@ XFAIL = [
      "(the drift's const, oab3, oab1 and ramps profiles pass since: 0.5-0.6 se, from 2.7-3.0), but "
      "keep their own noise floors (the rows' weights), outlier flags and operating point; the "
      "drift's steps and reversals profiles are 1.7 and 2.3 se apart"),
-    (["*/mounting_offset/reversals:stream_value"],
-     "the chunks' own fits of the model lie far apart (alpha -0.0067 +- 0.0097 and 0.0127 +- 0.01: "
-     "a 50 mrad offset turns the dq currents, which the default model cannot follow) and the merge "
-     "moves each run's statistics linearly to the merged point: theta_0 2.7 urad (11 se) from the "
-     "fit in memory. Relinearising every run at the merged point (Gauss-Newton over passes for the "
-     "model, as for a held candidate) is the fix; not built. (The eccentricity's phase at speed "
-     "steps was a candidate's phase standard error read as the Cartesian one: fixed.)"),
 ]

@@ -679,21 +679,22 @@ int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMe
   };
   const resolver::DiscoveryOptions options = discovery_options(a, model.config);
   resolver::MergedFiles merged = resolver::merge_files(statistics_with(model.effects, true, {}), logs, {}, options);
-  if (a.command == Command::kExplain) {
-    // As explain in memory: a candidate whose linearised step is not its fit is refitted,
-    // here by a further pass over the logs (they are files: read again).
-    const bool readable_again = std::all_of(logs.begin(), logs.end(), [](const std::string& l) {
-      std::error_code ec;
-      return std::filesystem::is_regular_file(l, ec);
-    });
-    if (readable_again) {
-      resolver::refit_from_logs(
-          merged,
-          [&](const std::vector<std::string>& effects, const resolver::FitStartValues& start) {
-            return statistics_with(effects, false, start);
-          },
-          options);
-    } else if (!resolver::candidates_to_refit(merged.fit, options).empty()) {
+  // As a fit in memory: a nonlinear model is fitted to convergence and a candidate whose
+  // linearised step is not its fit is refitted, here by further passes over the logs
+  // (they are files: read again).
+  const bool readable_again = std::all_of(logs.begin(), logs.end(), [](const std::string& l) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(l, ec);
+  });
+  if (readable_again) {
+    resolver::relinearise_merge(merged, statistics_with, options);
+    if (a.command == Command::kExplain) resolver::refit_from_logs(merged, statistics_with, options);
+  } else {
+    if (merged.fit.nonlinear && merged.runs.size() > 1) {
+      merged.fit.notes.emplace_back("the model's nonlinear parameters are one linearised step from each run's own fit: "
+                                    "a log is not a regular file and cannot be read a second time");
+    }
+    if (a.command == Command::kExplain && !resolver::candidates_to_refit(merged.fit, options).empty()) {
       merged.fit.notes.emplace_back("the candidates are not refitted: a log is not a regular file and cannot be read "
                                     "a second time (their scores are one linearised step)");
     }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -76,28 +78,37 @@ int run_merge(const std::vector<std::string>& paths, std::span<const std::string
   return print_merge(files, paths, effects, json, options);
 }
 
-MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+MergedFiles merge_files(std::vector<StatsFile> files, const std::vector<std::string>& paths,
                         std::span<const std::string> effects, const DiscoveryOptions& options) {
   MergedFiles out;
+  out.paths = paths;
   for (std::size_t i = 0; i < files.size(); ++i) {
     // A file of one run is named by its path; a chunked log's runs by path and span.
-    for (const NamedRun& r : files[i].runs) {
+    for (NamedRun& r : files[i].runs) {
       out.names.push_back(files[i].runs.size() == 1 ? paths[i]
                                                     : paths[i] + ": " + r.name.substr(r.name.rfind(" [") + 1));
-      out.runs.push_back(r.run);
+      out.runs.push_back(std::move(r.run));  // moved: a pass over a long log holds its runs' statistics once
       out.log_of.push_back(static_cast<int>(i));  // a file's runs are one log's chunks: one reference zero
     }
   }
+  for (const StatsFile& f : files) {
+    for (const std::string& l : f.left_out) out.file_notes.push_back("left out when the statistics were made: " + l);
+    for (const std::string& n : f.input) out.file_notes.push_back(f.log + ": " + n);
+  }
+  out.fit = merge_again(out, effects, options);
+  return out;
+}
+
+MergedFit merge_again(const MergedFiles& merged, std::span<const std::string> effects, const DiscoveryOptions& options,
+                      double lambda) {
+  MergedFit fit;
   try {
-    out.fit = merge_runs(out.runs, out.names, effects, options, out.log_of);
+    fit = merge_runs(merged.runs, merged.names, effects, options, merged.log_of, lambda);
   } catch (const std::invalid_argument& e) {
     throw InputError(Fault::kData, e.what());
   }
-  for (const StatsFile& f : files) {
-    for (const std::string& l : f.left_out) out.fit.notes.push_back("left out when the statistics were made: " + l);
-    for (const std::string& n : f.input) out.fit.notes.push_back(f.log + ": " + n);
-  }
-  return out;
+  fit.notes.insert(fit.notes.end(), merged.file_notes.begin(), merged.file_notes.end());
+  return fit;
 }
 
 namespace {
@@ -114,31 +125,139 @@ FitStartValues merged_start(const MergedFit& fit, const std::string& effect) {
   return start;
 }
 
-/// Runs that hold the candidate (their rows alone cannot separate it) make the refit
-/// Gauss-Newton over passes: each pass takes the statistics at the last merged value.
-/// Converged when a pass moves each of its parameters by less than kConvergedSe of its
-/// standard error; at most kMaxHeldPasses passes (each reads the logs again).
-constexpr int kMaxHeldPasses = 6;
+/// Gauss-Newton over passes of the logs (relinearise_merge, refit_from_logs): converged
+/// when a pass moves each parameter by less than kConvergedSe of its standard error; at
+/// most kMaxPasses passes (each reads the logs again).
+constexpr int kMaxPasses = 6;
 constexpr double kConvergedSe = 0.05;
 
-/// The largest move of `effect`'s parameters from `start` to `with`, in standard errors.
-double largest_step(const MergedFit& with, const FitStartValues& start, const std::string& effect,
-                    const DiscoveryOptions& options) {
-  const ModelTerm term = ModelSpec::parse(std::vector<std::string>{effect}, options.customs).terms.front();
+/// The largest move of a parameter from `before` to `now`, in `now`'s standard errors.
+double largest_step(const std::vector<ModelParameter>& now, const std::vector<ModelParameter>& before) {
   double widest = 0.0;
-  for (std::size_t k = 0; k < term.params.size(); ++k) {
-    const std::string name = term.param_name(k);
-    const auto at = [&](const std::vector<ModelParameter>& ps) {
-      return std::find_if(ps.begin(), ps.end(), [&](const ModelParameter& p) { return p.name == name; });
-    };
-    const auto now = at(with.params), before = at(start.values);
-    if (now == with.params.end() || before == start.values.end() || !(now->std_error > 0.0)) continue;
-    widest = std::max(widest, std::abs(now->value - before->value) / now->std_error);
+  for (const ModelParameter& p : now) {
+    const auto was = std::find_if(before.begin(), before.end(), [&](const ModelParameter& q) { return q.name == p.name; });
+    if (was == before.end() || !(p.std_error > 0.0)) continue;
+    widest = std::max(widest, std::abs(p.value - was->value) / p.std_error);
   }
   return widest;
 }
 
+/// What the passes of iterate_at_merged did.
+struct Passes {
+  int passes = 0;
+  double first = 0.0;  ///< [se] the first pass's step
+  double last = 0.0;   ///< [se] the last good pass's step
+  int accepted = 0;    ///< passes whose point was taken
+  std::string failed;  ///< why a pass could not be made or merged (the last good merge stands)
+  bool uphill = false;  ///< ended at the last good point: a step and its damped retry both went uphill
+};
+
+/// "over 3 passes of the logs, the first step 1.6 standard errors, the last 0.01".
+std::string passes_note(const Passes& p) {
+  const std::string passes = fmt::format("{} pass{} of the logs", p.passes, p.passes == 1 ? "" : "es");
+  if (!p.failed.empty()) {
+    return fmt::format("stopped after {}: {} (the last good merge is kept: approximate)", passes, p.failed);
+  }
+  if (p.uphill && p.accepted == 0) {
+    return fmt::format("over {}: the merged point fitted the rows worse than the one step from the runs' own fits "
+                       "said, damped too, so that step is kept (approximate: a parameter at a bound of its range, "
+                       "e.g. an ideal converter, does this)",
+                       passes);
+  }
+  if (p.uphill) {
+    return fmt::format("over {}: a step went uphill, damped too, so the last good merge is kept, its step {:.2g} "
+                       "standard errors (not converged: the values are approximate)",
+                       passes, p.last);
+  }
+  return fmt::format("over {}, the first step {:.2g} standard errors, the last {:.2g}{}", passes, p.first, p.last,
+                     p.last < kConvergedSe ? "" : " (not converged: the values are approximate)");
+}
+
+/// Gauss-Newton over passes from `at` (a merge of `effects`): each pass makes every run's
+/// statistics at the last merged fit (FitStartValues::at_start) and merges them; that
+/// merge's step from its point is undamped, so converged when it is < kConvergedSe. As
+/// the fit in memory (least_squares.cpp fit_from_start), a point whose cost is higher
+/// than the last good one's is not taken: the step from the good point is damped once
+/// (Levenberg-Marquardt, from its statistics: no pass), and when that goes uphill too
+/// the last good merge is the answer. `at`'s own cost is at its reference run's point,
+/// exact to second order in how far its runs' own fits lie apart. (Undamped, a tracking
+/// loop that every chunk fits at its bound, an ideal converter, swung between omega_n = 0
+/// and 5000 rad/s over six passes.) Ends with `at` the last good merge.
+Passes iterate_at_merged(MergedFiles& at, const std::vector<std::string>& effects, bool candidates, FitStartValues start,
+                         const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
+  start.at_start = true;
+  Passes out;
+  std::optional<MergedFiles> good;  // the last pass taken
+  double good_cost = at.fit.cost_at_point;
+  std::vector<ModelParameter> next = at.fit.params;  // the next pass's point
+  double lambda = 0.0;
+  while (out.passes < kMaxPasses) {
+    start.values = next;
+    std::optional<MergedFiles> made;
+    try {
+      made = merge_files(statistics_with(effects, candidates, start), at.paths, effects, options);
+    } catch (const InputError& e) {
+      out.failed = e.what();  // a chunk that no longer fits there, say: the last good merge stands
+      break;
+    }
+    MergedFiles& here = *made;
+    ++out.passes;
+    const double step = largest_step(here.fit.params, start.values);
+    if (out.passes == 1) out.first = step;
+    // Rounding in sums over many rows: a rise below 1e-9 relative is not a worse point.
+    if (here.fit.cost_at_point > good_cost + 1e-9 * good_cost + 1e-6) {
+      if (lambda > 0.0) {
+        out.uphill = true;
+        break;
+      }
+      lambda = 1e-4;  // fit_from_start's first damped step (1e-3, then /10 before it is taken)
+      next = merge_again(good ? *good : at, effects, options, lambda).params;
+      continue;
+    }
+    good = std::move(here);
+    good_cost = good->fit.cost_at_point;
+    out.last = step;
+    ++out.accepted;
+    at.runs = {};  // superseded: a long log's runs are held twice at most (the last good pass, the next)
+    lambda = 0.0;
+    if (step < kConvergedSe) break;
+    next = good->fit.params;
+  }
+  if (good) at = std::move(*good);
+  return out;
+}
+
+/// True when the merge of a nonlinear model is not exact enough as one step from the
+/// runs' own fits: a move that changes a run's signals by delta floors per row
+/// (MergedFit::run_move) leaves second-order terms of at most delta^2 / A floors per row,
+/// A the effect's nonlinearity scale in floors (an envelope effect's is the unit
+/// amplitude, ~1e4 floors; taken as 1 here, the most nonlinear any fitted effect is); a
+/// systematic error of e floors per row moves a parameter by at most e sqrt(N) standard
+/// errors over N rows. So one step is enough while delta^2 sqrt(N) < kConvergedSe:
+/// measured 0.0013 floors on a 600 r/min log in 10 s chunks (three runs) against 155 where
+/// a 50 mrad mounting offset the model lacks turns the currents.
+bool needs_passes(const MergedFit& m, std::size_t runs) {
+  if (!m.nonlinear || runs < 2) return false;
+  return m.run_move * m.run_move * std::sqrt(static_cast<double>(m.rows)) >= kConvergedSe;
+}
+
 }  // namespace
+
+void relinearise_merge(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
+  if (!merged.fit.nonlinear || merged.runs.size() < 2) return;
+  if (!needs_passes(merged.fit, merged.runs.size())) {
+    merged.fit.notes.push_back(fmt::format("the model is nonlinear: its merge is one step from each run's own fit, "
+                                           "which lie within {:.2g} floors of it (second order: < {} standard errors)",
+                                           merged.fit.run_move, kConvergedSe));
+    return;
+  }
+  const std::vector<std::string> effects = merged.fit.effects;
+  FitStartValues start;
+  start.settled = effects;
+  const Passes p = iterate_at_merged(merged, effects, true, start, statistics_with, options);
+  merged.fit.notes.push_back("the model is nonlinear: Gauss-Newton with every run's statistics made again at the "
+                             "merged fit " + passes_note(p));
+}
 
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
   for (const std::string& effect : candidates_to_refit(merged.fit, options)) {
@@ -150,31 +269,21 @@ void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with,
     FitStartValues start = merged_start(merged.fit, effect);
     start.held = {effect};
     try {
-      for (int pass = 1;; ++pass) {
-        std::vector<RunStatistics> runs;
-        for (const StatsFile& f : statistics_with(effects, start)) {
-          for (const NamedRun& r : f.runs) runs.push_back(r.run);
-        }
-        if (runs.size() != merged.runs.size()) {
-          not_refitted(fmt::format("{} of the {} runs could be fitted with it", runs.size(), merged.runs.size()));
-          break;
-        }
-        MergedFit with = merge_runs(runs, merged.names, effects, options, merged.log_of);
-        const bool held = std::any_of(runs.begin(), runs.end(), [](const RunStatistics& r) { return !r.held.empty(); });
-        const double step = held ? largest_step(with, start, effect, options) : 0.0;
-        if (held && step >= kConvergedSe && pass < kMaxHeldPasses) {
-          start.values = with.params;
-          continue;
-        }
-        if (held) {
-          merged.fit.notes.push_back(fmt::format(
-              "{}: some runs' rows alone cannot separate it (held at the merged value there): fitted by Gauss-Newton "
-              "over {} pass{} of the logs, the last step {:.2g} standard errors{}",
-              effect, pass, pass == 1 ? "" : "es", step, step < kConvergedSe ? "" : " (not converged: its value is approximate)"));
-        }
-        take_exact_refit(merged.fit, effect, with, options);
-        break;
+      // The first pass fits each run from the merged start (its own valley of the
+      // candidate); their merge is the fit only for a linear model or a single run.
+      MergedFiles with = merge_files(statistics_with(effects, false, start), merged.paths, effects, options);
+      if (with.runs.size() != merged.runs.size()) {
+        not_refitted(fmt::format("{} of the {} runs could be fitted with it", with.runs.size(), merged.runs.size()));
+        continue;
       }
+      const bool held = std::any_of(with.runs.begin(), with.runs.end(), [](const RunStatistics& r) { return !r.held.empty(); });
+      if (held || needs_passes(with.fit, with.runs.size())) {
+        const Passes p = iterate_at_merged(with, effects, false, start, statistics_with, options);
+        merged.fit.notes.push_back(fmt::format(
+            "{}: Gauss-Newton with every run's statistics made again at the merged fit with it{} {}", effect,
+            held ? " (some runs' rows alone cannot separate it: held at the merged value there)" : "", passes_note(p)));
+      }
+      take_exact_refit(merged.fit, effect, with.fit, options);
     } catch (const std::invalid_argument& e) {
       not_refitted(e.what());
     } catch (const InputError& e) {

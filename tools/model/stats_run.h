@@ -36,30 +36,50 @@ void write_stats_file(const StatsFile& file, const std::string& out);
 
 /// The runs of several statistics files, merged.
 struct MergedFiles {
+  std::vector<std::string> paths;  ///< the files (or logs) merged, as given
   std::vector<RunStatistics> runs;
   std::vector<std::string> names;  ///< a file's path; a chunk's with its span
   std::vector<int> log_of;         ///< each run's file: the runs of one file are one log's chunks
+  /// What the files say of themselves (chunks left out, input notes): every merge of them notes it.
+  std::vector<std::string> file_notes;
   MergedFit fit;
 };
 
 /// Merges the runs of `files` (named by `paths`, a chunk by its span too) with `effects`
 /// (empty: the first run's model); what the statistics left out goes into the notes.
-/// InputError (data) when they do not merge.
-[[nodiscard]] MergedFiles merge_files(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
+/// InputError (data) when they do not merge. The runs are moved out of `files`.
+[[nodiscard]] MergedFiles merge_files(std::vector<StatsFile> files, const std::vector<std::string>& paths,
                                       std::span<const std::string> effects, const DiscoveryOptions& options);
 
-/// The same logs' statistics made again with the model `effects`, each run's fit started
-/// at `start` (one file per log, the runs in the same order): a second pass over the logs.
-using StatisticsWith =
-    std::function<std::vector<StatsFile>(const std::vector<std::string>& effects, const FitStartValues& start)>;
+/// The runs of `merged` merged again with `effects`, the model's step damped by `lambda`
+/// (merge_runs), with the files' notes. InputError (data) when they do not merge.
+[[nodiscard]] MergedFit merge_again(const MergedFiles& merged, std::span<const std::string> effects,
+                                    const DiscoveryOptions& options, double lambda = 0.0);
+
+/// The same logs' statistics made again with the model `effects` (with every candidate's
+/// columns or only the model's), each run's fit started at `start` (one file per log, the
+/// runs in the same order): a further pass over the logs.
+using StatisticsWith = std::function<std::vector<StatsFile>(const std::vector<std::string>& effects, bool candidates,
+                                                            const FitStartValues& start)>;
+
+/// Gauss-Newton over passes for a nonlinear model (MergedFit::nonlinear) of several runs:
+/// the merge moves each run's statistics linearly from its own fit to the merged point,
+/// exact only to second order in how far apart those lie (a 50 mrad mounting offset
+/// turning the currents put theta_0 11 standard errors from the fit in memory). Each pass
+/// makes every run's statistics again at the last merged fit (FitStartValues::at_start)
+/// and merges them, until a pass moves every model parameter by < 0.05 standard errors
+/// (at most 6 passes); the candidates are ranked at that point. A note says how many.
+void relinearise_merge(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options);
 
 /// explain on statistics, as on a log in memory: each candidate whose linearised step is
 /// not its fit (candidates_to_refit) is refitted to convergence by making the statistics
 /// again with it in the model, and scored by that merge (take_exact_refit). Each run's
 /// refit starts at the merged fit: the model's values settled, the candidate's from its
 /// merged linearised step (with its own other starts), as the in-memory refit starts at
-/// the model's converged fit. A refit that fails leaves the candidate linearised, with a
-/// note saying why.
+/// the model's converged fit. A nonlinear refit of several runs, or one some run holds
+/// (its rows alone cannot separate it), is then relinearised at the merged fit over
+/// passes as relinearise_merge. A refit that fails leaves the candidate linearised, with
+/// a note saying why.
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options);
 
 /// Prints `merged` as text or JSON on stdout.

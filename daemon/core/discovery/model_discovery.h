@@ -50,6 +50,10 @@ struct FitStartValues {
   /// Effect references a run may hold at their start values when its own rows cannot
   /// separate them (a play in a chunk that turns one way): run_statistics.h.
   std::vector<std::string> held;
+  /// A run's statistics are taken at these values (the merged fit of an earlier pass:
+  /// run_statistics.h), each run's frame shift fitted there, not at the run's own fit:
+  /// the next merge is then a Gauss-Newton step relinearised on every run's rows.
+  bool at_start = false;
 };
 
 struct DiscoveryOptions {

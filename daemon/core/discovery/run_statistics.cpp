@@ -251,9 +251,12 @@ void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolut
 }
 
 /// How far the runs' own fits of the nonlinear parameters lie from the merged value,
-/// in the merged standard errors: the merge is exact to second order in this.
+/// in the merged standard errors: the merge is exact to second order in this. Runs
+/// relinearised at an earlier merge (RunStatistics::at_merged) have no note here: the
+/// passes say how far their last step went (stats_run.h relinearise_merge).
 std::string nonlinear_note(const Design& d, const std::vector<RunStatistics>& runs, const StepSolution& s,
                            const Eigen::VectorXd& z0) {
+  if (std::any_of(runs.begin(), runs.end(), [](const RunStatistics& r) { return r.at_merged; })) return "";
   const double s2 = s.rss_w / std::max(1.0, static_cast<double>(s.n[0] + s.n[1] + s.n[2] - s.k));
   const std::vector<std::string> names = d.column_names();
   double widest = 0.0;
@@ -316,11 +319,18 @@ ModelFit fit_or_hold(const PreparedLog& log, std::span<const std::string> effect
   }
 }
 
-/// The run's fitted model with the `held` effects added at their start values, in the
-/// fit's frame: the point the run's statistics are taken at.
-Model model_with_held(const ModelFit& fit, const PreparedLog& log, const std::vector<std::string>& held,
-                      const DiscoveryOptions& options) {
-  if (held.empty()) return fit.model;
+/// Passes over a run's rows that fit its frame shift at a point it was not fitted at
+/// (fit_frame_shift: a shift turns by the model's mean angle error, a few mrad; two or
+/// three passes settle it to 1e-7 rad).
+constexpr int kFramePasses = 4;
+
+/// The point the run's statistics are taken at: its fitted model, with the `held` effects
+/// added at their start values; with options.start.at_start every parameter at its start
+/// value (the merged fit). Off its own fit the run's frame shift is fitted again there
+/// (its reference zero at those values), from the fit's frame.
+Model statistics_point(const ModelFit& fit, const PreparedLog& log, const std::vector<std::string>& held,
+                       const DiscoveryOptions& options) {
+  if (held.empty() && !options.start.at_start) return fit.model;
   ModelSpec spec = fit.model.spec();
   for (const ModelTerm& t : ModelSpec::parse(held, options.customs).terms) spec.add(t);
   Model at(spec, log.p_r, log.p);
@@ -329,8 +339,54 @@ Model model_with_held(const ModelFit& fit, const PreparedLog& log, const std::ve
   Design d = design_for(at, log);  // the fit's frame, which a new Model does not have
   const std::vector<double>& shifts = fit.model.frame_shifts();
   for (int part = 0; part < d.parts(); ++part) d.set_frame_shift(part, shifts[static_cast<std::size_t>(part)]);
+  (void)fit_frame_shift(d, log.rows, log.floors.floors(), kFramePasses);
   at.take_values(d);
   return at;
+}
+
+/// [floors] How far the merged fit lies from the runs' own points, as the RMS change of a
+/// run's fitted signals over its rows (each group over the pooled floor): sqrt(d' M_r d /
+/// n_r), d the merged values of the model's columns minus the run's (MergedFit::run_move).
+double farthest_run_move(const Design& d, const std::vector<RunStatistics>& runs, const StepSolution& s,
+                         const Eigen::VectorXd& z0, const GroupFloors& floors) {
+  const std::vector<std::string> names = d.column_names();
+  const std::vector<int> cols = model_columns(d);
+  double widest = 0.0;
+  for (const RunStatistics& r : runs) {
+    std::vector<int> at;
+    Eigen::VectorXd move(static_cast<Eigen::Index>(cols.size()));
+    for (int c : cols) {
+      if (c < d.nuisance_columns()) continue;  // the run's own constants are profiled, not moved
+      const int k = column_index(r.columns, names[static_cast<std::size_t>(c)]);
+      if (k < 0) continue;
+      move[static_cast<Eigen::Index>(at.size())] = z0[c] + s.dz[c] - r.point[k];
+      at.push_back(k);
+    }
+    const auto n = static_cast<Eigen::Index>(at.size());
+    double q = 0.0;
+    for (int g = 0; g < kGroups; ++g) {
+      const double f = floors.of(static_cast<Group>(g));
+      const NormalEquations& ne = r.stats.all[static_cast<std::size_t>(g)];
+      if (!(f > 0.0) || ne.n() == 0) continue;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        for (Eigen::Index j = 0; j < n; ++j) q += move[i] * ne.m()(at[static_cast<std::size_t>(i)], at[static_cast<std::size_t>(j)]) * move[j] / (f * f);
+      }
+    }
+    if (r.fitted_rows > 0) widest = std::max(widest, std::sqrt(q / static_cast<double>(r.fitted_rows)));
+  }
+  return widest;
+}
+
+/// The weighted residual at the merge's point with only the runs' constants solved
+/// (MergedFit::cost_at_point): the merged statistics have them profiled out already
+/// (merged_statistics.h), so it is their yy, each group over its floor squared.
+double cost_at_point(const MergedStatistics& stats, const GroupFloors& floors) {
+  double c = 0.0;
+  for (int g = 0; g < kGroups; ++g) {
+    const double f = floors.of(static_cast<Group>(g));
+    if (f > 0.0) c += stats.all[static_cast<std::size_t>(g)].yy() / (f * f);
+  }
+  return c;
 }
 
 /// What the runs say of themselves: the effects some held (RunStatistics::held), and
@@ -357,7 +413,8 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
   const ModelFit fit = fit_or_hold(log, effects, options, out.held);
   out.layout = pool_layout(log);
   out.params = fit.params;
-  const Model model = model_with_held(fit, log, out.held, options);
+  const Model model = statistics_point(fit, log, out.held, options);
+  out.at_merged = options.start.at_start;
   out.effects = model.spec().references();
   out.values = model.values();
   Design d = design_for(model, log);
@@ -385,7 +442,8 @@ RunStatistics run_statistics(const PreparedLog& log, std::span<const std::string
 }
 
 MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names,
-                     std::span<const std::string> effects, const DiscoveryOptions& options, std::span<const int> log_of) {
+                     std::span<const std::string> effects, const DiscoveryOptions& options, std::span<const int> log_of,
+                     double lambda) {
   if (runs.empty()) throw std::invalid_argument("nothing to merge: no statistics given");
   if (names.size() != runs.size()) throw std::invalid_argument("merge: one name per run");
   for (std::size_t r = 1; r < runs.size(); ++r) {
@@ -420,7 +478,9 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   const RunsByLog logs = runs_by_log(runs.size(), log_of);
   const MergedStatistics stats = assemble(d, runs, logs);
   const std::vector<int> cols = model_columns(d);
-  const StepSolution s = solve_step(stats.all, gf, cols);
+  const StepSolution s = solve_step(stats.all, gf, cols, lambda);
+  out.cost_at_point = cost_at_point(stats, gf);
+  out.run_move = farthest_run_move(d, runs, s, z0, gf);
   if (!s.ok) {
     throw std::invalid_argument(fmt::format("the model's effects ({}) are not separable with the merged runs' signals",
                                             fmt::join(out.effects, ", ")));
@@ -471,6 +531,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   }
   out.notes.emplace_back("standard errors are formal (the merged residual variance): statistics keep no "
                          "revolution-to-revolution spread");
+  out.nonlinear = !strictly_linear(d);
   if (d.nonlinear()) {
     if (std::string n = nonlinear_note(d, runs, s, z0); !n.empty()) out.notes.push_back(std::move(n));
   }

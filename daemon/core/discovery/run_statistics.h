@@ -50,7 +50,8 @@ struct RunStatistics {
   int nuisance_columns = 0;  ///< the first columns are the run's own constants
   int model_columns = 0;     ///< then the model's parameters; the rest are candidates
   /// Internal coordinate (design.h) of every column at the linearisation point: the
-  /// run's fit for the model's, 0 for nuisances and candidates (neutral).
+  /// run's fit for the model's (or the start values: at_merged), 0 for nuisances and
+  /// candidates (neutral).
   Eigen::VectorXd point;
   /// Every model term's parameter values (all of its parameters, in effect order).
   std::vector<std::vector<double>> values;
@@ -77,6 +78,9 @@ struct RunStatistics {
   /// value of them is one Gauss-Newton step from there. Only in a refit pass's memory;
   /// a statistics file never has any.
   std::vector<std::string> held;
+  /// The statistics are at the start values of the pass (FitStartValues::at_start: the
+  /// merged fit of an earlier pass), not at the run's own fit. Only in memory.
+  bool at_merged = false;
 };
 
 /// Fits `effects` to the prepared run to convergence and takes one more pass there
@@ -116,10 +120,22 @@ struct MergedFit {
   /// (ranking.h needs_exact_refit): their value and residual are approximate.
   std::vector<std::string> stepped;
   bool untrusted = false;  ///< some run's signals were faulty for long: never explained, nothing proposed
+  /// The model's prediction is not linear in its parameters (least_squares.h
+  /// strictly_linear): the merge is one Gauss-Newton step from the runs' points, exact
+  /// only where they are the merged fit (FitStartValues::at_start passes iterate it).
+  bool nonlinear = false;
   std::int64_t outlier_samples = 0;  ///< left out of the runs' fits (SignalResidual::rms_with_outliers)
   bool rd = false;         ///< the position error is the R/D angle's (ranking.h score_candidate)
   double bic = std::numeric_limits<double>::quiet_NaN();  ///< of the model's merged solution (fit_support.h bic_of)
   double weighted_rss = 0.0;  ///< its residual, each signal over its floor squared
+  /// The weighted residual at the merge's point (the reference run's), the runs' constants
+  /// solved: where every run is at one point (RunStatistics::at_merged) that point's exact
+  /// cost, which Gauss-Newton over passes compares points by.
+  double cost_at_point = 0.0;
+  /// [floors] The largest RMS change of a run's fitted signals from its own fit to the
+  /// merged one (the model's parameters): the merge of a nonlinear model is exact to
+  /// second order in this, so Gauss-Newton over passes is needed only where it is not small.
+  double run_move = 0.0;
   std::vector<std::string> notes;
 };
 
@@ -133,9 +149,11 @@ struct MergedFit {
 /// log (its chunks, stats --chunk) share its reference zero, as the log's fit in memory
 /// has one; each run keeps its own amplitude and operating point (its sin/cos are
 /// normalised by its own amplitude when prepared).
+/// `lambda` > 0 damps the model's step (Levenberg-Marquardt, least_squares.h solve_step):
+/// Gauss-Newton over passes (stats_run.h) steps back so from a point that went uphill.
 [[nodiscard]] MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names,
                                    std::span<const std::string> effects, const DiscoveryOptions& options,
-                                   std::span<const int> log_of = {});
+                                   std::span<const int> log_of = {}, double lambda = 0.0);
 
 /// The candidates of `m` whose linearised step is not their fit (ranking.h exact_refits:
 /// envelope effects at real magnitudes, nonlinear parameters), to be refitted from

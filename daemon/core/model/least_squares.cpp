@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numeric>
 
 namespace resolver {
 
@@ -193,7 +194,8 @@ bool column_is_nonlinear(const Design& d, int col) {
   return false;
 }
 
-/// True when every term's prediction is linear in its fitted parameters: one pass solves it.
+}  // namespace
+
 bool strictly_linear(const Design& d) {
   for (const DesignTerm& t : d.terms()) {
     if (t.candidate) continue;
@@ -202,7 +204,26 @@ bool strictly_linear(const Design& d) {
   return !d.nonlinear();
 }
 
-}  // namespace
+int fit_frame_shift(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes) {
+  const std::vector<int> zero_cols = frame_constant_columns(design);
+  // Every nuisance column with it: the R/D angle's constant (the converter's own zero)
+  // and the envelopes' gain are solved beside the shift, not left in it.
+  std::vector<int> nuisance_cols(static_cast<std::size_t>(design.nuisance_columns()));
+  std::iota(nuisance_cols.begin(), nuisance_cols.end(), 0);
+  int passes = 0;
+  while (!zero_cols.empty() && passes < max_passes) {
+    PassStatistics stats(design.columns());
+    accumulate(design, rows, floors, stats);
+    ++passes;
+    const StepSolution c = solve_step(stats.all, floors, nuisance_cols);
+    if (!c.ok) break;
+    shift_frames(design, zero_cols, c.dz);
+    bool settled = true;
+    for (int col : zero_cols) settled = settled && std::abs(c.dz[col]) <= kShiftSettled;
+    if (settled) break;
+  }
+  return passes;
+}
 
 namespace {
 
@@ -231,16 +252,10 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     if (!column_is_nonlinear(design, c)) warm_cols.push_back(c);
   }
   const std::vector<int> zero_cols = linear ? std::vector<int>{} : frame_constant_columns(design);
-  if (!zero_cols.empty()) {
-    // Start in the sensor's frame: the constant alone at the starting values (its
-    // error is the windings' mean angle error, ~beta/2). From a frame half a turn
-    // away the first step would fit every harmonic turned and could only go uphill.
-    PassStatistics start(design.columns());
-    accumulate(design, rows, floors, start);
-    ++out.passes;
-    const StepSolution c = solve_step(start.all, floors, zero_cols);
-    if (c.ok) shift_frames(design, zero_cols, c.dz);
-  }
+  // Start in the sensor's frame: the constant alone at the starting values (its
+  // error is the windings' mean angle error, ~beta/2). From a frame half a turn
+  // away the first step would fit every harmonic turned and could only go uphill.
+  if (!zero_cols.empty()) out.passes += fit_frame_shift(design, rows, floors, 1);
   double lambda = 0.0;
   double cost = std::numeric_limits<double>::infinity();
   Design last_good = design;

@@ -64,6 +64,18 @@ struct StepSolution {
 [[nodiscard]] StepSolution solve_step(const std::vector<NormalEquations>& groups, const GroupFloors& floors,
                                       std::span<const int> columns = {}, double lambda = 0.0);
 
+/// True when every model term's prediction is linear in its fitted parameters and none
+/// shapes the basis: one linearised step is the exact fit, and statistics moved to another
+/// point (run_statistics.h) are exact there.
+[[nodiscard]] bool strictly_linear(const Design& design);
+
+/// Moves every part's frame shift (design.h) to its least-squares value at the
+/// design's parameters, which stay as they are: Gauss-Newton on the position-error
+/// constant (with the other nuisance constants) until it moves the shift by < 1e-7 rad,
+/// at most `max_passes` passes over the rows. Returns the passes taken (0 when the
+/// reference is aligned: no shift).
+int fit_frame_shift(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes);
+
 /// Result of fitting a design to convergence.
 struct FitResult {
   bool ok = false;
