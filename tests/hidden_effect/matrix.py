@@ -204,12 +204,6 @@ XFAIL = [
     #
     # The streaming path (run_hidden_effect.py --streaming: explain --chunk against explain
     # in memory), issue 23, still open:
-    (["*/backlash/oab3:stream_value", "*/backlash/oab1:stream_value", "*/backlash/angle1:stream_value"],
-     "a play's state at a chunk's start is unknown to the chunk: it starts with the play taken up in "
-     "the direction of its first motion, so when a chunk begins just after a reversal the take-up's "
-     "rows are mismatched (h 0.13 % low, 5e-6 rad: 7-23 formal se; about 3 rows of a 4 mrad take-up carry "
-     "that bias). The chunks now share the log's "
-     "reference zero (backlash is named first, as in memory)"),
     (["*/envelope_drift/steps:stream_value", "*/envelope_drift/reversals:stream_value"],
      "not yet diagnosed: the chunks of a log share its reference zero, envelope gain and clock "
      "(the drift's const, oab3, oab1 and ramps profiles pass since: 0.5-0.6 se, from 2.7-3.0), but "

@@ -58,6 +58,9 @@ struct StatsFile {
   double amplitude = 0.0;
   /// [s] the first run's time origin (PrepareOptions::time_origin), likewise.
   double time_origin = std::numeric_limits<double>::quiet_NaN();
+  /// Where the last chunk read left the rotor (PrepareOptions::continuation): the next
+  /// chunk goes on from it, as the whole log does (not written either).
+  MotionContinuation continuation;
 };
 
 /// The file's text.

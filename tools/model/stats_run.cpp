@@ -31,6 +31,7 @@ StatsFile stats_file_header(const std::string& log, const DaemonConfig& config) 
 void add_run(StatsFile& file, const std::string& name, const DiscoveryInput& input, std::span<const std::string> effects,
              const DiscoveryOptions& options) {
   const PreparedLog prepared = prepare_log(input, options.prepare);
+  file.continuation = prepared.continuation;
   file.runs.push_back({name, run_statistics(prepared, effects, options)});
   if (!(file.amplitude > 0.0) && prepared.sincos) file.amplitude = prepared.amplitude;
   if (!std::isfinite(file.time_origin)) file.time_origin = prepared.time_origin;
@@ -43,6 +44,10 @@ void add_chunk(StatsFile& file, const DiscoveryInput& chunk, std::span<const std
   DiscoveryOptions scaled = options;
   scaled.prepare.amplitude = file.amplitude;  // the first chunk's: one scale, one gain for the log
   scaled.prepare.time_origin = file.time_origin;  // and one time axis (a drift is one line)
+  // And the rotor's state where the last chunk left it (a play's take-up, the direction
+  // held through a standstill). A chunk that cannot be prepared (one that hardly moves)
+  // leaves it as it was.
+  scaled.prepare.continuation = file.continuation;
   try {
     add_run(file, name, chunk, effects, scaled);
   } catch (const std::invalid_argument& e) {

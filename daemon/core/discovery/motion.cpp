@@ -38,7 +38,7 @@ double second_difference_sigma(std::span<const double> values) {
 }
 
 std::vector<MotionSample> analyse_motion(std::span<const double> t, std::span<const double> angle,
-                                         MotionSummary& summary) {
+                                         MotionSummary& summary, double initial_direction) {
   const std::size_t n = t.size();
   std::vector<MotionSample> out(n);
   summary = MotionSummary{};
@@ -94,7 +94,7 @@ std::vector<MotionSample> analyse_motion(std::span<const double> t, std::span<co
   const double stop = kStopNoiseMultiple * summary.angle_noise;
   const double move = kMoveNoiseMultiple * summary.angle_noise;
   bool moving = false;
-  double direction = 0.0;
+  double direction = initial_direction;  // a reversal at a chunk's start counts, as in the whole log
   bool have_min_max = false;
   for (std::size_t i = 0; i < n; ++i) {
     const double travel = std::abs(out[i].omega) * window;
@@ -107,9 +107,10 @@ std::vector<MotionSample> analyse_motion(std::span<const double> t, std::span<co
       direction = dir;
     }
   }
-  // The direction before the first motion is the first motion's.
-  double held = 1.0;
-  for (std::size_t i = 0; i < n; ++i) {
+  // The direction before the first motion is the one held before the first sample, or
+  // else the first motion's.
+  double held = initial_direction != 0.0 ? initial_direction : 1.0;
+  for (std::size_t i = 0; i < n && initial_direction == 0.0; ++i) {
     if (out[i].moving) {
       held = out[i].omega < 0.0 ? -1.0 : 1.0;
       break;

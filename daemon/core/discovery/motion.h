@@ -42,9 +42,11 @@ struct MotionSummary {
 };
 
 /// Analyses a continuous (unwrapped) angle [rad] at times t [s] (increasing).
-/// Cannot fail; fewer than 3 samples are all "standstill".
+/// Cannot fail; fewer than 3 samples are all "standstill". `initial_direction` (+1 / -1)
+/// is the direction held before the first sample (a later chunk of a log: the earlier
+/// chunk's last); 0 = the first motion's.
 [[nodiscard]] std::vector<MotionSample> analyse_motion(std::span<const double> t, std::span<const double> angle,
-                                                       MotionSummary& summary);
+                                                       MotionSummary& summary, double initial_direction = 0.0);
 
 /// Robust (MAD) standard deviation of a series' second differences / sqrt(6): the
 /// sample noise of a smooth signal [unit of the values]. 0 for fewer than 3 values.

@@ -263,7 +263,8 @@ struct TrueAngles {
   std::vector<bool> usable;
 };
 
-TrueAngles true_angles(const std::vector<const Sample*>& s, const std::vector<double>& t, PreparedLog& p) {
+TrueAngles true_angles(const std::vector<const Sample*>& s, const std::vector<double>& t, const PrepareOptions& opt,
+                       PreparedLog& p) {
   const std::size_t n = s.size();
   TrueAngles a{std::vector<double>(n), std::vector<double>(n), {}, std::vector<bool>(n, true)};
   if (p.reference) {
@@ -272,7 +273,7 @@ TrueAngles true_angles(const std::vector<const Sample*>& s, const std::vector<do
       a.theta_m[i] = un.update(wrap_2pi(s[i]->theta_m_ref));
       a.theta[i] = p.p_r * a.theta_m[i];
     }
-    a.motion = analyse_motion(t, a.theta_m, p.motion);
+    a.motion = analyse_motion(t, a.theta_m, p.motion, opt.continuation.valid ? opt.continuation.direction : 0.0);
     check_turns_with_reference(s, a.theta, a.motion, p.rd, p.sincos, p.p_r);
   } else {
     std::vector<double> primary(n), cont(n), mech(n);
@@ -306,14 +307,25 @@ TrueAngles true_angles(const std::vector<const Sample*>& s, const std::vector<do
 }
 
 /// [rad, mechanical] travel since the last reversal, from its turning point
-/// (backlash's take-up); infinity before the first reversal.
-std::vector<double> travel_since_reversal(const TrueAngles& a) {
+/// (backlash's take-up); infinity before the first reversal. Goes on from where an
+/// earlier chunk left the rotor (`in`, when valid) and says where these samples leave it (`out`).
+std::vector<double> travel_since_reversal(const TrueAngles& a, const MotionContinuation& in, MotionContinuation& out) {
   const std::size_t n = a.theta_m.size();
   std::vector<double> since(n, std::numeric_limits<double>::infinity());
-  double held = a.motion.empty() ? 1.0 : a.motion.front().direction;
-  double extremum = a.theta_m.empty() ? 0.0 : a.theta_m.front();
+  if (n == 0) return since;
+  double held = a.motion.front().direction;
+  double extremum = a.theta_m.front();
   double turning = 0.0;
   bool reversed = false;
+  if (in.valid) {
+    // The earlier chunk's last sample in this chunk's unwrapped angle: the rotor moves
+    // less than half a turn between two samples.
+    const double before = a.theta_m.front() - wrap_pi(wrap_2pi(a.theta_m.front()) - in.last_angle);
+    held = in.direction;
+    extremum = before + in.extremum_offset;
+    turning = before + in.turning_offset;
+    reversed = in.reversed;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     if (a.motion[i].direction != held) {
       turning = extremum;
@@ -324,6 +336,12 @@ std::vector<double> travel_since_reversal(const TrueAngles& a) {
     extremum = held > 0.0 ? std::max(extremum, a.theta_m[i]) : std::min(extremum, a.theta_m[i]);
     if (reversed) since[i] = std::abs(a.theta_m[i] - turning);
   }
+  out = {.valid = true,
+         .direction = held,
+         .last_angle = wrap_2pi(a.theta_m.back()),
+         .reversed = reversed,
+         .turning_offset = turning - a.theta_m.back(),
+         .extremum_offset = extremum - a.theta_m.back()};
   return since;
 }
 
@@ -332,7 +350,10 @@ std::vector<double> travel_since_reversal(const TrueAngles& a) {
 void build_rows(const DiscoveryInput& in, const std::vector<const Sample*>& s, const std::vector<double>& t,
                 const TrueAngles& a, bool currents, const PrepareOptions& opt, PreparedLog& p) {
   const std::size_t n = s.size();
-  const std::vector<double> since = travel_since_reversal(a);
+  // Without a reference each chunk's angle has its own zero: nothing to go on from.
+  const std::vector<double> since =
+      travel_since_reversal(a, p.reference ? opt.continuation : MotionContinuation{}, p.continuation);
+  if (!p.reference) p.continuation = {};
   p.rows.resize(n);
   p.sample_of_row.resize(n);
   for (std::size_t i = 0; i < n; ++i) p.sample_of_row[i] = static_cast<std::size_t>(s[i] - in.samples.data());
@@ -507,7 +528,7 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   const std::vector<const Sample*> s = usable_samples(in, p);
   const std::vector<double> t = sample_times(s, opt, p);
   if (p.sincos) measure_amplitude(s, opt, p);
-  const TrueAngles angles = true_angles(s, t, p);
+  const TrueAngles angles = true_angles(s, t, opt, p);
   build_rows(in, s, t, angles, currents, opt, p);
   set_current_operating_point(p);
   if (p.rd) recenter(p, FitRow::kHasRd, &FitRow::y_rd);

@@ -36,6 +36,19 @@ struct DiscoveryInput {
 
 enum class DirectionFilter : std::uint8_t { kBoth, kForward, kBackward };
 
+/// Where an earlier chunk of a log left the rotor (add_chunk), so that the next chunk goes
+/// on as the whole log does: the direction held through a standstill, and backlash's
+/// take-up (the travel since the last reversal's turning point). Only with a reference:
+/// its zero is the same in every chunk, so the angle between two chunks is known.
+struct MotionContinuation {
+  bool valid = false;
+  double direction = 1.0;        ///< +1 / -1, held at the last sample
+  double last_angle = 0.0;       ///< [rad, mechanical] the last sample's true angle, in [0, 2 pi)
+  bool reversed = false;         ///< the rotor has reversed (the take-up's travel counts from then)
+  double turning_offset = 0.0;   ///< [rad] the last reversal's turning point minus the last angle
+  double extremum_offset = 0.0;  ///< [rad] the furthest angle in the held direction minus the last angle
+};
+
 struct PrepareOptions {
   DirectionFilter direction = DirectionFilter::kBoth;
   /// Standstill samples are not used at all (no standstill floor either).
@@ -52,6 +65,9 @@ struct PrepareOptions {
   /// later chunk of a long log takes its first chunk's: a drift over time is then one
   /// line across the chunks, as in the whole log.
   double time_origin = std::numeric_limits<double>::quiet_NaN();
+  /// Where the log's earlier chunk left the rotor (PreparedLog::continuation); not valid =
+  /// the log starts here (the play taken up in the direction of the first motion).
+  MotionContinuation continuation;
 };
 
 struct PreparedLog {
@@ -64,6 +80,9 @@ struct PreparedLog {
   double amplitude = 0.0;      ///< [counts] median sin/cos radius
   double sample_period = 0.0;  ///< [s] median
   double time_origin = 0.0;    ///< [s] the sample time of the rows' t = 0 (PrepareOptions)
+  /// Where these samples leave the rotor: the next chunk's PrepareOptions::continuation
+  /// (valid with a reference).
+  MotionContinuation continuation;
   std::vector<FitRow> rows;
   /// Of each row, its sample: rows[i] came from DiscoveryInput::samples[sample_of_row[i]]
   /// (the raw signals behind a row, e.g. for resolver-model export-data).
