@@ -201,12 +201,8 @@ XFAIL = [
     # found (mounting offset's winding frame, delay across speed steps, ranking's
     # alike(), backlash's take-up, the model-reference split, sin/cos outliers, the
     # drift's suggested block) are fixed; a new one goes here with the command that shows it.
-    #
-    # The streaming path (run_hidden_effect.py --streaming: explain --chunk against explain
-    # in memory), issue 23, still open:
-    (["*/envelope_drift/steps:stream_value", "*/envelope_drift/reversals:stream_value"],
-     "not yet diagnosed: the chunks of a log share its reference zero, envelope gain and clock "
-     "(the drift's const, oab3, oab1 and ramps profiles pass since: 0.5-0.6 se, from 2.7-3.0), but "
-     "keep their own noise floors (the rows' weights), outlier flags and operating point; the "
-     "drift's steps and reversals profiles are 1.7 and 2.3 se apart"),
+    # The streaming path's (run_hidden_effect.py --streaming, issue 23) are fixed too: a
+    # nonlinear merge relinearised over passes (mounting_offset/reversals), a chunk going on
+    # from where the last left the rotor (backlash's take-up), every proposed candidate
+    # refitted offline (envelope_drift's one step was 6 se from its fit in memory).
 ]

@@ -268,8 +268,7 @@ int run_fleet(const std::string& manifest, const std::string& out, const std::st
   options.effects = effects;
   options.points = points;
   options.merge_only = merge_only;
-  options.discovery.max_report_order = resolver::kOfflineReportOrder;
-  options.discovery.harmonic_families = true;
+  options.discovery = resolver::offline_discovery_options();
   options.discovery.customs = options.config.model.customs.get();
   options.discovery.prepare.reference_aligned = options.config.bench.reference_aligned;
   const std::vector<resolver::ManifestRow> rows = resolver::read_manifest(manifest);
@@ -543,9 +542,7 @@ resolver::LogSamples read_samples(const Arguments& a, const resolver::DaemonConf
 
 /// The offline discovery settings with the command line's slicing and the config's custom effects.
 resolver::DiscoveryOptions discovery_options(const Arguments& a, const resolver::DaemonConfig& config) {
-  resolver::DiscoveryOptions options;
-  options.max_report_order = resolver::kOfflineReportOrder;
-  options.harmonic_families = true;
+  resolver::DiscoveryOptions options = resolver::offline_discovery_options();
   options.customs = config.model.customs.get();  // the config's [[model.custom]] effects
   options.prepare.direction = a.direction == "forward"    ? resolver::DirectionFilter::kForward
                               : a.direction == "backward" ? resolver::DirectionFilter::kBackward

@@ -315,6 +315,14 @@ std::vector<bool> apply_start_values(const FitStartValues& start, Model& model) 
   return settled;
 }
 
+DiscoveryOptions offline_discovery_options() {
+  DiscoveryOptions o;
+  o.max_report_order = kOfflineReportOrder;
+  o.harmonic_families = true;
+  o.refit_proposed = true;
+  return o;
+}
+
 ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effects, const DiscoveryOptions& options) {
   const ModelSpec spec = ModelSpec::parse(effects, options.customs);
   check_model_against_log(spec, log);

@@ -73,6 +73,12 @@ struct DiscoveryOptions {
   /// for resolverd's live windows, where their columns slowed every window that misses
   /// an effect (and, on one emulated CPU, the socket reader beside it).
   bool harmonic_families = false;
+  /// Refit every proposed candidate to convergence with the model, not only those whose
+  /// one linearised step is known not to be their fit (ranking.h needs_exact_refit): with
+  /// a nonlinear model (the default's gain error goes through atan2) even a linear
+  /// candidate's step is first order. A drifting excitation (0.1 %/s) was named with g 6
+  /// standard errors from its fit. Offline (resolver-model); the live windows save the time.
+  bool refit_proposed = false;
   /// Speed bins of the residual breakdown (equal width over the signed speeds seen; empty bins dropped).
   int speed_bins = 6;
   /// Time windows of the breakdown (a residual that changes over time is outside the catalog).
@@ -96,6 +102,11 @@ struct DiscoveryOptions {
   /// health monitor as resolverd's): never "explained" while any is listed.
   std::vector<std::string> untrusted_input;
 };
+
+/// resolver-model's settings: every harmonic order to kOfflineReportOrder, harmonic
+/// families, every proposed candidate refitted (what the live windows leave out for
+/// time); the rest as DiscoveryOptions' defaults.
+[[nodiscard]] DiscoveryOptions offline_discovery_options();
 
 /// A value with its standard error (NaN: not identifiable / not computed).
 struct SignalResidual {

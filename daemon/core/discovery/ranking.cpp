@@ -245,6 +245,7 @@ void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSol
 bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options) {
   const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
   const ModelTerm& term = one.terms.front();
+  if (options.refit_proposed && c.proposed && !c.family) return true;
   bool nonlinear = term.effect->envelope_only() && !c.family && !c.reaches_floor;
   for (int p : term.params) nonlinear = nonlinear || term.effect->params()[static_cast<std::size_t>(p)].nonlinear;
   return nonlinear;

@@ -56,7 +56,8 @@ void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSol
 
 /// Whether a candidate's linearised score is not its fit: an envelope effect (through
 /// atan2) whose step does not already reach the floor, or one with a nonlinear parameter
-/// (delay, tracking loop). Such candidates are refitted to convergence with the model.
+/// (delay, tracking loop); offline (DiscoveryOptions::refit_proposed) every proposed
+/// one. Such candidates are refitted to convergence with the model.
 [[nodiscard]] bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options);
 
 /// The effects of `ranked` (best first) to refit so: the best kNonlinearRefits proposed
