@@ -377,18 +377,6 @@ double farthest_run_move(const Design& d, const std::vector<RunStatistics>& runs
   return widest;
 }
 
-/// The weighted residual at the merge's point with only the runs' constants solved
-/// (MergedFit::cost_at_point): the merged statistics have them profiled out already
-/// (merged_statistics.h), so it is their yy, each group over its floor squared.
-double cost_at_point(const MergedStatistics& stats, const GroupFloors& floors) {
-  double c = 0.0;
-  for (int g = 0; g < kGroups; ++g) {
-    const double f = floors.of(static_cast<Group>(g));
-    if (f > 0.0) c += stats.all[static_cast<std::size_t>(g)].yy() / (f * f);
-  }
-  return c;
-}
-
 /// What the runs say of themselves: the effects some held (RunStatistics::held), and
 /// faulty signals (never explained then).
 void take_run_flags(const std::vector<RunStatistics>& runs, const std::vector<std::string>& names, MergedFit& out) {
@@ -479,7 +467,8 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   const MergedStatistics stats = assemble(d, runs, logs);
   const std::vector<int> cols = model_columns(d);
   const StepSolution s = solve_step(stats.all, gf, cols, lambda);
-  out.cost_at_point = cost_at_point(stats, gf);
+  // The merged statistics have the runs' constants profiled out already (merged_statistics.h).
+  out.cost_at_point = weighted_yy(stats.all, gf);
   out.run_move = farthest_run_move(d, runs, s, z0, gf);
   if (!s.ok) {
     throw std::invalid_argument(fmt::format("the model's effects ({}) are not separable with the merged runs' signals",

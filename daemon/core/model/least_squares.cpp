@@ -144,12 +144,7 @@ double cost_at(const PassStatistics& s, const GroupFloors& floors, std::span<con
     const StepSolution n = solve_step(s.all, floors, std::vector<int>(nuisance_cols.begin(), nuisance_cols.end()));
     if (n.ok) return n.rss_w;
   }
-  double c = 0.0;
-  for (int g = 0; g < kGroups; ++g) {
-    const double f = floors.of(static_cast<Group>(g));
-    if (f > 0.0) c += s.all[static_cast<std::size_t>(g)].yy() / (f * f);
-  }
-  return c;
+  return weighted_yy(s.all, floors);
 }
 
 /// [rad] a change of the frame shift that no longer matters: it turns a harmonic error
@@ -195,6 +190,15 @@ bool column_is_nonlinear(const Design& d, int col) {
 }
 
 }  // namespace
+
+double weighted_yy(const std::vector<NormalEquations>& groups, const GroupFloors& floors) {
+  double c = 0.0;
+  for (int g = 0; g < kGroups; ++g) {
+    const double f = floors.of(static_cast<Group>(g));
+    if (f > 0.0) c += groups[static_cast<std::size_t>(g)].yy() / (f * f);
+  }
+  return c;
+}
 
 bool strictly_linear(const Design& d) {
   for (const DesignTerm& t : d.terms()) {

@@ -64,6 +64,10 @@ struct StepSolution {
 [[nodiscard]] StepSolution solve_step(const std::vector<NormalEquations>& groups, const GroupFloors& floors,
                                       std::span<const int> columns = {}, double lambda = 0.0);
 
+/// The groups' residual sum of squares, each over its floor squared (a group without a
+/// floor is not fitted): the cost at the statistics' point with no column solved.
+[[nodiscard]] double weighted_yy(const std::vector<NormalEquations>& groups, const GroupFloors& floors);
+
 /// True when every model term's prediction is linear in its fitted parameters and none
 /// shapes the basis: one linearised step is the exact fit, and statistics moved to another
 /// point (run_statistics.h) are exact there.
