@@ -2,7 +2,8 @@
 //
 // Two estimates, and which one is used is said:
 //  - standstill: where the log holds still (>= kMinStandstillSamples samples in
-//    stretches of >= 10), the spread of each signal about its stretch's mean is the
+//    stretches of >= 10, each after its first 0.1 s, where the converter's loop and the
+//    shaft still ring after a stop), the spread of each signal about its stretch's mean is the
 //    sensor's own noise; moving adds the quantization of the quantized channels
 //    (uniform: LSB^2 / 12 each, the LSB read off the data).
 //  - second differences: per speed bin, the signal's second differences after

@@ -2,6 +2,7 @@
 #include "daemon/core/discovery/noise_floor.h"
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -34,6 +35,38 @@ TEST(ChannelQuantum, ContinuousSignalHasNone) {
   std::vector<double> v;
   for (int i = 0; i < 2000; ++i) v.push_back(std::sin(0.01 * i) + 1e-3 * std::sin(1.7 * i * i));
   EXPECT_LT(channel_quantum(v), 1e-6);
+}
+
+TEST(StandstillFloor, TheConvertersRingingAfterAStopIsNotTheSensorsNoise) {
+  // A 10 kHz log that stops abruptly from 600 r/min (p_r = 3) and holds 2 s: the R/D
+  // loop (omega_n = 3000 rad/s, zeta = 0.7) rings down from ~omega / omega_n = 0.06 rad
+  // in the first milliseconds of the standstill; the sensor's noise is 3e-5 rad.
+  constexpr double kDt = 1e-4, kSigma = 3e-5, kOmega = 600.0 / 60.0 * kTwoPi * 3.0, kWn = 3000.0, kZeta = 0.7;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  std::vector<FitRow> rows(20000);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double t = static_cast<double>(i) * kDt;
+    const double wd = kWn * std::sqrt(1.0 - kZeta * kZeta);
+    rows[i].flags = FitRow::kHasRd;  // not moving: the whole stretch is standstill
+    rows[i].y_rd = kOmega / kWn * std::exp(-kZeta * kWn * t) * std::sin(wd * t) + noise(rng);
+  }
+  // Control: the ringing is far above the noise over the whole stretch, so a floor
+  // that took it in would fail the check below by a wide margin.
+  double ss = 0.0, sum = 0.0;
+  for (const FitRow& r : rows) {
+    sum += r.y_rd;
+    ss += r.y_rd * r.y_rd;
+  }
+  const double n = static_cast<double>(rows.size());
+  ASSERT_GT(std::sqrt(ss / n - sum * sum / (n * n)), 5.0 * kSigma);
+
+  const FloorReport f = estimate_floors(rows, kDt, true, ChannelQuanta{}, true);
+  EXPECT_EQ(f.rd.source, "standstill");
+  EXPECT_EQ(f.rd.standstill_samples, 19000);  // the first 0.1 s of the stretch is left to settle
+  // 19000 samples: the sample standard deviation's relative standard error is
+  // 1 / sqrt(2 N) = 0.5 %; 3 % is six of them.
+  EXPECT_NEAR(f.rd.chosen, kSigma, 0.03 * kSigma);
 }
 
 }  // namespace
