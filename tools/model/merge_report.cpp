@@ -7,6 +7,7 @@
 #include <fmt/ranges.h>
 
 #include "tools/model/json_text.h"
+#include "tools/model/model_report.h"
 
 namespace resolver {
 
@@ -123,6 +124,7 @@ std::string format_merge_text(const MergedFit& m, const std::vector<std::string>
   for (const Candidate& c : m.candidates) {
     o += fmt::format("  {} {:<26} BIC drop {:.1f} ERR {:.3f}{}\n      {}\n", c.proposed ? '*' : ' ', c.effect,
                      c.bic_drop, c.err, c.reaches_floor ? "  reaches the floor" : "", c.reason);
+    if (c.stepped) o += std::string(kOneStepNote);
   }
   for (const std::string& n : m.not_evaluated) o += "    not evaluated: " + n + "\n";
   const MergeVerdict v = merge_verdict(m, explained_ratio);
@@ -147,9 +149,10 @@ std::string format_merge_json(const MergedFit& m, const std::vector<std::string>
   o += "],\"candidates\":[";
   for (std::size_t i = 0; i < m.candidates.size(); ++i) {
     const Candidate& c = m.candidates[i];
-    o += fmt::format("{}{{\"effect\":{},\"bic_drop\":{},\"err\":{},\"proposed\":{},\"reaches_floor\":{},\"params\":{}}}",
+    o += fmt::format("{}{{\"effect\":{},\"bic_drop\":{},\"err\":{},\"proposed\":{},\"reaches_floor\":{},"
+                     "\"one_step\":{},\"params\":{}}}",
                      i > 0 ? "," : "", json::str(c.effect), json::num(c.bic_drop), json::num(c.err), c.proposed,
-                     c.reaches_floor, json_params(c.params));
+                     c.reaches_floor, c.stepped, json_params(c.params));
   }
   o += "],\"comparisons\":[";
   for (std::size_t i = 0; i < m.comparisons.size(); ++i) {

@@ -262,6 +262,9 @@ struct Candidate {
   /// Fitted to convergence with the model (ranking.h exact refits), not one linearised
   /// step: its params are a fit a later window may start from.
   bool refitted = false;
+  /// Its values and score are one linearised step from neutral although its fit is not
+  /// (ranking.h needs_exact_refit; beyond the refits' count): approximate, and said so.
+  bool stepped = false;
 };
 
 /// Whether a candidate that leaves `weighted_rss_after` (a row at its floor weighs 1)

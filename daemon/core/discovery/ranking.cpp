@@ -448,9 +448,13 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     out.candidates.push_back(std::move(c));
     if (options.progress) options.progress(0.5 + 0.3 * static_cast<double>(i + 1) / static_cast<double>(terms.size()));
   }
-  sort_by_score(out.candidates);
+  // The refits are the first candidates as they are listed (the simplest of those the
+  // log cannot tell apart first), as a merge of statistics chooses them
+  // (run_statistics.h candidates_to_refit): the same candidates carry exact values.
+  order_ranked(out.candidates, options);
   refit_nonlinear(out, log, fit, base, floors, options);
   order_ranked(out.candidates, options);
+  for (Candidate& c : out.candidates) c.stepped = !c.refitted && needs_exact_refit(c, options);
   return out;
 }
 

@@ -501,8 +501,9 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   }
   take_run_flags(runs, names, out);
   rank_merged(d, stats, s, gf, runs, logs, ref, options, out);
-  for (const Candidate& c : out.candidates) {
-    if (needs_exact_refit(c, options)) out.stepped.push_back(c.effect);
+  for (Candidate& c : out.candidates) {
+    c.stepped = needs_exact_refit(c, options);
+    if (c.stepped) out.stepped.push_back(c.effect);
   }
   if (out.explained || out.untrusted || !out.linearised.empty()) {
     // As explain: a model at the floor needs nothing; a candidate's BIC drop there is noise
@@ -565,6 +566,8 @@ void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& 
     }
   }
   c.reason = reason_of(term, c.params);
+  c.refitted = true;
+  c.stepped = false;
   m.refitted.push_back(effect);
   if (std::find(with.held.begin(), with.held.end(), effect) != with.held.end()) m.held.push_back(effect);
   std::erase(m.stepped, effect);
