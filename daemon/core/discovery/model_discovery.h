@@ -73,8 +73,9 @@ struct DiscoveryOptions {
   /// for resolverd's live windows, where their columns slowed every window that misses
   /// an effect (and, on one emulated CPU, the socket reader beside it).
   bool harmonic_families = false;
-  /// Refit every proposed candidate to convergence with the model, not only those whose
-  /// one linearised step is known not to be their fit (ranking.h needs_exact_refit): with
+  /// Refit the proposed candidates (the first kNonlinearRefits as listed, ranking.cpp) to
+  /// convergence with the model, not only those whose one linearised step is known not
+  /// to be their fit (ranking.h needs_exact_refit): with
   /// a nonlinear model (the default's gain error goes through atan2) even a linear
   /// candidate's step is first order. A drifting excitation (0.1 %/s) was named with g 6
   /// standard errors from its fit. Offline (resolver-model); the live windows save the time.
