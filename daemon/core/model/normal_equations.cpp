@@ -5,17 +5,18 @@
 namespace resolver {
 
 NormalEquations::NormalEquations(int columns)
-    : m_(Eigen::MatrixXd::Zero(columns, columns)),
-      b_(Eigen::VectorXd::Zero(columns)),
-      rows_(kBlock, columns),
-      y_(kBlock) {}
+    : m_(Eigen::MatrixXd::Zero(columns, columns)), b_(Eigen::VectorXd::Zero(columns)) {}
 
 void NormalEquations::add(const Eigen::Ref<const Eigen::VectorXd>& x, double y) {
+  if (rows_.rows() == 0) {  // released by flush(): the buffer is only held while rows come
+    rows_.resize(kBlock, columns());
+    y_.resize(kBlock);
+  }
   rows_.row(used_) = x.transpose();
   y_[used_] = y;
   yy_ += y * y;
   ++n_;
-  if (++used_ == kBlock) flush();
+  if (++used_ == kBlock) flush_const();
 }
 
 void NormalEquations::flush_const() const {
@@ -28,7 +29,11 @@ void NormalEquations::flush_const() const {
   m_.triangularView<Eigen::StrictlyUpper>() = m_.transpose();
 }
 
-void NormalEquations::flush() { flush_const(); }
+void NormalEquations::flush() {
+  flush_const();
+  rows_.resize(0, 0);
+  y_.resize(0);
+}
 
 const Eigen::MatrixXd& NormalEquations::m() const {
   flush_const();
@@ -54,11 +59,10 @@ double NormalEquations::rss(const Eigen::VectorXd& c) const {
 }
 
 void NormalEquations::set(Eigen::MatrixXd m, Eigen::VectorXd b, double yy, std::int64_t n) {
-  const auto k = static_cast<int>(b.size());
   m_ = std::move(m);
   b_ = std::move(b);
-  rows_.resize(kBlock, k);
-  y_.resize(kBlock);
+  rows_.resize(0, 0);
+  y_.resize(0);
   used_ = 0;
   yy_ = yy;
   n_ = n;

@@ -7,7 +7,9 @@
 // machines combine exactly.
 //
 // Rows are buffered and added a block at a time: one matrix product per block is
-// several times faster than a rank-1 update per row.
+// several times faster than a rank-1 update per row. flush() adds them and frees the
+// buffer (kBlock rows of every column: about as large as M itself), so statistics kept
+// after their pass (a long log's chunks, issue 23) hold only their sums.
 #pragma once
 
 #include <Eigen/Dense>
@@ -22,7 +24,8 @@ class NormalEquations {
 
   /// Adds one row x (length columns()) with target y and weight 1.
   void add(const Eigen::Ref<const Eigen::VectorXd>& x, double y);
-  /// Adds the buffered rows; call before reading m(), b() (the const readers flush lazily).
+  /// Adds the buffered rows and frees the buffer (the next add() takes it again); the
+  /// const readers m(), b() add them lazily without freeing.
   void flush();
   /// Adds another accumulation of the same columns (exact merge).
   void merge(const NormalEquations& other);
