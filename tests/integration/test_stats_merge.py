@@ -157,6 +157,10 @@ def check_faulty_log_through_passes(args, w):
     stepped = [x["effect"] for x in mem["candidates"] if x["one_step"]]
     c.check(bool(stepped) and all(by_effect[e]["one_step"] for e in stepped if e in by_effect),
             f"a faulty log: the candidates left at one linearised step are said so by both ({stepped[:4]})")
+    for what, j in (("in memory", mem), ("chunked", chk)):
+        said = all(("(one linearised step: " in x["reason"]) == x["one_step"] and ("(fit: " in x["reason"]) != x["one_step"]
+                   for x in j["candidates"] if x["params"])
+        c.check(said, f"a faulty log {what}: each candidate's reason calls its values a fit or one step as they are")
     for what, notes in (("in memory", mem["notes"]), ("chunked", chk["notes"])):
         c.check(any("outliers for" in n for n in notes) and any("input problems counted" in n for n in notes),
                 f"a faulty log {what}: the spikes and the reader's problems are counted in the notes")

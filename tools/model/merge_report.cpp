@@ -70,7 +70,7 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
   // of what lies above it.
   if (best != nullptr && (best->reaches_floor || removes_most_excess(m.signals, rows, m.rd, best->weighted_rss))) {
     const bool exact = std::find(m.refitted.begin(), m.refitted.end(), best->effect) != m.refitted.end();
-    const bool linear = std::find(m.stepped.begin(), m.stepped.end(), best->effect) == m.stepped.end();
+    const bool linear = !best->stepped;
     const bool held = std::find(m.held.begin(), m.held.end(), best->effect) != m.held.end();
     return {"missing_effect",
             "adding " + best->effect +
@@ -150,9 +150,9 @@ std::string format_merge_json(const MergedFit& m, const std::vector<std::string>
   for (std::size_t i = 0; i < m.candidates.size(); ++i) {
     const Candidate& c = m.candidates[i];
     o += fmt::format("{}{{\"effect\":{},\"bic_drop\":{},\"err\":{},\"proposed\":{},\"reaches_floor\":{},"
-                     "\"one_step\":{},\"params\":{}}}",
+                     "\"one_step\":{},\"reason\":{},\"params\":{}}}",
                      i > 0 ? "," : "", json::str(c.effect), json::num(c.bic_drop), json::num(c.err), c.proposed,
-                     c.reaches_floor, c.stepped, json_params(c.params));
+                     c.reaches_floor, c.stepped, json::str(c.reason), json_params(c.params));
   }
   o += "],\"comparisons\":[";
   for (std::size_t i = 0; i < m.comparisons.size(); ++i) {

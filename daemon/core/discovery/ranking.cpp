@@ -181,14 +181,14 @@ std::string motion_missing(const Effect& e, const MotionSummary& m, bool sincos)
   return "";
 }
 
-std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params) {
+std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params, bool one_step) {
   std::string vals;
   const std::string prefix = std::string(t.effect->name()) + ".";
   for (const ModelParameter& p : params) {
     vals += (vals.empty() ? "" : ", ") + p.name.substr(prefix.size()) + " = " + num(p.value) + " +- " +
             num(p.std_error, "%.2g");
   }
-  return std::string(t.effect->physics()) + " (fit: " + vals + ").";
+  return std::string(t.effect->physics()) + (one_step ? " (one linearised step: " : " (fit: ") + vals + ").";
 }
 
 namespace {
@@ -249,6 +249,13 @@ bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options) {
   bool nonlinear = term.effect->envelope_only() && !c.family && !c.reaches_floor;
   for (int p : term.params) nonlinear = nonlinear || term.effect->params()[static_cast<std::size_t>(p)].nonlinear;
   return nonlinear;
+}
+
+void flag_one_step(Candidate& c, const DiscoveryOptions& options) {
+  c.stepped = !c.refitted && needs_exact_refit(c, options);
+  if (!c.stepped) return;
+  const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
+  c.reason = reason_of(one.terms.front(), c.params, true);
 }
 
 StepSolution solve_candidate(const std::vector<NormalEquations>& groups, const GroupFloors& floors,
@@ -454,7 +461,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   order_ranked(out.candidates, options);
   refit_nonlinear(out, log, fit, base, floors, options);
   order_ranked(out.candidates, options);
-  for (Candidate& c : out.candidates) c.stepped = !c.refitted && needs_exact_refit(c, options);
+  for (Candidate& c : out.candidates) flag_one_step(c, options);
   return out;
 }
 

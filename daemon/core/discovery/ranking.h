@@ -30,8 +30,9 @@ struct Ranking {
 /// ("" = nothing): a speed change, a reversal, or sin/cos beside the R/D angle (`sincos`).
 [[nodiscard]] std::string motion_missing(const Effect& e, const MotionSummary& m, bool sincos);
 
-/// One sentence of the term's physics with its fitted values.
-[[nodiscard]] std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params);
+/// One sentence of the term's physics with its values, said to be its fit or (`one_step`)
+/// one linearised step from zero (Candidate::stepped).
+[[nodiscard]] std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& params, bool one_step = false);
 
 /// The parameters of `design`'s term in value coordinates with standard errors from `s`.
 /// `step` moves the term by the solution first (a linearised candidate taken from its
@@ -59,6 +60,10 @@ void score_candidate(Candidate& c, const StepSolution& s, bool rd, const StepSol
 /// (delay, tracking loop); offline (DiscoveryOptions::refit_proposed) every proposed
 /// one. Such candidates are refitted to convergence with the model.
 [[nodiscard]] bool needs_exact_refit(const Candidate& c, const DiscoveryOptions& options);
+
+/// Sets Candidate::stepped (not refitted, and its step is not its fit: needs_exact_refit)
+/// and says so in its reason, so no report calls one step a fit.
+void flag_one_step(Candidate& c, const DiscoveryOptions& options);
 
 /// The effects of `ranked` (best first) to refit so: the best kNonlinearRefits proposed
 /// ones that need it. The same rule for a log in memory and for merged statistics.

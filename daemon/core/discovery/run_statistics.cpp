@@ -501,10 +501,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
   }
   take_run_flags(runs, names, out);
   rank_merged(d, stats, s, gf, runs, logs, ref, options, out);
-  for (Candidate& c : out.candidates) {
-    c.stepped = needs_exact_refit(c, options);
-    if (c.stepped) out.stepped.push_back(c.effect);
-  }
+  for (Candidate& c : out.candidates) flag_one_step(c, options);
   if (out.explained || out.untrusted || !out.linearised.empty()) {
     // As explain: a model at the floor needs nothing; a candidate's BIC drop there is noise
     // fitted (with formal errors on 10^5 rows a few thousandths of the residual). Fitted
@@ -531,7 +528,9 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
 std::vector<std::string> candidates_to_refit(const MergedFit& m, const DiscoveryOptions& options) {
   if (m.explained || m.untrusted || !m.linearised.empty()) return {};
   std::vector<std::string> out = exact_refits(m.candidates, options);
-  std::erase_if(out, [&](const std::string& e) { return std::find(m.stepped.begin(), m.stepped.end(), e) == m.stepped.end(); });
+  std::erase_if(out, [&](const std::string& e) {
+    return std::none_of(m.candidates.begin(), m.candidates.end(), [&](const Candidate& c) { return c.effect == e && c.stepped; });
+  });
   return out;
 }
 
@@ -570,7 +569,6 @@ void take_exact_refit(MergedFit& m, const std::string& effect, const MergedFit& 
   c.stepped = false;
   m.refitted.push_back(effect);
   if (std::find(with.held.begin(), with.held.end(), effect) != with.held.end()) m.held.push_back(effect);
-  std::erase(m.stepped, effect);
   order_ranked(m.candidates, options);
 }
 

@@ -116,9 +116,6 @@ struct MergedFit {
   /// refitted candidates those: fitted by Gauss-Newton steps of merges over passes, not
   /// to convergence on each run.
   std::vector<std::string> held;
-  /// Candidates whose score is still one linearised step although their fit is not
-  /// (ranking.h needs_exact_refit): their value and residual are approximate.
-  std::vector<std::string> stepped;
   bool untrusted = false;  ///< some run's signals were faulty for long: never explained, nothing proposed
   /// The model's prediction is not linear in its parameters (least_squares.h
   /// strictly_linear): the merge is one Gauss-Newton step from the runs' points, exact

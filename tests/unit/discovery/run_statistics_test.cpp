@@ -125,7 +125,8 @@ TEST(RunStatistics, AMissingEffectIsRankedFromTheMergedStatistics) {
   // Converged: the ADC noise's standard error (~5e-7 here), not the step's 2e-4.
   EXPECT_NEAR(param(c.params, "quadrature.beta").value, 0.01, 1e-5);
   EXPECT_EQ(ranked.refitted, std::vector<std::string>{"quadrature"});
-  EXPECT_TRUE(std::find(ranked.stepped.begin(), ranked.stepped.end(), "quadrature") == ranked.stepped.end());
+  EXPECT_FALSE(c.stepped);
+  EXPECT_NE(c.reason.find("(fit: "), std::string::npos) << c.reason;
   for (const std::string& e : candidates_to_refit(ranked, kAligned)) EXPECT_NE(e, "quadrature") << "refitted twice";
 }
 
