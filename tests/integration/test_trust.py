@@ -202,6 +202,30 @@ class ExplainOnFaultySignals(unittest.TestCase):
         self.assertFalse([w for w in ex["where_it_fails"] if "signal health" in w])
 
 
+class StopOnASlowLoop(unittest.TestCase):
+    """A stop's first samples are the bench settling, not its noise: a software tracking
+    observer of omega_n = 30 rad/s rings for ~0.3 s after an abrupt stop from 60 r/min
+    (p_r = 1), longer than the fixed 0.1 s the floor waits. That ringing made the position
+    error's standstill floor 1.95e-3 rad against the moving samples' 3.7e-5 (53x), and any
+    model within 50x of it "at the floor". The floor now waits until the stop has settled
+    (noise_floor.cpp settled_start)."""
+
+    def test_the_standstill_floor_is_the_moving_samples_noise(self):
+        log = sim_log("slow_loop_stop.log", "--profile", "60:3,0:3,60:3", "--p-r", "1", "--sample-rate", "10000",
+                      "-e", "tracking_loop:omega_n=30,zeta=0.7", "-e", "quadrature:beta=0.002")
+        p = run([os.path.join(ARGS.bin, "resolver-model"), "explain", log, "--effects", "tracking_loop", "--json"])
+        ex = json.loads(p.stdout)
+        for signal in ("position_error", "sin_cos"):
+            f = ex["floors"][signal]
+            self.assertGreater(f["standstill_samples"], 20000)  # most of the 3 s stop is kept
+            # The two estimates of one noise (second differences of the moving samples,
+            # spread of the still ones, the quantization in both) agree within 1.5x: a
+            # 16-bit R/D code is 2.8e-5 rad by either.
+            self.assertLess(f["standstill"], 1.5 * f["second_differences"], (signal, f))
+        # The ringing at the steps and the quadrature are both above the floor.
+        self.assertNotEqual(ex["verdict"], "explained")
+
+
 class OverlappingDbc(unittest.TestCase):
     def test_refused_naming_both_signals_message_and_bits(self):
         cfg = os.path.join(work("overlap.toml"))

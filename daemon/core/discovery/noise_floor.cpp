@@ -25,6 +25,19 @@ constexpr std::size_t kMinStretch = 10;
 /// called explained. 0.1 s is e^-7 of it for omega_n >= 100 rad/s at zeta = 0.7 (the
 /// slow end of R/D converters) and covers a coupling's mechanical ring-down of tens of ms.
 constexpr double kStandstillSettling = 0.1;
+/// Samples per block by which a standstill stretch is judged settled beyond that: a
+/// block's sample variance of white noise has a relative standard error
+/// sqrt(2 / (B - 1)) = 0.14.
+constexpr std::size_t kSettleBlock = 100;
+/// A leading block whose mean square exceeds this multiple of the stretch's settled
+/// variance is still settling. What rings on past it adds (ratio - 1) x tau / (2 T) of the
+/// variance over a stretch of T s (tau the ringing's decay time): 1.5 keeps that to ~1 %
+/// for tau = T / 10. White noise passes a block with chance ~0.9995 (3.5 of the standard
+/// errors above), and a false skip only drops that block. A slow loop (a software
+/// tracking observer of omega_n = 30 rad/s rings for ~0.3 s) or a lightly damped
+/// coupling rings for longer than kStandstillSettling: such a stop made the position
+/// error's floor 70x the sensor's (1.95e-3 rad against 2.8e-5).
+constexpr double kSettleRatio = 1.5;
 
 int nyquist_order(double omega_abs_max, double dt) {
   if (!(omega_abs_max > 0.0) || !(dt > 0.0)) return kSaturatedOrder;
@@ -166,8 +179,59 @@ std::vector<double> second_difference_floors(std::span<const FitRow> rows, doubl
   return out;
 }
 
+/// Running sums of one signal's values over some rows.
+struct Moments {
+  double sum = 0.0, sum2 = 0.0;
+  std::int64_t n = 0;
+  void add(double v) {
+    sum += v;
+    sum2 += v * v;
+    ++n;
+  }
+  [[nodiscard]] double mean() const { return n == 0 ? 0.0 : sum / static_cast<double>(n); }
+  [[nodiscard]] double variance() const {
+    return n < 2 ? 0.0 : std::max(0.0, sum2 - sum * sum / static_cast<double>(n)) / static_cast<double>(n - 1);
+  }
+};
+
+/// Each signal's moments over rows [from, to), outliers left out.
+std::array<Moments, kSigCount> moments(std::span<const FitRow> rows, std::size_t from, std::size_t to) {
+  std::array<Moments, kSigCount> m{};
+  for (std::size_t k = from; k < to; ++k) {
+    if (rows[k].has(FitRow::kOutlier)) continue;
+    for (int s = 0; s < kSigCount; ++s) {
+      if (has_sig(rows[k], s)) m[static_cast<std::size_t>(s)].add(value(rows[k], s));
+    }
+  }
+  return m;
+}
+
+/// Where standstill stretch [i, j) has settled: the first block of kSettleBlock rows in
+/// which every signal's mean square about its mean over the stretch's second half is
+/// within kSettleRatio x its variance there (the second half assumed settled; at most it
+/// is kept). About that mean, not the block's own: a ringing slower than a block (a 20 Hz
+/// coupling mode is 500 rows at 10 kHz) moves the block's mean. A stretch too short to
+/// judge is taken from `i`.
+std::size_t settled_start(std::span<const FitRow> rows, std::size_t i, std::size_t j) {
+  if (j - i < 4 * kSettleBlock) return i;
+  const std::size_t half = i + (j - i) / 2;
+  const std::array<Moments, kSigCount> tail = moments(rows, half, j);
+  for (std::size_t b = i; b + kSettleBlock <= half; b += kSettleBlock) {
+    const std::array<Moments, kSigCount> block = moments(rows, b, b + kSettleBlock);
+    bool settled = true;
+    for (std::size_t s = 0; s < block.size(); ++s) {
+      if (block[s].n < 2 || tail[s].n < 2) continue;
+      const double off = block[s].mean() - tail[s].mean();
+      if (block[s].variance() + off * off > kSettleRatio * tail[s].variance()) settled = false;
+    }
+    if (settled) return b;
+  }
+  return half;
+}
+
 /// Pooled within-stretch standard deviation of standstill samples, per signal, each
-/// stretch after its first kStandstillSettling seconds.
+/// stretch after its first kStandstillSettling seconds and what it took beyond that to
+/// settle (settled_start).
 std::vector<double> standstill_floors(std::span<const FitRow> rows, double sample_period, std::int64_t& samples) {
   const auto settling =
       sample_period > 0.0 ? static_cast<std::size_t>(std::ceil(kStandstillSettling / sample_period)) : std::size_t{0};
@@ -183,22 +247,14 @@ std::vector<double> standstill_floors(std::span<const FitRow> rows, double sampl
     }
     std::size_t j = i;
     while (j < rows.size() && still(j)) ++j;
-    i = std::min(j, i + settling);
+    i = settled_start(rows, std::min(j, i + settling), j);
     if (j - i >= kMinStretch) {
-      for (int s = 0; s < kSigCount; ++s) {
-        double sum = 0.0, sum2 = 0.0;
-        std::int64_t m = 0;
-        for (std::size_t k = i; k < j; ++k) {
-          if (rows[k].has(FitRow::kOutlier) || !has_sig(rows[k], s)) continue;
-          const double v = value(rows[k], s);
-          sum += v;
-          sum2 += v * v;
-          ++m;
-        }
-        if (m < 2) continue;
-        ss[static_cast<std::size_t>(s)] += std::max(0.0, sum2 - sum * sum / static_cast<double>(m));
-        n[static_cast<std::size_t>(s)] += m;
-        ++stretches[static_cast<std::size_t>(s)];
+      const std::array<Moments, kSigCount> m = moments(rows, i, j);
+      for (std::size_t s = 0; s < m.size(); ++s) {
+        if (m[s].n < 2) continue;
+        ss[s] += m[s].variance() * static_cast<double>(m[s].n - 1);
+        n[s] += m[s].n;
+        ++stretches[s];
       }
       samples += static_cast<std::int64_t>(j - i);
     }

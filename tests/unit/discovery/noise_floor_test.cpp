@@ -69,5 +69,58 @@ TEST(StandstillFloor, TheConvertersRingingAfterAStopIsNotTheSensorsNoise) {
   EXPECT_NEAR(f.rd.chosen, kSigma, 0.03 * kSigma);
 }
 
+/// Sample standard deviation of the R/D signal over rows [from, end).
+double rd_deviation(const std::vector<FitRow>& rows, std::size_t from) {
+  double sum = 0.0, ss = 0.0;
+  for (std::size_t i = from; i < rows.size(); ++i) {
+    sum += rows[i].y_rd;
+    ss += rows[i].y_rd * rows[i].y_rd;
+  }
+  const double n = static_cast<double>(rows.size() - from);
+  return std::sqrt(ss / n - sum * sum / (n * n));
+}
+
+TEST(StandstillFloor, ARingingLongerThanTheFixedGuardIsWaitedOut) {
+  // A 10 kHz log's 3 s stop on a bench whose coupling between resolver and reference has
+  // a lightly damped 20 Hz mode (zeta = 0.05, decay time 0.16 s): the position error
+  // rings from 1 mrad, far longer than the fixed 0.1 s guard. The sensor's noise is 3e-5 rad.
+  constexpr double kDt = 1e-4, kSigma = 3e-5, kF = 20.0, kZeta = 0.05, kA = 1e-3;
+  const double wn = kTwoPi * kF;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  std::vector<FitRow> rows(30000);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double t = static_cast<double>(i) * kDt;
+    rows[i].flags = FitRow::kHasRd;
+    rows[i].y_rd = kA * std::exp(-kZeta * wn * t) * std::cos(wn * t) + noise(rng);
+  }
+  // Control: after the fixed guard alone the ringing still makes the deviation 2x the noise.
+  ASSERT_GT(rd_deviation(rows, 1000), 2.0 * kSigma);
+  const FloorReport f = estimate_floors(rows, kDt, true, ChannelQuanta{}, true);
+  EXPECT_EQ(f.rd.source, "standstill");
+  // What is kept starts once a 10 ms block's mean square is within 1.5x the noise's
+  // variance (ringing amplitude ~3e-5, after ~0.5 s); what rings on beyond adds ~1.6 % of
+  // the variance (0.8 % of the deviation). With ~25000 samples the estimate's own
+  // standard error is 0.45 %: 3 % is that bias and four of them.
+  EXPECT_NEAR(f.rd.chosen, kSigma, 0.03 * kSigma);
+  EXPECT_LT(f.rd.standstill_samples, 26000);
+  EXPECT_GT(f.rd.standstill_samples, 20000) << "waited for longer than the ringing lasts";
+}
+
+TEST(StandstillFloor, NoiseAloneIsNotMistakenForSettling) {
+  // Control of the above: a 3 s stop of white noise keeps everything after the fixed guard.
+  constexpr double kDt = 1e-4, kSigma = 3e-5;
+  std::mt19937 rng(12);
+  std::normal_distribution<double> noise(0.0, kSigma);
+  std::vector<FitRow> rows(30000);
+  for (FitRow& r : rows) {
+    r.flags = FitRow::kHasRd;
+    r.y_rd = noise(rng);
+  }
+  const FloorReport f = estimate_floors(rows, kDt, true, ChannelQuanta{}, true);
+  EXPECT_EQ(f.rd.standstill_samples, 29000);
+  EXPECT_NEAR(f.rd.chosen, kSigma, 0.03 * kSigma);  // 0.4 % standard error: 3 %
+}
+
 }  // namespace
 }  // namespace resolver
