@@ -28,6 +28,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "daemon/app/exit_codes.h"
@@ -36,6 +37,7 @@
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/model/calibration_table.h"
 #include "daemon/core/model/model_spec.h"
+#include "daemon/core/model/row_blocks.h"
 #include "daemon/service/table_file.h"
 #include "tools/model/export_data.h"
 #include "tools/model/fleet.h"
@@ -306,7 +308,16 @@ struct Arguments {
   std::string stats_out;                // stats
   double chunk_s = 0.0;                 // stats: one run per chunk of this many seconds
   std::vector<std::string> stats_files;  // merge
+  int threads = 0;                       // passes over a log's rows (0: every core)
 };
+
+/// Threads for the passes over a log's rows (row_blocks.h: the answer does not depend on it).
+void add_threads_option(CLI::App* sub, Arguments& a) {
+  sub->add_option("--threads", a.threads,
+                  "threads each pass over the log's rows uses (default: every core; the result is the same to the "
+                  "last bit with any number)")
+      ->check(CLI::Range(1, 1024));
+}
 
 /// fit and explain: the log, the model (with the fittable effects listed) and --json.
 void add_model_options(CLI::App* sub, Arguments& a, const std::string& fittable) {
@@ -335,6 +346,7 @@ void add_slicing_options(CLI::App* sub, Arguments& a) {
   sub->add_flag("--moving-only", a.moving_only,
                 "leave standstill samples out of everything, the noise floor too (default: they give the floor "
                 "and never enter a fit)");
+  add_threads_option(sub, a);
 }
 
 /// How the log is read: config, format, time range and progress.
@@ -477,6 +489,7 @@ void add_calibration_subcommands(CLI::App& app, Arguments& a, Subcommands& subs)
   fleet->add_option("--points", a.export_points, "calibration table points per mechanical revolution (default 1024)")
       ->check(CLI::Range(8, 1 << 20));
   fleet->add_option("--config", a.config_path, "resolverd config (TOML), as for explain");
+  add_threads_option(fleet, a);
   add_statistics_subcommands(app, a, subs);
 }
 
@@ -734,6 +747,7 @@ int run(int argc, char** argv) {
   if (auto code = resolver::exit_code::parse_command_line(app, argc, argv)) return *code;
   a.command = subs.parsed();
   if (!a.logs.empty()) a.log = a.logs.front();
+  resolver::set_pass_threads(a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency()));
   if (a.command == Command::kFleet) {
     return run_fleet(a.manifest, a.fleet_out, a.summarize_dir, split_effects(a.effects_args), a.config_path,
                      a.export_points, a.merge_only);

@@ -4,6 +4,8 @@
 #include <limits>
 #include <numeric>
 
+#include "daemon/core/model/row_blocks.h"
+
 namespace resolver {
 
 namespace {
@@ -34,14 +36,17 @@ NormalEquations PassStatistics::fold_b(Group g) const {
   return out;
 }
 
-void accumulate(const Design& design, std::span<const FitRow> rows, const GroupFloors& floors, PassStatistics& out) {
-  if (out.all.empty() || out.all.front().columns() != design.columns()) out = PassStatistics(design.columns());
+namespace {
+
+/// Rows [from, to) of one pass added to `out` (unflushed).
+void accumulate_rows(const Design& design, std::span<const FitRow> rows, std::size_t from, std::size_t to,
+                     const GroupFloors& floors, PassStatistics& out) {
   AngleBasis basis;
   SignalValues pred;
   RowJacobian jac;
   jac.resize(design.columns());
   const bool use_rd = floors.rd > 0.0, use_sc = floors.sc > 0.0, use_cur = floors.cur > 0.0;
-  for (std::size_t i = 0; i < rows.size(); ++i) {
+  for (std::size_t i = from; i < to; ++i) {
     const FitRow& r = rows[i];
     if (!r.fitted()) continue;
     design.evaluate(rows, i, basis, pred, jac);
@@ -61,8 +66,39 @@ void accumulate(const Design& design, std::span<const FitRow> rows, const GroupF
       add(Group::kCur, jac.q, r.y_q - pred.q);
     }
   }
-  for (auto& g : out.all) g.flush();
-  for (auto& g : out.fold_a) g.flush();
+}
+
+void flush(PassStatistics& s) {
+  for (auto& g : s.all) g.flush();
+  for (auto& g : s.fold_a) g.flush();
+}
+
+}  // namespace
+
+void accumulate(const Design& design, std::span<const FitRow> rows, const GroupFloors& floors, PassStatistics& out) {
+  if (out.all.empty() || out.all.front().columns() != design.columns()) out = PassStatistics(design.columns());
+  if (rows.size() <= kRowBlock) {
+    accumulate_rows(design, rows, 0, rows.size(), floors, out);
+  } else {
+    // Blocks summed apart and added in order (row_blocks.h): the same sums on any number
+    // of threads. A design's evaluation keeps scratch in it: one copy per further worker.
+    const int workers = row_block_workers(rows.size());
+    std::vector<Design> copies(static_cast<std::size_t>(workers - 1), design);
+    std::vector<PassStatistics> parts(static_cast<std::size_t>(workers), PassStatistics(design.columns()));
+    over_row_blocks(
+        rows.size(),
+        [&](int w, std::size_t from, std::size_t to) {
+          const Design& d = w == 0 ? design : copies[static_cast<std::size_t>(w - 1)];
+          accumulate_rows(d, rows, from, to, floors, parts[static_cast<std::size_t>(w)]);
+        },
+        [&](int w) {
+          PassStatistics& part = parts[static_cast<std::size_t>(w)];
+          flush(part);
+          out.merge(part);
+          part = PassStatistics(design.columns());
+        });
+  }
+  flush(out);
 }
 
 StepSolution solve_step(const std::vector<NormalEquations>& groups, const GroupFloors& floors,

@@ -109,7 +109,9 @@ def run_stats(resolver_model, log, stats_path, error_path, extra):
     A log resolver-model refuses (exit 1, 2, 3) leaves error_path with its reason and
     returns ("failed", reason); anything else (killed, crashed) raises so Dask retries."""
     tmp = os.path.join(os.path.dirname(stats_path), f".tmp-{uuid.uuid4().hex}.stats")
-    proc = subprocess.run([resolver_model, "stats", log, "--out", tmp, *extra],
+    # One thread per task: the cluster's workers are the parallelism (a process each
+    # using every core would oversubscribe a machine running several).
+    proc = subprocess.run([resolver_model, "stats", log, "--out", tmp, "--threads", "1", *extra],
                           capture_output=True, text=True, errors="replace")
     if proc.returncode == EXIT_DONE and os.path.exists(tmp):
         _remove(error_path)
