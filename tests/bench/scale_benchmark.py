@@ -4,10 +4,12 @@
 
 Prints two tables (medians of --repeats runs, each under /usr/bin/time -v):
 
-  1. explain: peak RSS, wall time and bytes per sample for logs of a 10 kHz bench
+  1. explain: peak RSS, wall and CPU time and bytes per sample for logs of a 10 kHz bench
      (resolver-sim --sample-rate 10000, 200 r/min, alpha = 0.003) of each --minutes
-     length; a length whose projected RSS (from the shortest log's bytes per sample)
-     exceeds --max-rss-gb is not run and is printed as projected.
+     length, or the --logs given, per --threads count, each beside resolverd --replay
+     --fast with the model fit off on the same log (the issue's ratio); a length whose
+     projected RSS (from the shortest log's bytes per sample) exceeds --max-rss-gb is not
+     run and is printed as projected.
   2. replay: resolverd --replay LOG --once --fast with the default config (the live
      model fit on, every window fitted), the same with --baseline-bin (an older build,
      to measure a change side by side), and log2asc on the same log; ratios are the
@@ -22,6 +24,8 @@ Examples:
   /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin
   /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin --skip-replay --skip-explain --stats-chunk 30 --minutes 1 5 60
   /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin --minutes 1 10 --baseline-bin ../old/build/bin
+  # explain on 1 and 2 threads on a log the seed model does not explain, beside the replay
+  /usr/bin/python3 tests/bench/scale_benchmark.py --bin build/bin --skip-replay --logs b30.log --threads 1 2
 """
 import argparse
 import pathlib
@@ -50,6 +54,12 @@ def parse_args():
     p.add_argument("--stats-chunk", type=float, default=0.0,
                    help="[s] also the table of resolver-model stats --chunk S against the replay with the fit off")
     p.add_argument("--effects", default="amplitude_imbalance", help="the model for stats (default the seed's)")
+    p.add_argument("--threads", type=int, nargs="+", default=[],
+                   help="explain table: one row per thread count (resolver-model --threads N; none: its default), "
+                        "each beside resolverd --replay --fast with the model fit off on the same log")
+    p.add_argument("--logs", type=pathlib.Path, nargs="+", default=[],
+                   help="explain table: these logs instead of generated ones of --minutes (e.g. one with an effect "
+                        "the seed model lacks)")
     return p.parse_args()
 
 
@@ -64,24 +74,40 @@ def make_log(args, minutes):
 
 
 def explain_table(args):
+    """explain per log (and per --threads count), each repetition beside the replay with the fit off."""
     per_sample = None
-    print("\nresolver-model explain, 10 kHz bench (median of %d)" % args.repeats)
-    print("| log | samples | wall [s] | peak RSS [MB] | bytes/sample |")
-    print("|---|---|---|---|---|", flush=True)
-    for minutes in sorted(args.minutes):
-        samples = SAMPLE_RATE * minutes * 60
+    threads = args.threads or [None]
+    print("\nresolver-model explain, 10 kHz bench, beside resolverd --replay --fast with the model fit off on the same "
+          "log (median of %d; ratios: median of the per-repetition ratios)" % args.repeats)
+    print("| log | samples | threads | wall [s] | CPU [s] | peak RSS [MB] | bytes/sample | x replay (fit off) |")
+    print("|---|---|---|---|---|---|---|---|", flush=True)
+    logs = [(log, None) for log in args.logs] or [(None, m) for m in sorted(args.minutes)]
+    for given, minutes in logs:
+        log = given or make_log(args, minutes)
+        frames = rb.count_lines(log)
+        samples = (frames - frames // 3001) / 3 if given else SAMPLE_RATE * minutes * 60
+        name = log.name if given else f"{minutes:g} min"
         # Projected from the largest log run so far, with 20 % margin (bytes per sample fall with length).
         if per_sample is not None and 1.2 * per_sample * samples > args.max_rss_gb * 1e9:
-            print(f"| {minutes:g} min | {samples:.3g} | not run | {per_sample * samples / 1e6:.0f} projected | "
-                  f"{per_sample:.0f} |", flush=True)
+            print(f"| {name} | {samples:.3g} | | not run | | {per_sample * samples / 1e6:.0f} projected | "
+                  f"{per_sample:.0f} | |", flush=True)
             continue
-        log = make_log(args, minutes)
         rb.warm_cache(log)
-        runs = [rb.timed([str(args.bin / "resolver-model"), "explain", str(log)]) for _ in range(args.repeats)]
-        wall = statistics.median(r[0] for r in runs)
-        rss_mb = statistics.median(r[1] for r in runs) / 1024
-        per_sample = rss_mb * 1e6 / samples
-        print(f"| {minutes:g} min | {samples:.3g} | {wall:.1f} | {rss_mb:.0f} | {per_sample:.0f} |", flush=True)
+        runs = {t: [] for t in threads}
+        replay = []
+        for _ in range(args.repeats):
+            replay.append(rb.run_resolverd_pipeline(argparse.Namespace(bin=args.bin, work=args.work), log, frames))
+            for t in threads:
+                cmd = [str(args.bin / "resolver-model"), "explain", str(log)] + ([] if t is None else ["--threads", str(t)])
+                runs[t].append(rb.timed(cmd))
+        for t in threads:
+            wall = statistics.median(r[0] for r in runs[t])
+            rss_mb = statistics.median(r[1] for r in runs[t]) / 1024
+            per_sample = rss_mb * 1e6 / samples
+            ratio = statistics.median(r[0] / p["wall"] for r, p in zip(runs[t], replay))
+            print(f"| {name} | {samples:.3g} | {'default' if t is None else t} | {wall:.2f} | "
+                  f"{statistics.median(r[2] for r in runs[t]):.2f} | {rss_mb:.0f} | {per_sample:.0f} | {ratio:.1f} |",
+                  flush=True)
 
 
 def stats_table(args):
