@@ -1,7 +1,9 @@
 // Passes over many rows on several threads, with an answer that does not depend on
 // how many: the rows are cut into blocks of a fixed size, each block summed alone
 // (on whichever thread is free), and the blocks' sums added in block order. A pass is
-// then the same to the last bit on a laptop's eight cores and on CI's two.
+// then the same to the last bit on one thread or eight (on one CPU: the maths library
+// picks its sin and cos by the processor, so another machine may differ in the last
+// bits whatever the threads).
 //
 // The offline tools set the thread count once (resolver-model --threads); the default
 // is one, so the daemon's live windows (a few thousand rows, one block) run on its fit
