@@ -7,6 +7,8 @@
                  --progress and with stderr not a terminal: no progress at all
   ChangingFile   a log that grows while resolver-model reads it: exit 0, a warning and
                  a note saying so; one truncated while it is read: exit 3 naming it
+  Threads        explain (and --chunk) on --threads 1, 3 and the default: the same JSON
+                 byte for byte; --threads 0 refused naming it
   ReadOnce       a FIFO or a pipe read where a loop would read it twice: resolverd
                  --replay without --once stops after one pass saying why (exit 0, it
                  used to wait for another writer or say "no frames to loop over");
@@ -112,6 +114,29 @@ class Progress(unittest.TestCase):
         p = run([f"{ARGS.bin}/resolver-model", "explain", sim_log(2)], env=env)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertRegex(p.stderr, r"fitting .*100%")
+
+
+class Threads(unittest.TestCase):
+    """Each pass over a log's rows runs on --threads N (row_blocks.h): the answer is the
+    same to the last bit on any number."""
+
+    def test_the_same_report_on_one_thread_and_on_three(self):
+        log = sim_log(60)  # 120,000 samples: four blocks of 32,768 rows, so the passes are split
+        model = f"{ARGS.bin}/resolver-model"
+        for extra in ([], ["--chunk", "20"]):
+            with self.subTest(extra=extra):
+                one = run([model, "explain", log, "--json", "--threads", "1", *extra])
+                three = run([model, "explain", log, "--json", "--threads", "3", *extra])
+                default = run([model, "explain", log, "--json", *extra])
+                self.assertEqual(one.returncode, 0, one.stderr)
+                self.assertIn('"verdict"', one.stdout)
+                self.assertEqual(three.stdout, one.stdout)
+                self.assertEqual(default.stdout, one.stdout)
+
+    def test_a_thread_count_out_of_range_is_refused_naming_the_option(self):
+        p = run([f"{ARGS.bin}/resolver-model", "explain", sim_log(60), "--threads", "0"])
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("--threads", p.stderr)
 
 
 class ChangingFile(unittest.TestCase):
