@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -36,8 +37,15 @@ void over_row_blocks(std::size_t rows, const std::function<void(int worker, std:
       }
     };
     std::vector<std::thread> others;
-    for (std::size_t w = 1; w < workers; ++w) others.emplace_back(run, w);
+    others.reserve(workers - 1);
+    try {
+      for (std::size_t w = 1; w < workers; ++w) others.emplace_back(run, w);
+    } catch (const std::system_error&) {
+      // No thread to be had (a process or memory limit): the blocks of the workers that
+      // did not start run here below, each with its worker's state, as they would have.
+    }
     run(0);
+    for (std::size_t w = others.size() + 1; w < workers; ++w) run(w);
     for (std::thread& t : others) t.join();
     for (const std::exception_ptr& e : failed) {
       if (e) std::rethrow_exception(e);
