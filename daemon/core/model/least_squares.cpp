@@ -86,7 +86,7 @@ void accumulate(const Design& design, std::span<const FitRow> rows, const GroupF
     std::vector<Design> copies(static_cast<std::size_t>(workers - 1), design);
     std::vector<PassStatistics> parts(static_cast<std::size_t>(workers), PassStatistics(design.columns()));
     over_row_blocks(
-        rows.size(),
+        rows.size(), workers,
         [&](int w, std::size_t from, std::size_t to) {
           const Design& d = w == 0 ? design : copies[static_cast<std::size_t>(w - 1)];
           accumulate_rows(d, rows, from, to, floors, parts[static_cast<std::size_t>(w)]);

@@ -22,9 +22,10 @@ int row_block_workers(std::size_t rows) {
   return static_cast<int>(std::clamp<std::size_t>(blocks, 1, static_cast<std::size_t>(pass_threads())));
 }
 
-void over_row_blocks(std::size_t rows, const std::function<void(int worker, std::size_t from, std::size_t to)>& work,
+void over_row_blocks(std::size_t rows, int worker_count,
+                     const std::function<void(int worker, std::size_t from, std::size_t to)>& work,
                      const std::function<void(int worker)>& add) {
-  const auto workers = static_cast<std::size_t>(row_block_workers(rows));
+  const auto workers = static_cast<std::size_t>(std::max(1, worker_count));
   for (std::size_t first = 0; first < rows; first += workers * kRowBlock) {
     std::vector<std::exception_ptr> failed(workers);
     const auto run = [&](std::size_t w) {

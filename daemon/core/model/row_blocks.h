@@ -27,10 +27,12 @@ void set_pass_threads(int threads);
 [[nodiscard]] int row_block_workers(std::size_t rows);
 
 /// Calls work(worker, from, to) for every block [from, to) of kRowBlock rows of [0, rows),
-/// row_block_workers(rows) blocks at a time (worker 0 on the calling thread), and after
-/// each such round add(worker) for the round's blocks in block order. An exception from
-/// a block is rethrown once the round has ended (the earliest block's).
-void over_row_blocks(std::size_t rows, const std::function<void(int worker, std::size_t from, std::size_t to)>& work,
+/// `workers` blocks at a time (worker 0 on the calling thread; the caller holds each
+/// worker's state, sized by the same count: row_block_workers), and after each such round
+/// add(worker) for the round's blocks in block order. An exception from a block is
+/// rethrown once the round has ended (the earliest block's).
+void over_row_blocks(std::size_t rows, int workers,
+                     const std::function<void(int worker, std::size_t from, std::size_t to)>& work,
                      const std::function<void(int worker)>& add);
 
 }  // namespace resolver

@@ -31,10 +31,11 @@ TEST(RowBlocks, EveryRowOnceAndTheBlocksAddedInOrder) {
     const Threads use(threads);
     for (const std::size_t rows : {std::size_t{0}, std::size_t{1}, kRowBlock, kRowBlock + 1, 7 * kRowBlock / 2}) {
       std::vector<int> seen(rows, 0);
-      std::vector<std::size_t> from_of(static_cast<std::size_t>(row_block_workers(rows)));
+      const int workers = row_block_workers(rows);
+      std::vector<std::size_t> from_of(static_cast<std::size_t>(workers));
       std::vector<std::size_t> added;
       over_row_blocks(
-          rows,
+          rows, workers,
           [&](int w, std::size_t from, std::size_t to) {
             from_of[static_cast<std::size_t>(w)] = from;
             for (std::size_t i = from; i < to; ++i) ++seen[i];  // disjoint blocks: no two threads share a row
@@ -50,7 +51,7 @@ TEST(RowBlocks, EveryRowOnceAndTheBlocksAddedInOrder) {
 TEST(RowBlocks, ABlocksExceptionReachesTheCaller) {
   const Threads use(2);
   EXPECT_THROW(over_row_blocks(
-                   3 * kRowBlock,
+                   3 * kRowBlock, 2,
                    [](int, std::size_t from, std::size_t) {
                      if (from == kRowBlock) throw std::runtime_error("block 1");
                    },
