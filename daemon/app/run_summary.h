@@ -8,26 +8,9 @@
 #include <string>
 
 #include "daemon/core/estimation/sample_processor.h"
+#include "daemon/core/running_stats.h"
 
 namespace resolver {
-
-/// Welford running mean/variance.
-struct RunningStats {
-  std::int64_t n = 0;
-  double mean = 0.0;
-  double m2 = 0.0;
-  void add(double x) {
-    ++n;
-    const double d = x - mean;
-    mean += d / static_cast<double>(n);
-    m2 += d * (x - mean);
-  }
-  /// Standard deviation about the mean (= RMS with the mean removed).
-  [[nodiscard]] double stddev() const {
-    return n > 1 ? std::sqrt(m2 / static_cast<double>(n - 1)) : std::numeric_limits<double>::quiet_NaN();
-  }
-  [[nodiscard]] double value_or_nan() const { return n > 0 ? mean : std::numeric_limits<double>::quiet_NaN(); }
-};
 
 /// One error statistic and what it covers.
 struct ErrorStats {

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/running_stats.h"
 #include "daemon/core/model/normal_equations.h"
 
 namespace resolver {
@@ -179,24 +180,9 @@ std::vector<double> second_difference_floors(std::span<const FitRow> rows, doubl
   return out;
 }
 
-/// Running sums of one signal's values over some rows.
-struct Moments {
-  double sum = 0.0, sum2 = 0.0;
-  std::int64_t n = 0;
-  void add(double v) {
-    sum += v;
-    sum2 += v * v;
-    ++n;
-  }
-  [[nodiscard]] double mean() const { return n == 0 ? 0.0 : sum / static_cast<double>(n); }
-  [[nodiscard]] double variance() const {
-    return n < 2 ? 0.0 : std::max(0.0, sum2 - sum * sum / static_cast<double>(n)) / static_cast<double>(n - 1);
-  }
-};
-
 /// Each signal's moments over rows [from, to), outliers left out.
-std::array<Moments, kSigCount> moments(std::span<const FitRow> rows, std::size_t from, std::size_t to) {
-  std::array<Moments, kSigCount> m{};
+std::array<RunningStats, kSigCount> moments(std::span<const FitRow> rows, std::size_t from, std::size_t to) {
+  std::array<RunningStats, kSigCount> m{};
   for (std::size_t k = from; k < to; ++k) {
     if (rows[k].has(FitRow::kOutlier)) continue;
     for (int s = 0; s < kSigCount; ++s) {
@@ -215,13 +201,13 @@ std::array<Moments, kSigCount> moments(std::span<const FitRow> rows, std::size_t
 std::size_t settled_start(std::span<const FitRow> rows, std::size_t i, std::size_t j) {
   if (j - i < 4 * kSettleBlock) return i;
   const std::size_t half = i + (j - i) / 2;
-  const std::array<Moments, kSigCount> tail = moments(rows, half, j);
+  const std::array<RunningStats, kSigCount> tail = moments(rows, half, j);
   for (std::size_t b = i; b + kSettleBlock <= half; b += kSettleBlock) {
-    const std::array<Moments, kSigCount> block = moments(rows, b, b + kSettleBlock);
+    const std::array<RunningStats, kSigCount> block = moments(rows, b, b + kSettleBlock);
     bool settled = true;
     for (std::size_t s = 0; s < block.size(); ++s) {
       if (block[s].n < 2 || tail[s].n < 2) continue;
-      const double off = block[s].mean() - tail[s].mean();
+      const double off = block[s].mean - tail[s].mean;
       if (block[s].variance() + off * off > kSettleRatio * tail[s].variance()) settled = false;
     }
     if (settled) return b;
@@ -249,10 +235,10 @@ std::vector<double> standstill_floors(std::span<const FitRow> rows, double sampl
     while (j < rows.size() && still(j)) ++j;
     i = settled_start(rows, std::min(j, i + settling), j);
     if (j - i >= kMinStretch) {
-      const std::array<Moments, kSigCount> m = moments(rows, i, j);
+      const std::array<RunningStats, kSigCount> m = moments(rows, i, j);
       for (std::size_t s = 0; s < m.size(); ++s) {
         if (m[s].n < 2) continue;
-        ss[s] += m[s].variance() * static_cast<double>(m[s].n - 1);
+        ss[s] += m[s].m2;
         n[s] += m[s].n;
         ++stretches[s];
       }
