@@ -105,12 +105,19 @@ def drawn_share(browser, plot_id, series_index, colour):
     for k in range(len(spec["series"])):
         browser.evaluate(f"resolverReport.setShown('{plot_id}', {k}, {'true' if k == series_index else 'false'})")
     left, top, width, height = rect_of(browser, f"resolverReport.chart('{plot_id}').over", scroll=False)
-    browser.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
-    png = browser.call("Page.captureScreenshot", {
-        "format": "png", "captureBeyondViewport": True,
-        "clip": {"x": left, "y": top, "width": width, "height": height, "scale": 1}})["data"]
-    img = read_png(base64.b64decode(png))
-    inked = [any(near(img.pixel(x, y), colour) for y in range(img.height)) for x in range(img.width)]
+    # Two animation frames are not always enough on a loaded machine (CI with ctest -j2:
+    # once a series read 9 % drawn, 50 % alone): capture until two captures agree.
+    inked, img = None, None
+    for _ in range(6):
+        browser.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
+        png = browser.call("Page.captureScreenshot", {
+            "format": "png", "captureBeyondViewport": True,
+            "clip": {"x": left, "y": top, "width": width, "height": height, "scale": 1}})["data"]
+        img = read_png(base64.b64decode(png))
+        now = [any(near(img.pixel(x, y), colour) for y in range(img.height)) for x in range(img.width)]
+        if now == inked:
+            break
+        inked = now
     series = spec["series"][series_index]
     if series["mark"] == "band":
         xs = browser.evaluate(f"resolverReport.plots.find(p => p.id === '{plot_id}').series[{series_index}].x"
