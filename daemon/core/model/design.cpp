@@ -265,6 +265,18 @@ const Design::EnvelopeCache& Design::envelope() const {
   return envelope_;
 }
 
+const LoopCorrection& Design::loop_correction(const TrackingLoopParams& loop) const {
+  const EnvelopeCache& env = envelope();
+  for (const LoopCorrection& c : env.loops) {
+    if (c.loop()["omega_n"] == loop["omega_n"] && c.loop()["zeta"] == loop["zeta"]) return c;
+  }
+  // A fit point needs the model's loop and one moved per fitted loop parameter.
+  constexpr std::size_t kLoopsKept = 4;
+  if (envelope_.loops.size() >= kLoopsKept) envelope_.loops.erase(envelope_.loops.begin());
+  envelope_.loops.emplace_back(env.series, loop);
+  return envelope_.loops.back();
+}
+
 BasisTransform Design::transform(const SignatureRow& row, int part, std::size_t extra_term,
                                  const std::vector<double>* extra_values) const {
   BasisTransform tr;
@@ -288,6 +300,9 @@ SignalValues Design::predict_with(const SignatureRow& row, int part, AngleBasis&
   pred += envelope_override ? envelope_series(envelope_members(override_term, override_values, terms_.size()))
                                   .at(basis)
                             : envelope().series.at(basis);
+  // The converter's loop gain is the envelopes' radius: what its linear filter misses
+  // at real magnitudes (loop_correction.h).
+  if (basis.rd_filtered()) pred.rd += loop_correction(basis.transform().loop).at(basis);
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = override_values != nullptr && i == override_term;

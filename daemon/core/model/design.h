@@ -41,6 +41,7 @@
 #include "daemon/core/effects/effect.h"
 #include "daemon/core/model/envelope_spectrum.h"
 #include "daemon/core/model/fit_row.h"
+#include "daemon/core/model/loop_correction.h"
 #include "daemon/core/model/model_spec.h"
 
 namespace resolver {
@@ -153,8 +154,13 @@ class Design {
     std::vector<std::size_t> model_terms;  ///< indices of non-candidate envelope terms
     EnvelopeSeries series;                 ///< the model's e(phi), r(phi)
     std::vector<std::vector<EnvelopeSeries>> columns;  ///< [term][k]: d/d(param k), empty for other terms
+    /// The series' correction under each loop the rows were evaluated with (the model's,
+    /// and its numeric derivatives' moved ones), nodes filled as rows need them.
+    std::vector<LoopCorrection> loops;
   };
   const EnvelopeCache& envelope() const;
+  /// The model's envelope series' loop correction under `loop` (loop_correction.h).
+  [[nodiscard]] const LoopCorrection& loop_correction(const TrackingLoopParams& loop) const;
   [[nodiscard]] std::vector<EnvelopeMember> envelope_members(std::size_t override_term,
                                                              const std::vector<double>* override_values,
                                                              std::size_t with_candidate) const;
