@@ -185,7 +185,8 @@ std::string reason_of(const ModelTerm& t, const std::vector<ModelParameter>& par
   std::string vals;
   const std::string prefix = std::string(t.effect->name()) + ".";
   for (const ModelParameter& p : params) {
-    vals += (vals.empty() ? "" : ", ") + p.name.substr(prefix.size()) + " = " + num(p.value) + " +- " +
+    const bool own = p.name.starts_with(prefix);  // another term's parameter keeps its whole name
+    vals += (vals.empty() ? "" : ", ") + (own ? p.name.substr(prefix.size()) : p.name) + " = " + num(p.value) + " +- " +
             num(p.std_error, "%.2g");
   }
   return std::string(t.effect->physics()) + (one_step ? " (one linearised step: " : " (fit: ") + vals + ").";
@@ -308,6 +309,11 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     const ModelTerm& term = one.terms.front();
     ModelSpec with = fit.model.spec();
     with.add(term);
+    // A candidate of an effect the model has (a harmonic order beside the model's orders)
+    // joins that term (ModelSpec::add); any other is a term of its own, the last.
+    const bool own_term = with.terms.size() > fit.model.spec().terms.size();
+    std::size_t at = with.terms.size() - 1;
+    while (!own_term && with.terms[at].effect != term.effect) --at;
     // The model's terms start at its converged fit (their valleys chosen there, with
     // their other starts); the candidate's own parameters are started again, unless
     // the options settle it (a live window's refit starts where the last window's
@@ -315,17 +321,31 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     Model candidate_start(one, log.p_r, log.p);
     const bool warm = apply_start_values(options.start, candidate_start).front();
     std::vector<std::vector<double>> values = fit.model.values();
-    values.push_back(warm ? candidate_start.values().front() : std::vector<double>{});
+    if (own_term) {
+      values.push_back(warm ? candidate_start.values().front() : std::vector<double>{});
+    } else if (warm) {
+      const std::vector<double>& start = candidate_start.values().front();
+      for (int p : term.params) {
+        const auto i = static_cast<std::size_t>(p);
+        if (i < values[at].size() && i < start.size()) values[at][i] = start[i];
+      }
+    }
     Design dm(with, values, nuisances_for(log));
     dm.set_parts(log.part_count());
     std::vector<bool> settled(dm.terms().size(), true);
-    settled.back() = warm;
+    if (own_term) settled[at] = warm;
     const FitResult fr = fit_design(dm, log.rows, floors, 12, {}, settled);
     out.passes += fr.passes;
     if (!fr.ok) continue;
     c.refitted = true;
     score_candidate(c, fr.last, log.rd, base, floors, options);
-    c.params = term_params(dm, dm.terms().size() - 1, fr.last, false);
+    // The candidate's own parameters, by name (a joined term has the model's too).
+    c.params.clear();
+    for (const ModelParameter& q : term_params(dm, at, fr.last, false)) {
+      for (std::size_t k = 0; k < term.params.size(); ++k) {
+        if (q.name == term.param_name(k)) c.params.push_back(q);
+      }
+    }
     c.reason = reason_of(term, c.params);
   }
 }

@@ -38,21 +38,21 @@ double AngleBasis::loop_gain(double w) const { return tracking_loop_gain(transfo
 
 double AngleBasis::loop_phase(double w) const { return tracking_loop_phase(transform_.loop, w); }
 
-double AngleBasis::filtered(const Series& series, int k, double w, bool sine) const {
+double AngleBasis::filtered(const Series& series, int k, double w, double w_rate, bool sine) const {
   const double sk = series.sin_k(k), ck = series.cos_k(k);
   if (k == 0 || !rd_filtered()) return sine ? sk : ck;
-  const std::complex<double> h = tracking_loop_response(transform_.loop, w);
+  const std::complex<double> h = tracking_loop_response(transform_.loop, w, w_rate);
   // g sin(x + phi) = Re(h) sin x + Im(h) cos x;  g cos(x + phi) = Re(h) cos x - Im(h) sin x.
   return sine ? h.real() * sk + h.imag() * ck : h.real() * ck - h.imag() * sk;
 }
 
-double AngleBasis::rd_sin(int k) const { return filtered(env_, k, k * row_.omega, true); }
-double AngleBasis::rd_cos(int k) const { return filtered(env_, k, k * row_.omega, false); }
+double AngleBasis::rd_sin(int k) const { return filtered(env_, k, k * row_.omega, k * row_.accel, true); }
+double AngleBasis::rd_cos(int k) const { return filtered(env_, k, k * row_.omega, k * row_.accel, false); }
 double AngleBasis::rd_mech_sin(int n) const {
-  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), true);
+  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), n * row_.accel / static_cast<double>(row_.p_r), true);
 }
 double AngleBasis::rd_mech_cos(int n) const {
-  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), false);
+  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), n * row_.accel / static_cast<double>(row_.p_r), false);
 }
 double AngleBasis::env_sin(int k) const { return env_.sin_k(k); }
 double AngleBasis::env_cos(int k) const { return env_.cos_k(k); }

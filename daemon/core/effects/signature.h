@@ -140,10 +140,12 @@ class AngleBasis {
   /// sin / cos (n theta_m') of the mechanical angle the envelopes carry.
   [[nodiscard]] double env_mech_sin(int n) const;
   [[nodiscard]] double env_mech_cos(int n) const;
-  /// H(j k omega) of the R/D loop for order k of the resolver angle (1 without a loop):
+  /// H(j k omega) of the R/D loop for order k of the resolver angle (1 without a loop), its
+  /// frequency ramping at k accel (tracking_loop.h):
   /// rd_sin(k) = Re(H) env_sin(k) + Im(H) env_cos(k); rd_cos(k) = Re(H) env_cos(k) - Im(H) env_sin(k).
   [[nodiscard]] std::complex<double> rd_response(int k) const {
-    return k != 0 ? tracking_loop_response(transform_.loop, k * row_.omega) : std::complex<double>(1.0, 0.0);
+    return k != 0 ? tracking_loop_response(transform_.loop, k * row_.omega, k * row_.accel)
+                  : std::complex<double>(1.0, 0.0);
   }
   /// False when no tracking loop filters the R/D angle: rd_sin(k) == env_sin(k) then,
   /// and a caller summing both may compute one.
@@ -182,7 +184,7 @@ class AngleBasis {
     }
   };
   /// g sin(k a + phi) or g cos(k a + phi) with g e^{j phi} = H(j k w).
-  [[nodiscard]] double filtered(const Series& series, int k, double w, bool sine) const;
+  [[nodiscard]] double filtered(const Series& series, int k, double w, double w_rate, bool sine) const;
 
   SignatureRow row_;
   BasisTransform transform_;

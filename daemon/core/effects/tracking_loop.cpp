@@ -51,6 +51,20 @@ std::complex<double> tracking_loop_response(const TrackingLoopParams& config, do
   return {(a * c + b * b) * inv, (b * c - a * b) * inv};
 }
 
+std::complex<double> tracking_loop_response(const TrackingLoopParams& config, double omega, double omega_rate) {
+  const std::complex<double> h = tracking_loop_response(config, omega);
+  if (omega_rate == 0.0 || !tracking_loop_active(config)) return h;
+  // H = N / D, N = wn^2 + j b w, D = wn^2 - w^2 + j b w (b = 2 zeta wn); N'' = 0, D'' = -2:
+  // H' = (N' - H D') / D, H'' = -(2 H' D' + H D'') / D.
+  const double wn = config["omega_n"];
+  const double b = 2.0 * config["zeta"] * wn;
+  const std::complex<double> d(wn * wn - omega * omega, b * omega);
+  const std::complex<double> d1(-2.0 * omega, b);
+  const std::complex<double> h1 = (std::complex<double>(0.0, b) - h * d1) / d;
+  const std::complex<double> h2 = -(2.0 * h1 * d1 - 2.0 * h) / d;
+  return h - std::complex<double>(0.0, 0.5 * omega_rate) * h2;
+}
+
 double tracking_loop_gain(const TrackingLoopParams& config, double omega) {
   return std::abs(tracking_loop_response(config, omega));
 }

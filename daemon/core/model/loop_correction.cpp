@@ -29,11 +29,16 @@ int order_of(int j) { return j <= kGridPoints / 2 ? j : j - kGridPoints; }
 
 }  // namespace
 
-double LoopCorrectionSeries::at(const AngleBasis& basis) const {
+double LoopCorrectionSeries::at(const AngleBasis& basis, double lag) const {
   double out = 0.0;
   for (std::size_t n = 0; n < c_cos.size(); ++n) {
     const int k = static_cast<int>(n);
     out += c_cos[n] * basis.env_cos(k) + c_sin[n] * basis.env_sin(k);
+  }
+  if (lag == 0.0) return out;
+  for (std::size_t n = 0; n < g_cos.size(); ++n) {
+    const int k = static_cast<int>(n);
+    out += lag * (g_cos[n] * basis.env_cos(k) + g_sin[n] * basis.env_sin(k));
   }
   return out;
 }
@@ -63,53 +68,94 @@ LoopCorrection::LoopCorrection(const EnvelopeSeries& series, const TrackingLoopP
   spacing_ = kNodeWidth * std::min(loop["zeta"], 1.0) * loop["omega_n"] / (2.0 * highest);
 }
 
+namespace {
+
+/// Iterates the linear balance x = x0 - H [f x] (f pointwise on the grid, H diagonal in
+/// the orders) from x0 until no coefficient moves by kTolerance. Returns whether it converged.
+bool balance(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& x0, const std::vector<double>& f, Spectrum& x) {
+  const std::size_t n = h.size();
+  Spectrum grid(n), f_hat;
+  x = x0;
+  for (int it = 0; it < kMaxIterations; ++it) {
+    fft.inv(grid, x);  // the values on the grid (unscaled inverse of coefficients)
+    for (std::size_t j = 0; j < n; ++j) grid[j] = f[j] * grid[j].real();
+    fft.fwd(f_hat, grid);
+    double moved = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const std::complex<double> next = x0[j] - h[j] * f_hat[j] / static_cast<double>(n);
+      moved = std::max(moved, std::abs(next - x[j]));
+      x[j] = next;
+    }
+    if (moved < kTolerance) return true;
+  }
+  return false;
+}
+
+/// The real series of coefficients x (k >= 0: cos, sin), trailing orders below kKeepAbove dropped.
+void to_series(const Spectrum& x, std::vector<double>& cos_k, std::vector<double>& sin_k) {
+  const int half = static_cast<int>(x.size()) / 2;
+  cos_k.assign(static_cast<std::size_t>(half), 0.0);
+  sin_k.assign(static_cast<std::size_t>(half), 0.0);
+  for (int k = 0; k < half; ++k) {
+    const std::complex<double> c = x[static_cast<std::size_t>(k)];
+    cos_k[static_cast<std::size_t>(k)] = k == 0 ? c.real() : 2.0 * c.real();
+    sin_k[static_cast<std::size_t>(k)] = k == 0 ? 0.0 : -2.0 * c.imag();
+  }
+  std::size_t keep = cos_k.size();
+  while (keep > 0 && std::abs(cos_k[keep - 1]) + std::abs(sin_k[keep - 1]) < kKeepAbove) --keep;
+  cos_k.resize(keep);
+  sin_k.resize(keep);
+}
+
+}  // namespace
+
 LoopCorrectionSeries LoopCorrection::solve(double omega) const {
   LoopCorrectionSeries out;
   if (!active_) return out;
   constexpr int n = kGridPoints;
+  constexpr auto un = static_cast<std::size_t>(n);
   Eigen::FFT<double> fft;
   fft.SetFlag(Eigen::FFT<double>::Unscaled);
-  Spectrum h(n), grid(n), e_hat, d0(n), d(n), n_hat;
+  Spectrum h(un), grid(un), e_hat, d0(un), d(un);
   for (int j = 0; j < n; ++j) {
-    const int k = order_of(j);
-    h[static_cast<std::size_t>(j)] = j == n / 2 ? 0.0 : tracking_loop_response(loop_, k * omega);
+    h[static_cast<std::size_t>(j)] = j == n / 2 ? 0.0 : tracking_loop_response(loop_, order_of(j) * omega);
     grid[static_cast<std::size_t>(j)] = e_[static_cast<std::size_t>(j)];
   }
   fft.fwd(e_hat, grid);
-  for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) d0[j] = -(1.0 - h[j]) * e_hat[j] / double{n};
-  d = d0;
+  for (std::size_t j = 0; j < un; ++j) d0[j] = -(1.0 - h[j]) * e_hat[j] / double{n};
+  // D = D0 - H[N(D)], N(D) = (1 + r) sin D - D pointwise on the grid.
+  Spectrum n_hat;
   out.converged = false;
-  for (int it = 0; it < kMaxIterations; ++it) {
-    fft.inv(grid, d);  // D on the grid (unscaled inverse of coefficients: the values)
-    for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) {
+  d = d0;
+  for (int it = 0; it < kMaxIterations && !out.converged; ++it) {
+    fft.inv(grid, d);  // the values on the grid (unscaled inverse of coefficients)
+    for (std::size_t j = 0; j < un; ++j) {
       const double dj = grid[j].real();
       grid[j] = (1.0 + r_[j]) * std::sin(dj) - dj;
     }
     fft.fwd(n_hat, grid);
     double moved = 0.0;
-    for (std::size_t j = 0; j < static_cast<std::size_t>(n); ++j) {
-      n_hat[j] /= double{n};
-      const std::complex<double> next = d0[j] - h[j] * n_hat[j];
+    for (std::size_t j = 0; j < un; ++j) {
+      const std::complex<double> next = d0[j] - h[j] * n_hat[j] / double{n};
       moved = std::max(moved, std::abs(next - d[j]));
       d[j] = next;
     }
-    if (moved < kTolerance) {
-      out.converged = true;
-      break;
-    }
+    out.converged = moved < kTolerance;
   }
-  // c = -H N(D) (header), as cos / sin coefficients of the real series.
-  out.c_cos.assign(n / 2, 0.0);
-  out.c_sin.assign(n / 2, 0.0);
-  for (int k = 0; k < n / 2; ++k) {
-    const std::complex<double> c = -h[static_cast<std::size_t>(k)] * n_hat[static_cast<std::size_t>(k)];
-    out.c_cos[static_cast<std::size_t>(k)] = k == 0 ? c.real() : 2.0 * c.real();
-    out.c_sin[static_cast<std::size_t>(k)] = k == 0 ? 0.0 : -2.0 * c.imag();
-  }
-  std::size_t keep = out.c_cos.size();
-  while (keep > 0 && std::abs(out.c_cos[keep - 1]) + std::abs(out.c_sin[keep - 1]) < kKeepAbove) --keep;
-  out.c_cos.resize(keep);
-  out.c_sin.resize(keep);
+  // c = -H N(D) = D - D0 (header).
+  Spectrum c(un);
+  for (std::size_t j = 0; j < un; ++j) c[j] = d[j] - d0[j];
+  to_series(c, out.c_cos, out.c_sin);
+  // The acceleration lag L = a / wn^2 enters D0 as a constant: dD/dL = delta solves
+  // delta = 1 - H[N'(D) delta], N'(D) = (1 + r) cos D - 1, and dc/dL = delta - 1.
+  std::vector<double> f(un);
+  fft.inv(grid, d);
+  for (std::size_t j = 0; j < un; ++j) f[j] = (1.0 + r_[j]) * std::cos(grid[j].real()) - 1.0;
+  Spectrum one(un, 0.0), delta;
+  one[0] = 1.0;
+  out.converged = balance(fft, h, one, f, delta) && out.converged;
+  delta[0] -= 1.0;
+  to_series(delta, out.g_cos, out.g_sin);
   return out;
 }
 
@@ -126,8 +172,10 @@ double LoopCorrection::at(const AngleBasis& basis) const {
   const double below = std::floor(x);
   const double f = x - below;
   const auto i = static_cast<std::int64_t>(below);
-  const double a = node(i).at(basis);
-  return f == 0.0 ? a : (1.0 - f) * a + f * node(i + 1).at(basis);
+  // The loop's lag behind a constant acceleration (tracking_loop.h): a / wn^2.
+  const double lag = basis.row().accel / (loop_["omega_n"] * loop_["omega_n"]);
+  const double a = node(i).at(basis, lag);
+  return f == 0.0 ? a : (1.0 - f) * a + f * node(i + 1).at(basis, lag);
 }
 
 }  // namespace resolver

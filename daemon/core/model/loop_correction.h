@@ -32,8 +32,14 @@
 // (measured 1.6e-9), far below a 16-bit converter's quantization floor (2.8e-5 rad). loop_correction_test checks it against the exact nodes and the whole
 // prediction against the simulated loop (RK4 of the nonlinear detector).
 //
+// Under a constant acceleration a the loop lags by L = a / wn^2 (the loop effect's linear
+// term), which enters D as a constant: N(D) then carries r L, the radius ripple times the
+// lag (2.6e-6 rad at 2 theta on a 0-1500 r/min ramp in 1.5 s with a 15 % gain error, which
+// biased the quadrature by 6 standard errors). It is kept to first order in L (the rest is
+// r^2 L and L D^2: < 2e-7 rad at such a ramp): per node, dc/dL from delta = 1 - H[N'(D) delta].
+//
 // Left out: speed changes within the loop's settling time (quasi-static at the row's
-// speed; the acceleration lag stays the linear a / wn^2 of the loop's effect), and the
+// speed and acceleration), and the
 // radius and tracking error of effects that are not envelope effects (a delay's, an
 // eccentricity's: their tracking error times the radius ripple is second order in
 // two small effects).
@@ -53,11 +59,13 @@ namespace resolver {
 /// Node spacing as a share of the loop's narrowest feature the series reaches (header).
 inline constexpr double kNodeWidth = 0.02;
 
-/// The correction's Fourier series in phi at one speed: c_cos[n] cos(n phi) + c_sin[n] sin(n phi).
+/// The correction's Fourier series in phi at one speed, c_cos[n] cos(n phi) + c_sin[n] sin(n phi),
+/// and its derivative in the acceleration lag L = a / wn^2 (g_cos, g_sin; header).
 struct LoopCorrectionSeries {
-  std::vector<double> c_cos, c_sin;
+  std::vector<double> c_cos, c_sin, g_cos, g_sin;
   bool converged = true;  ///< the harmonic balance met its tolerance (|H| |r| < 1)
-  [[nodiscard]] double at(const AngleBasis& basis) const;
+  /// [rad] at the basis' envelope angle with lag `lag` [rad].
+  [[nodiscard]] double at(const AngleBasis& basis, double lag = 0.0) const;
 };
 
 class LoopCorrection {
