@@ -157,6 +157,29 @@ TEST(ModelDiscovery, OfflineACandidatesValueIsItsFit) {
   EXPECT_GT(std::abs(stepped.value - fit.value), 1.0 * fit.std_error) << "the step is already the fit";
 }
 
+// A candidate of an effect the model has (a harmonic order beside the model's orders) joins
+// the model's term when refitted: its value and reason are its own parameters, not the
+// design's last term's (they printed the loop's "oop.omega_n", and a model ending in delay
+// threw).
+TEST(ModelDiscovery, ARefittedCandidateBesideTheModelsTermNamesItsOwnParameters) {
+  const auto in = simulate({"amplitude_imbalance:alpha=0.003", "harmonics:k3=0.02,k5=0.004"},
+                           {{1.0, 0.0, 613.7}, {2.0, 613.7, 613.7}});  // not a whole number of samples per turn
+  DiscoveryOptions offline = offline_discovery_options();
+  offline.prepare.reference_aligned = true;
+  const std::vector<std::string> model{"amplitude_imbalance", "harmonics(k3,k3_q)", "tracking_loop"};
+  const Explanation ex = explain_model(in, model, offline);
+  const auto c = std::find_if(ex.candidates.begin(), ex.candidates.end(), [](const Candidate& x) {
+    return x.refitted && x.effect.starts_with("harmonics(k5");
+  });
+  ASSERT_NE(c, ex.candidates.end()) << ex.summary;
+  ASSERT_FALSE(c->params.empty());
+  for (const ModelParameter& p : c->params) {
+    EXPECT_TRUE(p.name.starts_with("harmonics.k5")) << p.name << " in " << c->effect;
+  }
+  EXPECT_EQ(c->reason.find("omega_n"), std::string::npos) << c->reason;
+  EXPECT_NEAR(c->params.front().value, 0.004, 4.0 * c->params.front().std_error) << c->reason;
+}
+
 TEST(ModelDiscovery, HiddenOffsetsAreNamedFirst) {
   const auto in = simulate({"amplitude_imbalance:alpha=0.003", "offsets:o_s=0.001,o_c=-0.0015"});
   const Explanation ex = explain_model(in, kDefault, kAligned);
