@@ -28,6 +28,7 @@ void AngleBasis::Series::grow(int k) const {
 void AngleBasis::set(const SignatureRow& row, const BasisTransform& transform) {
   row_ = row;
   transform_ = transform;
+  ++rows_set_;  // every order's response is computed again (rd_response)
   const double d = transform.delay;
   const double late = d != 0.0 ? row.theta_at(row.t - d) : row.theta;
   env_.reset(late + transform.shift);
@@ -46,8 +47,16 @@ double AngleBasis::filtered(const Series& series, int k, double w, double w_rate
   return sine ? h.real() * sk + h.imag() * ck : h.real() * ck - h.imag() * sk;
 }
 
-double AngleBasis::rd_sin(int k) const { return filtered(env_, k, k * row_.omega, k * row_.accel, true); }
-double AngleBasis::rd_cos(int k) const { return filtered(env_, k, k * row_.omega, k * row_.accel, false); }
+double AngleBasis::rd_sin(int k) const {
+  if (k == 0 || !rd_filtered()) return env_.sin_k(k);
+  const std::complex<double> h = rd_response(k);
+  return h.real() * env_.sin_k(k) + h.imag() * env_.cos_k(k);
+}
+double AngleBasis::rd_cos(int k) const {
+  if (k == 0 || !rd_filtered()) return env_.cos_k(k);
+  const std::complex<double> h = rd_response(k);
+  return h.real() * env_.cos_k(k) - h.imag() * env_.sin_k(k);
+}
 double AngleBasis::rd_mech_sin(int n) const {
   return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), n * row_.accel / static_cast<double>(row_.p_r), true);
 }

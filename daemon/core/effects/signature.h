@@ -23,8 +23,10 @@
 // The envelopes carry the delay but not the loop: env_sin(k) = sin(k (theta - omega d)).
 #pragma once
 
+#include <algorithm>
 #include <complex>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <span>
 #include <vector>
@@ -143,9 +145,15 @@ class AngleBasis {
   /// H(j k omega) of the R/D loop for order k of the resolver angle (1 without a loop), its
   /// frequency ramping at k accel (tracking_loop.h):
   /// rd_sin(k) = Re(H) env_sin(k) + Im(H) env_cos(k); rd_cos(k) = Re(H) env_cos(k) - Im(H) env_sin(k).
+  /// Each order's is computed once per row (a fit reads it for the prediction and for every
+  /// envelope column: a quarter of a fit's time with a loop in the model before).
   [[nodiscard]] std::complex<double> rd_response(int k) const {
-    return k != 0 ? tracking_loop_response(transform_.loop, k * row_.omega, k * row_.accel)
-                  : std::complex<double>(1.0, 0.0);
+    if (k == 0) return {1.0, 0.0};
+    const auto i = static_cast<std::size_t>(k);
+    if (i >= responses_.size()) responses_.resize(std::max<std::size_t>(i + 1, 2 * responses_.size() + 16));
+    Response& r = responses_[i];
+    if (r.row != rows_set_) r = {rows_set_, tracking_loop_response(transform_.loop, k * row_.omega, k * row_.accel)};
+    return r.h;
   }
   /// False when no tracking loop filters the R/D angle: rd_sin(k) == env_sin(k) then,
   /// and a caller summing both may compute one.
@@ -186,8 +194,16 @@ class AngleBasis {
   /// g sin(k a + phi) or g cos(k a + phi) with g e^{j phi} = H(j k w).
   [[nodiscard]] double filtered(const Series& series, int k, double w, double w_rate, bool sine) const;
 
+  /// rd_response(k) by k, valid for the row set as the `row`-th (set() counts them: no
+  /// clearing per row, which cost as much as the responses it kept).
+  struct Response {
+    std::uint64_t row = 0;
+    std::complex<double> h;
+  };
   SignatureRow row_;
   BasisTransform transform_;
+  std::uint64_t rows_set_ = 0;
+  mutable std::vector<Response> responses_;
   Series env_;   // theta - omega d
   Series mech_;  // theta_m - omega_m d
 };

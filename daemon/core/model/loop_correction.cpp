@@ -21,8 +21,6 @@ constexpr int kMaxIterations = 200;
 /// A coefficient of e or r below this [rad or 1] is not counted in the orders the
 /// correction reaches (it modulates nothing above 1e-12 rad).
 constexpr double kSignificant = 1e-9;
-/// Trailing orders of a node smaller than this [rad] are not kept.
-constexpr double kKeepAbove = 1e-15;
 
 /// The order of FFT bin j (0 .. N/2 - 1, then negative; the Nyquist bin is left out).
 int order_of(int j) { return j <= kGridPoints / 2 ? j : j - kGridPoints; }
@@ -31,14 +29,9 @@ int order_of(int j) { return j <= kGridPoints / 2 ? j : j - kGridPoints; }
 
 double LoopCorrectionSeries::at(const AngleBasis& basis, double lag) const {
   double out = 0.0;
-  for (std::size_t n = 0; n < c_cos.size(); ++n) {
-    const int k = static_cast<int>(n);
-    out += c_cos[n] * basis.env_cos(k) + c_sin[n] * basis.env_sin(k);
-  }
-  if (lag == 0.0) return out;
-  for (std::size_t n = 0; n < g_cos.size(); ++n) {
-    const int k = static_cast<int>(n);
-    out += lag * (g_cos[n] * basis.env_cos(k) + g_sin[n] * basis.env_sin(k));
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    const double c = basis.env_cos(k[i]), s = basis.env_sin(k[i]);
+    out += (c_cos[i] + lag * g_cos[i]) * c + (c_sin[i] + lag * g_sin[i]) * s;
   }
   return out;
 }
@@ -91,20 +84,22 @@ bool balance(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& x0, con
   return false;
 }
 
-/// The real series of coefficients x (k >= 0: cos, sin), trailing orders below kKeepAbove dropped.
-void to_series(const Spectrum& x, std::vector<double>& cos_k, std::vector<double>& sin_k) {
-  const int half = static_cast<int>(x.size()) / 2;
-  cos_k.assign(static_cast<std::size_t>(half), 0.0);
-  sin_k.assign(static_cast<std::size_t>(half), 0.0);
+/// The real series (k >= 0: cos, sin) of the coefficients c and g into `out`, orders where
+/// both are below kDropBelow left out.
+void to_series(const Spectrum& c, const Spectrum& g, LoopCorrectionSeries& out) {
+  const int half = static_cast<int>(c.size()) / 2;
   for (int k = 0; k < half; ++k) {
-    const std::complex<double> c = x[static_cast<std::size_t>(k)];
-    cos_k[static_cast<std::size_t>(k)] = k == 0 ? c.real() : 2.0 * c.real();
-    sin_k[static_cast<std::size_t>(k)] = k == 0 ? 0.0 : -2.0 * c.imag();
+    const std::complex<double> a = c[static_cast<std::size_t>(k)], b = g[static_cast<std::size_t>(k)];
+    const double w = k == 0 ? 1.0 : 2.0;
+    const double cc = w * a.real(), cs = k == 0 ? 0.0 : -2.0 * a.imag();
+    const double gc = w * b.real(), gs = k == 0 ? 0.0 : -2.0 * b.imag();
+    if (std::abs(cc) + std::abs(cs) + std::abs(gc) + std::abs(gs) <= kDropBelow) continue;
+    out.k.push_back(k);
+    out.c_cos.push_back(cc);
+    out.c_sin.push_back(cs);
+    out.g_cos.push_back(gc);
+    out.g_sin.push_back(gs);
   }
-  std::size_t keep = cos_k.size();
-  while (keep > 0 && std::abs(cos_k[keep - 1]) + std::abs(sin_k[keep - 1]) < kKeepAbove) --keep;
-  cos_k.resize(keep);
-  sin_k.resize(keep);
 }
 
 }  // namespace
@@ -145,7 +140,6 @@ LoopCorrectionSeries LoopCorrection::solve(double omega) const {
   // c = -H N(D) = D - D0 (header).
   Spectrum c(un);
   for (std::size_t j = 0; j < un; ++j) c[j] = d[j] - d0[j];
-  to_series(c, out.c_cos, out.c_sin);
   // The acceleration lag L = a / wn^2 enters D0 as a constant: dD/dL = delta solves
   // delta = 1 - H[N'(D) delta], N'(D) = (1 + r) cos D - 1, and dc/dL = delta - 1.
   std::vector<double> f(un);
@@ -155,7 +149,7 @@ LoopCorrectionSeries LoopCorrection::solve(double omega) const {
   one[0] = 1.0;
   out.converged = balance(fft, h, one, f, delta) && out.converged;
   delta[0] -= 1.0;
-  to_series(delta, out.g_cos, out.g_sin);
+  to_series(c, delta, out);
   return out;
 }
 

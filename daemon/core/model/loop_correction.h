@@ -62,6 +62,9 @@ inline constexpr double kNodeWidth = 0.02;
 /// The correction's Fourier series in phi at one speed, c_cos[n] cos(n phi) + c_sin[n] sin(n phi),
 /// and its derivative in the acceleration lag L = a / wn^2 (g_cos, g_sin; header).
 struct LoopCorrectionSeries {
+  /// The orders whose coefficients are not negligible (kDropBelow, envelope_spectrum.h) and
+  /// theirs; a zero where one of c and g has none.
+  std::vector<int> k;
   std::vector<double> c_cos, c_sin, g_cos, g_sin;
   bool converged = true;  ///< the harmonic balance met its tolerance (|H| |r| < 1)
   /// [rad] at the basis' envelope angle with lag `lag` [rad].
