@@ -17,6 +17,7 @@
 #include "daemon/core/model/design.h"
 #include "daemon/core/model/envelope_spectrum.h"
 #include "daemon/core/model/model_spec.h"
+#include "tests/unit/discovery/envelope_members.h"
 
 namespace resolver {
 namespace {
@@ -38,23 +39,8 @@ const std::vector<Setting>& settings() {
 }
 
 /// The members of the forward chain's envelope effects at the setting's values.
-struct Members {
-  ChainValues values;
-  std::vector<std::vector<double>> storage;
-  std::vector<EnvelopeMember> members;
-  explicit Members(const Setting& s) {
-    for (const std::string& spec : s.specs) values.apply_spec(spec);
-    for (const Effect* e : effect_registry()) {
-      if (!e->envelope_only() || !values.active(*e)) continue;
-      const Values v = values.of(*e);
-      storage.emplace_back(v.begin(), v.end());
-    }
-    std::size_t k = 0;
-    for (const Effect* e : effect_registry()) {
-      if (!e->envelope_only() || !values.active(*e)) continue;
-      members.push_back(EnvelopeMember{e, storage[k++]});
-    }
-  }
+struct Members : test::EnvelopeMembers {
+  explicit Members(const Setting& s) : EnvelopeMembers(s.specs) {}
 };
 
 /// The simulator's envelopes of the seen angle (forward_chain.h), as the truth.

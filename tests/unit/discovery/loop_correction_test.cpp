@@ -19,29 +19,12 @@
 #include "daemon/core/effects/tracking_loop.h"
 #include "daemon/core/model/envelope_spectrum.h"
 #include "daemon/core/model/loop_correction.h"
+#include "tests/unit/discovery/envelope_members.h"
 
 namespace resolver {
 namespace {
 
-/// The envelope effects of `specs` (resolver-sim style) as members, with their chain.
-struct Sensor {
-  ChainValues values;
-  std::vector<std::vector<double>> storage;
-  std::vector<EnvelopeMember> members;
-  explicit Sensor(const std::vector<std::string>& specs) {
-    for (const std::string& spec : specs) values.apply_spec(spec);
-    for (const Effect* e : effect_registry()) {
-      if (!e->envelope_only() || !values.active(*e)) continue;
-      const Values v = values.of(*e);
-      storage.emplace_back(v.begin(), v.end());
-    }
-    std::size_t k = 0;
-    for (const Effect* e : effect_registry()) {
-      if (!e->envelope_only() || !values.active(*e)) continue;
-      members.push_back(EnvelopeMember{e, storage[k++]});
-    }
-  }
-};
+using Sensor = test::EnvelopeMembers;
 
 /// [rad] prediction against simulation (ThePredictionIsTheSimulatedNonlinearLoopAtRealMagnitudes).
 constexpr double kAgrees = 5e-8;
