@@ -18,7 +18,15 @@ quantization error repeats with the angle and biases harmonics by several standa
   values    omega_n, alpha and beta within 4 standard errors of the truth (1 in 16,000 by
             chance);
   control   the same sensor read through an ideal converter (tracking_loop:omega_n=0): the
-            loop ends explained without tracking_loop (the correction invents no loop).
+            loop ends explained without tracking_loop (the correction invents no loop);
+  slow      a slow loop (omega_n 800 rad/s, zeta 0.5, a software observer's) whose
+            resonance the 2 theta ripple crosses at 1213.7 r/min, alpha 0.12: the true model
+            with zeta fitted reaches <= 1.2x its floor, omega_n and zeta within 0.1 % (the
+            ramp's second-order remainder, loop_correction_test: measured 0.01 %). Before the
+            start at 1000 rad/s (least_squares.cpp other_starts) it ended at 286 rad/s, 738x.
+            Not checked: the user's loop from the seed model, which names a mechanical
+            harmonic first here (a linearised step from an ideal converter cannot show a
+            resonant loop; docs/ACCURACY.md).
 """
 import argparse
 import json
@@ -91,6 +99,16 @@ def main():
     print(f"control, ideal converter: {refs}, {ex['verdict']}")
     if ex["verdict"] != "explained" or "tracking_loop" in refs:
         failures.append(f"control: the ideal converter's loop ended at {refs} ({ex['verdict']})")
+
+    slow = os.path.join(args.work, "slow_loop.log")
+    run([os.path.join(args.bin, "resolver-sim"), "--profile", "0:0.3,0-1213.7:1,1213.7:3", "--sample-rate", "10000",
+         "--seed", "5", "-e", "amplitude_imbalance:alpha=0.12", "-e", "tracking_loop:omega_n=800,zeta=0.5",
+         "--out", slow])
+    fit = explain(args, slow, ["amplitude_imbalance", "tracking_loop(omega_n,zeta)"])
+    wn, zeta = fit["params"]["tracking_loop.omega_n"]["value"], fit["params"]["tracking_loop.zeta"]["value"]
+    print(f"slow loop: omega_n {wn:.6g}, zeta {zeta:.6g}, worst {worst_ratio(fit):.2f}x the floor")
+    if worst_ratio(fit) > LIMIT or abs(wn / 800.0 - 1.0) > 1e-3 or abs(zeta / 0.5 - 1.0) > 1e-3:
+        failures.append(f"slow loop: omega_n {wn:.6g}, zeta {zeta:.6g}, {worst_ratio(fit):.2f}x its floor")
 
     for f in failures:
         print("FAIL:", f)

@@ -403,10 +403,12 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
 
 /// Other starting values of a model's nonlinear parameter, where its cost has more
 /// than one valley (the loop's |H| and the delay's phase wrap; the take-up of a play):
-/// a tracking loop at 30000, 3000 and 300 rad/s (z = 1 / omega_n^2), other parameters
+/// a tracking loop at 30000, 10000, 3000, 1000 and 300 rad/s (z = 1 / omega_n^2: a slow loop
+/// of 800 rad/s whose resonance the ripple crosses ended at 286 rad/s, 738x its floor, from
+/// the ladder without 1000), other parameters
 /// a thousandth of their range either side of the start.
 std::vector<double> other_starts(const ParamInfo& p, double start) {
-  if (p.scale == FitScale::kInverseSquare) return {3e4, 3e3, 3e2};
+  if (p.scale == FitScale::kInverseSquare) return {3e4, 1e4, 3e3, 1e3, 3e2};
   const double step = 1e-3 * (p.max - p.min);
   std::vector<double> out;
   for (double v : {start + step, start - step}) {
