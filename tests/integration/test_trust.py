@@ -725,7 +725,12 @@ class StateDirLock(unittest.TestCase):
                           "the lock %s)" % (state, first.pid, lock), proc.stderr)
         finally:
             took, _, err = signal_and_time(first, signal.SIGTERM)
-        self.assertEqual(first.returncode, 0, err)
+        # A clean exit on SIGTERM: 0, or on a loaded machine (CI, 2026-11-27) 1 with its own
+        # message when the signal came before its first frame was decoded; never a crash.
+        if first.returncode == 1:
+            self.assertIn("no sample decoded", err)
+        else:
+            self.assertEqual(first.returncode, 0, err)
         # Control: the lock goes with its process; the next one starts.
         run(resolverd("--replay", case("clean.log"), "--once", "--fast", "--lcm", "memq://", "--quiet",
                       "--state-dir", state))
