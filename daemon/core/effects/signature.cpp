@@ -58,10 +58,12 @@ double AngleBasis::rd_cos(int k) const {
   return h.real() * env_.cos_k(k) - h.imag() * env_.sin_k(k);
 }
 double AngleBasis::rd_mech_sin(int n) const {
-  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), n * row_.accel / static_cast<double>(row_.p_r), true);
+  const double p_r = row_.p_r;
+  return filtered(mech_, n, n * row_.omega / p_r, n * row_.accel / p_r, true);
 }
 double AngleBasis::rd_mech_cos(int n) const {
-  return filtered(mech_, n, n * row_.omega / static_cast<double>(row_.p_r), n * row_.accel / static_cast<double>(row_.p_r), false);
+  const double p_r = row_.p_r;
+  return filtered(mech_, n, n * row_.omega / p_r, n * row_.accel / p_r, false);
 }
 double AngleBasis::env_sin(int k) const { return env_.sin_k(k); }
 double AngleBasis::env_cos(int k) const { return env_.cos_k(k); }

@@ -67,15 +67,16 @@ LoopCorrection::LoopCorrection(const EnvelopeSeries& series, const TrackingLoopP
 
 namespace {
 
-/// Iterates the linear balance x = x0 - H [f x] (f pointwise on the grid, H diagonal in
+/// Iterates the balance x = x0 - H [F(x)] (F pointwise on the grid: F(j, x_j); H diagonal in
 /// the orders) from x0 until no coefficient moves by kTolerance. Returns whether it converged.
-bool balance(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& x0, const std::vector<double>& f, Spectrum& x) {
+template <typename Pointwise>
+bool balance(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& x0, Pointwise&& pointwise, Spectrum& x) {
   const std::size_t n = h.size();
   Spectrum grid(n), f_hat;
   x = x0;
   for (int it = 0; it < kMaxIterations; ++it) {
     fft.inv(grid, x);  // the values on the grid (unscaled inverse of coefficients)
-    for (std::size_t j = 0; j < n; ++j) grid[j] = f[j] * grid[j].real();
+    for (std::size_t j = 0; j < n; ++j) grid[j] = pointwise(j, grid[j].real());
     fft.fwd(f_hat, grid);
     double moved = 0.0;
     for (std::size_t j = 0; j < n; ++j) {
@@ -115,7 +116,7 @@ LoopCorrectionSeries LoopCorrection::solve(double omega) const {
   constexpr auto un = static_cast<std::size_t>(n);
   Eigen::FFT<double> fft;
   fft.SetFlag(Eigen::FFT<double>::Unscaled);
-  Spectrum h(un), grid(un), e_hat, d0(un), d(un);
+  Spectrum h(un), grid(un), e_hat, d0(un), d;
   for (int j = 0; j < n; ++j) {
     h[static_cast<std::size_t>(j)] = j == n / 2 ? 0.0 : tracking_loop_response(loop_, order_of(j) * omega);
     grid[static_cast<std::size_t>(j)] = e_[static_cast<std::size_t>(j)];
@@ -123,35 +124,18 @@ LoopCorrectionSeries LoopCorrection::solve(double omega) const {
   fft.fwd(e_hat, grid);
   for (std::size_t j = 0; j < un; ++j) d0[j] = -(1.0 - h[j]) * e_hat[j] / double{n};
   // D = D0 - H[N(D)], N(D) = (1 + r) sin D - D pointwise on the grid.
-  Spectrum n_hat;
-  out.converged = false;
-  d = d0;
-  for (int it = 0; it < kMaxIterations && !out.converged; ++it) {
-    fft.inv(grid, d);  // the values on the grid (unscaled inverse of coefficients)
-    for (std::size_t j = 0; j < un; ++j) {
-      const double dj = grid[j].real();
-      grid[j] = (1.0 + r_[j]) * std::sin(dj) - dj;
-    }
-    fft.fwd(n_hat, grid);
-    double moved = 0.0;
-    for (std::size_t j = 0; j < un; ++j) {
-      const std::complex<double> next = d0[j] - h[j] * n_hat[j] / double{n};
-      moved = std::max(moved, std::abs(next - d[j]));
-      d[j] = next;
-    }
-    out.converged = moved < kTolerance;
-  }
+  out.converged = balance(fft, h, d0, [&](std::size_t j, double dj) { return (1.0 + r_[j]) * std::sin(dj) - dj; }, d);
   // c = -H N(D) = D - D0 (header).
   Spectrum c(un);
   for (std::size_t j = 0; j < un; ++j) c[j] = d[j] - d0[j];
   // The acceleration lag L = a / wn^2 enters D0 as a constant: dD/dL = delta solves
   // delta = 1 - H[N'(D) delta], N'(D) = (1 + r) cos D - 1, and dc/dL = delta - 1.
-  std::vector<double> f(un);
+  std::vector<double> slope(un);
   fft.inv(grid, d);
-  for (std::size_t j = 0; j < un; ++j) f[j] = (1.0 + r_[j]) * std::cos(grid[j].real()) - 1.0;
+  for (std::size_t j = 0; j < un; ++j) slope[j] = (1.0 + r_[j]) * std::cos(grid[j].real()) - 1.0;
   Spectrum one(un, 0.0), delta;
   one[0] = 1.0;
-  out.converged = balance(fft, h, one, f, delta) && out.converged;
+  out.converged = balance(fft, h, one, [&](std::size_t j, double x) { return slope[j] * x; }, delta) && out.converged;
   delta[0] -= 1.0;
   to_series(c, delta, out);
   return out;
