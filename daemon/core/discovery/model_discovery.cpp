@@ -1,6 +1,7 @@
 #include "daemon/core/discovery/model_discovery.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -361,7 +362,17 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   ++f.passes;
   const StepSolution& s = fr.last;
   fill_params(f, d, parameter_covariance(s, pass, cols, f));
-  const std::vector<std::string> convergence_notes = signal_residuals(log, fr, pass, raw_sol, floors, cols, f);
+  std::vector<std::string> convergence_notes = signal_residuals(log, fr, pass, raw_sol, floors, cols, f);
+  if (const std::int64_t n = d.loop_balance_unconverged(log.rows); n > 0) {
+    // The prediction at those rows is the balance's last iterate, not the loop's steady
+    // state (loop_correction.h): whatever the residual, it is no evidence for the model.
+    f.converged = false;
+    convergence_notes.push_back(fmt::format(
+        "r/d: the converter's loop has no steady state the model can compute at {} of the fitted rows: the "
+        "envelopes' radius (the loop's gain) swings too far near the loop's resonance (|H| |r| >= 1); the "
+        "R/D prediction there is not converged",
+        n));
+  }
   f.residual_rms_rad = f.signals.empty() ? 0.0 : f.signals.front().rms;
   f.noise_floor_rad = f.signals.empty() ? 0.0 : f.signals.front().floor;
   take_breakdowns(pass, f);

@@ -277,6 +277,16 @@ const LoopCorrection& Design::loop_correction(const TrackingLoopParams& loop) co
   return envelope_.loops.back();
 }
 
+std::int64_t Design::loop_balance_unconverged(std::span<const FitRow> rows) const {
+  std::int64_t out = 0;
+  for (const FitRow& r : rows) {
+    if (!r.fitted() || !r.has(FitRow::kHasRd)) continue;
+    const TrackingLoopParams loop = transform(r.sig, r.part, terms_.size(), nullptr).loop;
+    if (tracking_loop_active(loop) && !loop_correction(loop).converged_at(r.sig.omega)) ++out;
+  }
+  return out;
+}
+
 BasisTransform Design::transform(const SignatureRow& row, int part, std::size_t extra_term,
                                  const std::vector<double>* extra_values) const {
   BasisTransform tr;

@@ -34,6 +34,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -122,6 +123,11 @@ class Design {
   [[nodiscard]] bool pushed_past_bound(int col, double dz) const;
   /// Moves one column's coordinate only (numeric derivatives).
   [[nodiscard]] std::vector<double> values_with(std::size_t term, int column_in_term, double dz) const;
+
+  /// How many of `rows` (fitted, with an R/D angle) take the loop correction at a speed
+  /// where its harmonic balance did not converge (loop_correction.h: the envelopes'
+  /// radius swings too far for the loop's steady state); 0 without a loop.
+  [[nodiscard]] std::int64_t loop_balance_unconverged(std::span<const FitRow> rows) const;
 
   /// Evaluates one row: the prediction of every signal (model terms) and the
   /// Jacobian rows of every column. `basis` is scratch.

@@ -22,7 +22,12 @@
 // tracking error, filtered. It is solved by harmonic balance: on kGridPoints angles,
 // D's Fourier coefficients are iterated (H is diagonal in the orders, N is pointwise)
 // until they move by less than 1e-15 rad; the contraction factor is about |H| |r|
-// (0.1 at a 15 % gain error), so ~15 iterations.
+// (0.1 at a 15 % gain error), so ~15 iterations. A lightly damped loop (zeta <~ 0.05 at
+// gain errors >~ 10 %) amplifies the orders the ripple couples near its resonance and the
+// iteration diverges there; Newton's method on the grid then solves the same equations
+// (loop_correction.cpp newton). Where that fails too (the catalog's extremes: zeta 0.01,
+// a 50 % gain error, the ripple at the resonance) the loop has no periodic steady state:
+// the correction is left out, the node says so, and the fit is not called converged.
 //
 // c depends on the speed through H(j k w): it is solved at speed nodes spaced
 // kNodeWidth of the narrowest loop feature the series reaches (zeta wn / order) and
@@ -66,7 +71,7 @@ struct LoopCorrectionSeries {
   /// theirs; a zero where one of c and g has none.
   std::vector<int> k;
   std::vector<double> c_cos, c_sin, g_cos, g_sin;
-  bool converged = true;  ///< the harmonic balance met its tolerance (|H| |r| < 1)
+  bool converged = true;  ///< a periodic steady state was found (else no correction: header)
   /// [rad] at the basis' envelope angle with lag `lag` [rad].
   [[nodiscard]] double at(const AngleBasis& basis, double lag = 0.0) const;
 };
@@ -82,6 +87,10 @@ class LoopCorrection {
   [[nodiscard]] double at(const AngleBasis& basis) const;
   /// The harmonic balance at speed `omega` [rad/s, resolver electrical], exactly.
   [[nodiscard]] LoopCorrectionSeries solve(double omega) const;
+  /// Whether the balance converged at the nodes `at` interpolates for a row at speed
+  /// `omega` (not: |H| |r| >= 1, the last iterate is no steady state; model_discovery
+  /// says so and does not call such a fit explained).
+  [[nodiscard]] bool converged_at(double omega) const;
   /// [rad/s] spacing of the speed nodes.
   [[nodiscard]] double spacing() const { return spacing_; }
 

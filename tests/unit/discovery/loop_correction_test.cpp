@@ -17,8 +17,10 @@
 #include "daemon/core/effects/forward_chain.h"
 #include "daemon/core/effects/registry.h"
 #include "daemon/core/effects/tracking_loop.h"
+#include "daemon/core/model/design.h"
 #include "daemon/core/model/envelope_spectrum.h"
 #include "daemon/core/model/loop_correction.h"
+#include "daemon/core/model/model_spec.h"
 #include "tests/unit/discovery/envelope_members.h"
 
 namespace resolver {
@@ -195,6 +197,62 @@ TEST(LoopCorrection, BetweenNodesIsTheExactBalanceToFarBelowAFloor) {
   // The header's bound: (spacing / width)^2 / 8 = 5e-5 of the largest correction
   // (2e-7 rad here; measured 1.6e-9 at most).
   for (const auto& [interpolated, exact] : pairs) EXPECT_NEAR(interpolated, exact, 5e-5 * largest);
+}
+
+TEST(LoopCorrection, ALightlyDampedLoopWhereTheBalanceDoesNotContract) {
+  // zeta 0.02 and a 15 % gain error: near the resonance |H| ~ 25 and the radius ripple
+  // couples the orders around it, so the plain iteration diverges (before the Newton
+  // fallback, at 145 of 279 speeds from 20 to 5000 rad/s: a prediction of 0.67 rad at
+  // 100 rad/s where the simulated loop is within 6e-5 rad of the linear filter's). At a
+  // twentieth of wn, at the 2 theta ripple's resonance (the simulated loop's tracking error
+  // ~1 rad) and just below wn.
+  const TrackingLoopParams loop = loop_of(2000.0, 0.02);
+  const Sensor s({"amplitude_imbalance:alpha=0.15"});
+  const LoopCorrection correction(envelope_series(s.members), loop);
+  for (double w : {100.0, 700.0, 1978.2}) {
+    EXPECT_TRUE(correction.converged_at(w)) << "w=" << w;
+    EXPECT_LT(worst_miss(s, loop, w, true), kAgrees) << "w=" << w;
+    // The control: the linear filter alone misses by more than a 16-bit floor there.
+    EXPECT_GT(worst_miss(s, loop, w, false), 2.8e-5) << "w=" << w;
+  }
+}
+
+TEST(LoopCorrection, SaysWhereTheLoopHasNoSteadyState) {
+  // The catalog's extremes, zeta 0.01 and a 50 % gain error, with the 2 theta ripple just
+  // below the resonance: the simulated loop's error leaves the linear prediction by 1.1 rad
+  // and no periodic solution is found. The correction is then none (the linear filter's
+  // prediction, never a diverged iterate) and said to be unconverged.
+  const TrackingLoopParams loop = loop_of(2000.0, 0.01);
+  const Sensor s({"amplitude_imbalance:alpha=0.5"});
+  const LoopCorrection correction(envelope_series(s.members), loop);
+  const LoopCorrectionSeries at_resonance = correction.solve(944.027);
+  EXPECT_FALSE(at_resonance.converged);
+  EXPECT_TRUE(at_resonance.k.empty());
+  EXPECT_FALSE(correction.converged_at(944.027));
+  // The control: a little further from it the balance has its steady state (the
+  // simulated loop within 1.5e-7 rad of it).
+  EXPECT_TRUE(correction.converged_at(900.0));
+}
+
+TEST(LoopCorrection, TheDesignCountsTheRowsWithoutASteadyState) {
+  // What model_discovery turns into a note and "not converged" (never explained).
+  const ModelSpec spec = ModelSpec::parse(std::vector<std::string>{"amplitude_imbalance", "tracking_loop"});
+  const Design d(spec, {{0.5}, {2000.0, 0.01}}, {});
+  const auto rows_at = [](double omega) {
+    std::vector<FitRow> rows(10);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      rows[i].sig.theta = 0.3 * static_cast<double>(i);
+      rows[i].sig.omega = omega;
+      rows[i].flags = FitRow::kHasRd | FitRow::kMoving;
+    }
+    return rows;
+  };
+  EXPECT_EQ(d.loop_balance_unconverged(rows_at(944.027)), 10);
+  EXPECT_EQ(d.loop_balance_unconverged(rows_at(900.0)), 0);
+  // Rows without an R/D angle take no correction.
+  std::vector<FitRow> sincos_only = rows_at(944.027);
+  for (FitRow& r : sincos_only) r.flags = FitRow::kHasSc | FitRow::kMoving;
+  EXPECT_EQ(d.loop_balance_unconverged(sincos_only), 0);
 }
 
 TEST(LoopCorrection, NothingWithoutALoopOrWithoutEnvelopeErrors) {
