@@ -74,6 +74,43 @@ void fill_params(ModelFit& f, const Design& d, const Eigen::MatrixXd& cov) {
   f.model.set_standard_errors(ses);
 }
 
+/// Terms of the model whose every fitted parameter lies within 2 standard errors of its
+/// neutral value (a phase aside: it has none), as one note; "" when none. A term the
+/// user's loop added earlier that a later one made redundant (a mechanical 6th harmonic
+/// standing in for the loop's 2 theta lag without sin/cos: 1.3e-8 +- 8.7e-8 rad once the
+/// loop was in) otherwise sat in an "explained" model unremarked.
+std::string unsupported_terms_note(const Design& d, const ModelFit& f) {
+  constexpr double kSupportedFrom = 2.0;  // standard errors: 1 in 22 by chance
+  std::vector<std::string> unsupported, values;
+  std::size_t at = 0, model_term = 0;
+  for (const DesignTerm& t : d.terms()) {
+    if (t.candidate) continue;
+    const auto ps = t.effect->params();
+    bool supported = false, checked = false;
+    std::vector<std::string> these;
+    for (std::size_t k = 0; k < t.params.size(); ++k, ++at) {
+      const ParamInfo& info = ps[static_cast<std::size_t>(t.params[k])];
+      const ModelParameter& p = f.params[at];
+      if (info.polar == Polar::kPhase) continue;
+      if (!(std::isfinite(p.std_error) && p.std_error > 0.0)) supported = true;  // said elsewhere
+      checked = true;
+      if (std::abs(p.value - info.neutral) >= kSupportedFrom * p.std_error) supported = true;
+      these.push_back(fmt::format("{} = {:.3g} +- {:.2g}", info.name, p.value, p.std_error));
+    }
+    if (checked && !supported) {
+      unsupported.push_back(model_term < f.effects.size() ? f.effects[model_term] : std::string(t.effect->name()));
+      values.push_back(fmt::format("{}", fmt::join(these, ", ")));
+    }
+    ++model_term;
+  }
+  if (unsupported.empty()) return {};
+  return fmt::format("{} {} within {:g} standard errors of doing nothing ({}): this log does not support {}; the "
+                     "model without {} may fit as well",
+                     fmt::join(unsupported, ", "), unsupported.size() == 1 ? "is" : "are", kSupportedFrom,
+                     fmt::join(values, "; "), unsupported.size() == 1 ? "it" : "them",
+                     unsupported.size() == 1 ? "it" : "them");
+}
+
 /// A custom term that is inf or nan on most of this log's rows leaves its
 /// coefficient nothing to fit: says so, naming the block and the term, instead of
 /// "not separable". (A term inf or nan everywhere is refused at load, custom_effect.h.)
@@ -388,6 +425,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   f.currents_used = log.currents;
   f.notes = log.notes;
   f.notes.insert(f.notes.end(), convergence_notes.begin(), convergence_notes.end());
+  if (std::string n = unsupported_terms_note(d, f); !n.empty()) f.notes.push_back(std::move(n));
   // Faulty signals for a large part of the log (a dead excitation, a lost channel,
   // clipping, a lost track): a fit at the floor on them is no evidence.
   f.untrusted = !options.untrusted_input.empty();

@@ -460,8 +460,17 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
                                   (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));
       continue;
     }
+    // Without sin/cos a pair whose columns the R/D angle cannot separate keeps its better
+    // one (solve_candidate): harmonics and harmonics(k3,k3_q) can both become
+    // harmonics(k3_q). Listed twice, such a term took two of the exact refits' places
+    // and pushed the third candidate (the true one, a tracking loop) out of them.
+    const std::string reference = terms[i].reference();
+    if (std::any_of(out.candidates.begin(), out.candidates.end(),
+                    [&](const Candidate& o) { return o.effect == reference; })) {
+      continue;
+    }
     Candidate c;
-    c.effect = terms[i].reference();
+    c.effect = reference;
     c.family = is_family(terms[i]);
     score_candidate(c, s, log.rd, base, floors, options);
     c.params = term_params(d, term, s, true);
