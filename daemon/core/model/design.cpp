@@ -53,6 +53,9 @@ std::vector<double> neutral_values(const Effect& e) {
   return v;
 }
 
+/// The largest factor a positive nonlinear parameter moves by in one step (Design::step).
+constexpr double kScaleStep = 2.0;
+
 /// Finite-difference step of a nonlinear parameter's internal coordinate z.
 double fd_step(const ParamInfo& p, double z) {
   if (p.scale == FitScale::kInverseSquare) {
@@ -173,7 +176,15 @@ void Design::step(const Eigen::VectorXd& dz) {
       } else {
         double z = z0[col] + dz[col];
         if (ps[p].nonlinear && ps[p].scale == FitScale::kInverseSquare) z = std::max(z, 0.0);
-        t.values[p] = std::clamp(from_internal(ps[p], z), ps[p].min, ps[p].max);
+        double v = from_internal(ps[p], z);
+        if (ps[p].nonlinear && ps[p].scale == FitScale::kLinear && ps[p].min > 0.0) {
+          // A positive scale parameter (a loop's damping ratio: the resonance peak goes as
+          // 1 / (2 zeta)) moves by at most a factor kScaleStep per step: linearised at 0.7,
+          // a lightly damped loop's (0.05) first step went to the bound 0.01, where the
+          // balance has no steady state and the columns no longer separate.
+          v = std::clamp(v, t.values[p] / kScaleStep, t.values[p] * kScaleStep);
+        }
+        t.values[p] = std::clamp(v, ps[p].min, ps[p].max);
       }
     }
   }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "daemon/core/model/row_blocks.h"
 
@@ -300,6 +301,11 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   double cost = std::numeric_limits<double>::infinity();
   Design last_good = design;
   PassStatistics good_stats(design.columns());  // at last_good: a step back costs no pass
+  // The point the last step left, its statistics and cost: where a step that lands
+  // where the columns cannot be solved goes back to.
+  std::optional<Design> before_step;
+  PassStatistics before_stats(design.columns());
+  double before_cost = cost;
   bool back = false;
   for (int pass = 0; pass < max_passes; ++pass) {
     PassStatistics stats(design.columns());
@@ -346,6 +352,20 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     if (sol.ok && std::erase_if(cols, [&](int c) { return design.pushed_past_bound(c, sol.dz[c]); }) > 0) {
       sol = solve_step(stats.all, floors, cols, lambda);
     }
+    if (!sol.ok && before_step && !back) {
+      // The last step landed where the columns cannot be solved: a lightly damped loop's
+      // zeta stepped from 0.7 to its bound 0.01 in one go (where zeta and omega_n no longer
+      // separate), and every start ended "not separable". Back to the point it left, damped
+      // like an uphill step.
+      design = *before_step;
+      last_good = *before_step;
+      good_stats = before_stats;
+      cost = before_cost;
+      lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
+      back = true;
+      before_step.reset();
+      continue;
+    }
     if (!sol.ok) {
       out.last = sol;
       out.stats = std::move(stats);
@@ -371,6 +391,9 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       }
     }
     out.last = sol;
+    before_step = design;
+    before_stats = stats;
+    before_cost = here;
     out.stats = std::move(stats);
     design.step(sol.dz);
     shift_frames(design, zero_cols, sol.dz);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <Eigen/Dense>
 #include <unsupported/Eigen/FFT>
@@ -22,6 +23,8 @@ constexpr int kMaxIterations = 200;
 /// A coefficient of e or r below this [rad or 1] is not counted in the orders the
 /// correction reaches (it modulates nothing above 1e-12 rad).
 constexpr double kSignificant = 1e-9;
+/// The iteration is taken as diverging when a coefficient moves by this much [rad].
+constexpr double kDiverged = 1.0;
 /// Newton's method (newton below) stops when no grid value of D moves by more than this
 /// [rad] (it converges quadratically: the step after is at rounding).
 constexpr double kNewtonTolerance = 1e-13;
@@ -89,6 +92,9 @@ bool balance(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& x0, Poi
       x[j] = next;
     }
     if (moved < kTolerance) return true;
+    // A tracking error moving by a radian per iteration is diverging (|H| |r| > 1 near a
+    // resonance): Newton's turn, without 200 iterations on ever larger arguments of sin.
+    if (!(moved < kDiverged)) return false;
   }
   return false;
 }
@@ -107,7 +113,7 @@ bool balance(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& x0, Poi
 bool newton(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& d0, const std::array<double, kGridPoints>& r,
             Spectrum& d, Spectrum& delta) {
   constexpr int n = kGridPoints;
-  constexpr int kMaxSteps = 40;
+  constexpr int kMaxSteps = 30;
   Spectrum grid;
   fft.inv(grid, h);  // the impulse response (times n: the inverse is unscaled)
   Eigen::MatrixXd circulant(n, n);
@@ -121,6 +127,7 @@ bool newton(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& d0, cons
   Eigen::VectorXd nonlinear(n), slope(n);
   Eigen::MatrixXd jacobian(n, n);
   bool converged = false;
+  double last_size = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxSteps && !converged; ++step) {
     for (int j = 0; j < n; ++j) {
       const double one_plus_r = 1.0 + r[static_cast<std::size_t>(j)];
@@ -130,9 +137,14 @@ bool newton(Eigen::FFT<double>& fft, const Spectrum& h, const Spectrum& d0, cons
     jacobian = circulant * slope.asDiagonal();
     jacobian.diagonal().array() += 1.0;
     const Eigen::VectorXd dx = jacobian.partialPivLu().solve(-(x - base + circulant * nonlinear));
-    if (!dx.allFinite()) return false;
+    // No steady state near: a step of half a turn (the loop would slip a cycle), or one no
+    // smaller than the last once past the start (where it converges, quadratically, each
+    // step is far smaller than the last), ends it.
+    const double size = dx.cwiseAbs().maxCoeff();
+    if (!(size < std::numbers::pi) || (step >= 10 && size >= last_size)) return false;
+    last_size = size;
     x += dx;
-    converged = dx.cwiseAbs().maxCoeff() < kNewtonTolerance;
+    converged = size < kNewtonTolerance;
   }
   if (!converged || x.cwiseAbs().maxCoeff() > std::numbers::pi) return false;
   for (int j = 0; j < n; ++j) slope[j] = (1.0 + r[static_cast<std::size_t>(j)]) * std::cos(x[j]) - 1.0;

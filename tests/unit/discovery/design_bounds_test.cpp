@@ -34,5 +34,23 @@ TEST(DesignBounds, TheIdealConverterHoldsAgainstAFasterThanIdealStep) {
   EXPECT_FALSE(d.pushed_past_bound(col, +1e-9));
 }
 
+TEST(DesignBounds, ADampingRatioMovesByAtMostAFactorTwoPerStep) {
+  // Linearised at 0.7 a lightly damped loop's (0.05) first step asked for zeta 0.01, the
+  // bound, where the balance has no steady state (design.cpp kScaleStep).
+  const ModelSpec spec = ModelSpec::parse(std::vector<std::string>{"tracking_loop(omega_n,zeta)"});
+  Design d(spec, {{2000.0, 0.7}}, {});
+  Eigen::VectorXd dz = Eigen::VectorXd::Zero(d.columns());
+  dz[d.term_column(0) + 1] = -0.69;
+  d.step(dz);
+  EXPECT_DOUBLE_EQ(d.terms()[0].values[1], 0.35);
+  dz[d.term_column(0) + 1] = +5.0;
+  d.step(dz);
+  EXPECT_DOUBLE_EQ(d.terms()[0].values[1], 0.7);
+  // The control: a step within the factor is taken as it is.
+  dz[d.term_column(0) + 1] = -0.2;
+  d.step(dz);
+  EXPECT_DOUBLE_EQ(d.terms()[0].values[1], 0.5);
+}
+
 }  // namespace
 }  // namespace resolver
