@@ -187,6 +187,10 @@ double cost_at(const PassStatistics& s, const GroupFloors& floors, std::span<con
 /// [rad] a change of the frame shift that no longer matters: it turns a harmonic error
 /// of 0.1 rad by 1e-8 rad, far below any floor (a 24-bit converter's LSB is 3.7e-7).
 constexpr double kShiftSettled = 1e-7;
+/// Levenberg-Marquardt damping on the scaled normal equations' unit diagonal: the first
+/// after an uphill step, and the last tried before the last good point is the answer.
+constexpr double kFirstDamping = 1.0;
+constexpr double kLastDamping = 100.0;
 
 /// The columns of the position-error constant the frame shift follows, one per
 /// pooled part (design.h): the sin/cos angle's where the log has it (the windings'
@@ -322,21 +326,26 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     const double tolerance = 1e-9 * here + 1e-6;
     if (!back && here > cost + tolerance) {
       // The last step made it worse (nonlinear): go back and damp. When the damped
-      // step goes uphill too, the last good point is the answer, never an uphill one
+      // steps go uphill too, the last good point is the answer, never an uphill one
       // (a tracking loop once ended at omega_n = 14 rad/s, 364x the floor, from an
-      // ideal converter at 1x). It ends there at once: from the same point and
-      // statistics the schedule below (x10 back, /10 on the point's statistics) would
-      // try that same step again; a refit near its solution once spent 10 of its 12
-      // passes so and ended at the last good point all the same.
+      // ideal converter at 1x). The damping is added to the unit diagonal of the scaled
+      // normal equations: the first damped step takes 1 (about half the step where the
+      // columns are well apart, far less along nearly collinear ones), the second 100;
+      // then it ends (a refit near its solution once spent 10 of its 12 passes on damped
+      // steps and ended at the last good point all the same). It took 1e-4 first, which
+      // is no damping: the same step again, uphill, and the fit ended at its start (a
+      // slow loop's omega_n and zeta fitted together stayed at the start values, 247x
+      // the floor).
       design = last_good;
-      if (lambda > 0.0) {
+      if (lambda >= kLastDamping) {
         out.last = solve_step(good_stats.all, floors, model_cols, 0.0);
         out.stats = std::move(good_stats);
         out.cost = cost;
         out.ok = out.last.ok;
         return out;
       }
-      lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
+      // Used after the /10 below: 1, then 100.
+      lambda = lambda < kFirstDamping ? 10.0 * kFirstDamping : lambda * 1000.0;
       back = true;
       continue;
     }
@@ -361,7 +370,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       last_good = *before_step;
       good_stats = before_stats;
       cost = before_cost;
-      lambda = lambda == 0.0 ? 1e-3 : lambda * 10.0;
+      lambda = lambda < kFirstDamping ? 10.0 * kFirstDamping : lambda * 1000.0;
       back = true;
       before_step.reset();
       continue;
