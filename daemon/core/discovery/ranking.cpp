@@ -136,7 +136,20 @@ std::vector<ModelTerm> candidate_terms(const PreparedLog& log, const ModelFit& f
   }
   for (const Effect* e : effect_registry()) {
     if (!e->fittable() || std::find(answered.begin(), answered.end(), e) != answered.end()) continue;
-    if (spec.find(*e) != nullptr) continue;
+    if (spec.find(*e) != nullptr) {
+      // The parameters the catalog does not fit by default that the model's term holds
+      // (a loop's zeta at 0.7): a lightly damped or slow loop's resonance is what they
+      // add. Without this the user's loop on such a converter went on to mechanical
+      // harmonics from tracking_loop(omega_n) and never recovered (docs/ACCURACY.md).
+      std::vector<int> held;
+      for (int i = 0; i < static_cast<int>(e->params().size()); ++i) {
+        const ParamInfo& p = e->params()[static_cast<std::size_t>(i)];
+        if (!p.default_fit && !in_model(spec, *e, i)) held.push_back(i);
+      }
+      const ModelTerm t{e, held};
+      if (!held.empty() && usable(t)) out.push_back(t);
+      continue;
+    }
     const ModelTerm t{e, default_params(*e)};
     if (!t.params.empty() && usable(t)) out.push_back(t);
   }

@@ -83,8 +83,22 @@ Design::Design(const ModelSpec& spec, const std::vector<std::vector<double>>& va
 }
 
 void Design::add_candidate(const ModelTerm& term) {
-  terms_.push_back(DesignTerm{term.effect, term.params, neutral_values(*term.effect), true});
+  DesignTerm added{term.effect, term.params, neutral_values(*term.effect), true};
+  if (!term.effect->envelope_only() && !term.effect->linear_in_params()) {
+    for (const DesignTerm& t : terms_) {
+      if (t.candidate || t.effect != term.effect) continue;
+      added.values = t.values;
+      added.replaces_model_term = true;
+    }
+  }
+  terms_.push_back(std::move(added));
   rebuild();
+}
+
+bool Design::stood_in_for(std::size_t i, std::size_t override_term, const std::vector<double>* override_values) const {
+  if (override_values == nullptr || override_term >= terms_.size() || i == override_term) return false;
+  const DesignTerm& o = terms_[override_term];
+  return o.replaces_model_term && !terms_[i].candidate && terms_[i].effect == o.effect;
 }
 
 void Design::set_parts(int parts) {
@@ -305,7 +319,7 @@ BasisTransform Design::transform(const SignatureRow& row, int part, std::size_t 
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = extra_values != nullptr && i == extra_term;
-    if (t.candidate && !override) continue;
+    if ((t.candidate && !override) || stood_in_for(i, extra_term, extra_values)) continue;
     t.effect->configure_basis(row, override ? *extra_values : t.values, tr);
   }
   return tr;
@@ -327,7 +341,7 @@ SignalValues Design::predict_with(const SignatureRow& row, int part, AngleBasis&
   for (std::size_t i = 0; i < terms_.size(); ++i) {
     const DesignTerm& t = terms_[i];
     const bool override = override_values != nullptr && i == override_term;
-    if (t.candidate && !override) continue;
+    if ((t.candidate && !override) || stood_in_for(i, override_term, override_values)) continue;
     if (t.effect->envelope_only()) continue;
     const std::vector<double>& v = override ? *override_values : t.values;
     if (!t.effect->linear_in_params()) {

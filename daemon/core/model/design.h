@@ -61,6 +61,10 @@ struct DesignTerm {
   std::vector<int> params;     ///< fitted parameter indices (ascending)
   std::vector<double> values;  ///< every parameter's value (the linearisation point)
   bool candidate = false;      ///< columns only: contributes nothing to the prediction
+  /// A candidate that frees a parameter the model's term of the same effect holds fixed
+  /// (a loop's zeta): its values are that term's, and moved it stands in for that term
+  /// (Design::add_candidate).
+  bool replaces_model_term = false;
 };
 
 /// The five signals' Jacobian rows of one sample (length = columns).
@@ -76,7 +80,11 @@ class Design {
   /// `spec` at `values` (one vector per term, every parameter; empty = neutral).
   Design(const ModelSpec& spec, const std::vector<std::vector<double>>& values, std::vector<Nuisance> nuisances);
 
-  /// Adds a candidate term (columns at the effect's neutral values).
+  /// Adds a candidate term (columns at the effect's neutral values). Of an effect whose
+  /// contribution is not linear in its values (a tracking loop) that the model has, the
+  /// candidate starts at the model's term's values and, moved, stands in for it: its
+  /// columns are the derivatives at the model's point (at neutral values a loop's zeta
+  /// column is that of an ideal converter: zero).
   void add_candidate(const ModelTerm& term);
 
   [[nodiscard]] int columns() const { return columns_; }
@@ -153,6 +161,10 @@ class Design {
   /// numerically, one prediction with the shift moved.
   [[nodiscard]] SignalValues shift_slope(const SignatureRow& row, int part, const SignalValues& prediction) const;
   void rebuild();
+  /// Whether model term `i` is left out of a prediction with `override_term` moved: that
+  /// candidate replaces_model_term and is of i's effect.
+  [[nodiscard]] bool stood_in_for(std::size_t i, std::size_t override_term,
+                                  const std::vector<double>* override_values) const;
   /// The envelope terms' joint series and every envelope column's derivative series
   /// at the current values (computed on first use after a change).
   struct EnvelopeCache {
