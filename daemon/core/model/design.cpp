@@ -303,11 +303,14 @@ const LoopCorrection& Design::loop_correction(const TrackingLoopParams& loop) co
 }
 
 std::int64_t Design::loop_balance_unconverged(std::span<const FitRow> rows) const {
+  // The loop is the converter's, not the row's: one transform per part, not per row.
+  std::vector<std::optional<TrackingLoopParams>> loops(static_cast<std::size_t>(parts()));
   std::int64_t out = 0;
   for (const FitRow& r : rows) {
     if (!r.fitted() || !r.has(FitRow::kHasRd)) continue;
-    const TrackingLoopParams loop = transform(r.sig, r.part, terms_.size(), nullptr).loop;
-    if (tracking_loop_active(loop) && !loop_correction(loop).converged_at(r.sig.omega)) ++out;
+    std::optional<TrackingLoopParams>& loop = loops[r.part];
+    if (!loop) loop = transform(r.sig, r.part, terms_.size(), nullptr).loop;
+    if (tracking_loop_active(*loop) && !loop_correction(*loop).converged_at(r.sig.omega)) ++out;
   }
   return out;
 }

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <optional>
 
 #include "daemon/core/model/row_blocks.h"
 
@@ -305,12 +304,8 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   double cost = std::numeric_limits<double>::infinity();
   Design last_good = design;
   PassStatistics good_stats(design.columns());  // at last_good: a step back costs no pass
-  // The point the last step left, its statistics and cost: where a step that lands
-  // where the columns cannot be solved goes back to.
-  std::optional<Design> before_step;
-  PassStatistics before_stats(design.columns());
-  double before_cost = cost;
   bool back = false;
+  bool stepped = false;  // design is a step from last_good, not yet taken as good
   for (int pass = 0; pass < max_passes; ++pass) {
     PassStatistics stats(design.columns());
     if (back) {
@@ -337,6 +332,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       // slow loop's omega_n and zeta fitted together stayed at the start values, 247x
       // the floor).
       design = last_good;
+      stepped = false;
       if (lambda >= kLastDamping) {
         out.last = solve_step(good_stats.all, floors, model_cols, 0.0);
         out.stats = std::move(good_stats);
@@ -351,9 +347,6 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     }
     back = false;
     lambda = lambda / 10.0 < 1e-9 ? 0.0 : lambda / 10.0;
-    cost = here;
-    last_good = design;
-    good_stats = stats;
     std::vector<int> cols = pass == 0 ? warm_cols : model_cols;
     StepSolution sol = solve_step(stats.all, floors, cols, lambda);
     // Parameters at a bound that the step pushes past are held there (their solution
@@ -361,20 +354,20 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
     if (sol.ok && std::erase_if(cols, [&](int c) { return design.pushed_past_bound(c, sol.dz[c]); }) > 0) {
       sol = solve_step(stats.all, floors, cols, lambda);
     }
-    if (!sol.ok && before_step && !back) {
+    if (!sol.ok && stepped) {
       // The last step landed where the columns cannot be solved: a lightly damped loop's
       // zeta stepped from 0.7 to its bound 0.01 in one go (where zeta and omega_n no longer
-      // separate), and every start ended "not separable". Back to the point it left, damped
-      // like an uphill step.
-      design = *before_step;
-      last_good = *before_step;
-      good_stats = before_stats;
-      cost = before_cost;
+      // separate), and every start ended "not separable". Back to the point it left (still
+      // last_good, with its statistics and cost), damped like an uphill step.
+      design = last_good;
       lambda = lambda < kFirstDamping ? 10.0 * kFirstDamping : lambda * 1000.0;
       back = true;
-      before_step.reset();
+      stepped = false;
       continue;
     }
+    cost = here;
+    last_good = design;
+    good_stats = stats;
     if (!sol.ok) {
       out.last = sol;
       out.stats = std::move(stats);
@@ -400,11 +393,9 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       }
     }
     out.last = sol;
-    before_step = design;
-    before_stats = stats;
-    before_cost = here;
     out.stats = std::move(stats);
     design.step(sol.dz);
+    stepped = true;
     shift_frames(design, zero_cols, sol.dz);
     if (linear) {
       // One linearised step is exact; the statistics move with it (RSS(dz) above).
