@@ -438,6 +438,10 @@ std::vector<ModelTerm> residual_candidate_terms(const ModelFit& fit, const Disco
   return out;
 }
 
+bool already_listed(const std::vector<Candidate>& candidates, const std::string& effect) {
+  return std::any_of(candidates.begin(), candidates.end(), [&](const Candidate& o) { return o.effect == effect; });
+}
+
 bool is_family(const ModelTerm& t) { return t.params.size() >= 2 * static_cast<std::size_t>(kFamilyFrom); }
 
 void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
@@ -473,15 +477,8 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
                                   (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));
       continue;
     }
-    // Without sin/cos a pair whose columns the R/D angle cannot separate keeps its better
-    // one (solve_candidate): harmonics and harmonics(k3,k3_q) can both become
-    // harmonics(k3_q). Listed twice, such a term took two of the exact refits' places
-    // and pushed the third candidate (the true one, a tracking loop) out of them.
     const std::string reference = terms[i].reference();
-    if (std::any_of(out.candidates.begin(), out.candidates.end(),
-                    [&](const Candidate& o) { return o.effect == reference; })) {
-      continue;
-    }
+    if (already_listed(out.candidates, reference)) continue;
     Candidate c;
     c.effect = reference;
     c.family = is_family(terms[i]);

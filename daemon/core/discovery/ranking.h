@@ -79,6 +79,13 @@ void flag_one_step(Candidate& c, const DiscoveryOptions& options);
 /// A harmonic family: every significant order at once (named first only alone).
 [[nodiscard]] bool is_family(const ModelTerm& t);
 
+/// Whether `effect` is already among `candidates`. Without sin/cos a pair whose columns the
+/// R/D angle cannot separate keeps its better one (solve_candidate): harmonics and
+/// harmonics(k3,k3_q) can both become harmonics(k3_q). Listed twice, such a term took two of
+/// the exact refits' places and pushed the third candidate (the true one, a tracking loop)
+/// out of them: it is scored once, in memory and in a merge.
+[[nodiscard]] bool already_listed(const std::vector<Candidate>& candidates, const std::string& effect);
+
 /// explain's order of scored candidates: best BIC first, candidates the log cannot tell
 /// apart simplest first (fits_as_well), a family first only when nothing smaller does.
 void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& options);

@@ -195,13 +195,8 @@ void score_merged(const Design& d, std::size_t i, const ModelTerm& asked, const 
     out.not_evaluated.push_back(set.reference() + ": not separable from the model with the merged runs");
     return;
   }
-  // As in memory (ranking.cpp): a pair and a family reduced to the same column are one
-  // candidate.
   const std::string reference = set.reference();
-  if (std::any_of(out.candidates.begin(), out.candidates.end(),
-                  [&](const Candidate& o) { return o.effect == reference; })) {
-    return;
-  }
+  if (already_listed(out.candidates, reference)) return;
   Candidate c;
   c.effect = reference;
   c.family = is_family(set);
