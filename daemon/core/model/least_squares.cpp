@@ -271,6 +271,18 @@ int fit_frame_shift(Design& design, std::span<const FitRow> rows, const GroupFlo
 
 namespace {
 
+/// Whether the undamped step `s` from a point of weighted cost `cost` is too small to
+/// matter: it would lower the cost by less than a tenth of what one standard error's move
+/// of a parameter does (each row weighs 1 at its floor, so that is max(1, cost / rows): the
+/// standard errors scale with the residual). A fit that stopped where its damped steps went
+/// uphill is converged only so; with a larger step left it stopped on a slope (a candidate
+/// nearly an alias of model terms stayed at its start, reported as its fit).
+bool step_negligible(const StepSolution& s, double cost) {
+  const auto rows = static_cast<double>(s.n[0] + s.n[1] + s.n[2]);
+  const double per_standard_error = rows > 0.0 ? std::max(1.0, cost / rows) : 1.0;
+  return cost - s.rss_w <= 0.1 * per_standard_error;
+}
+
 FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
                          const std::function<void()>& progress) {
   FitResult out;
@@ -338,6 +350,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
         out.stats = std::move(good_stats);
         out.cost = cost;
         out.ok = out.last.ok;
+        out.converged = out.ok && step_negligible(out.last, cost);
         return out;
       }
       // Used after the /10 below: 1, then 100.
@@ -389,6 +402,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
         out.stats = std::move(stats);
         out.cost = here;
         out.ok = true;
+        out.converged = true;
         return out;
       }
     }
@@ -401,6 +415,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       // One linearised step is exact; the statistics move with it (RSS(dz) above).
       out.cost = sol.rss_w;
       out.ok = true;
+      out.converged = true;
       return out;
     }
   }
@@ -421,6 +436,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   out.stats = std::move(final_stats);
   out.cost = final_cost;
   out.ok = out.last.ok;
+  out.converged = out.ok && step_negligible(out.last, final_cost);
   return out;
 }
 

@@ -89,6 +89,12 @@ struct FitResult {
   /// Weighted RSS at the final point with the nuisance constants solved (what the
   /// starts of a multimodal fit are compared by).
   double cost = std::numeric_limits<double>::infinity();
+  /// The final point is the solution: the undamped step from it would move the parameters
+  /// by less than ~0.3 standard errors (least_squares.cpp step_negligible). False where the
+  /// fit ended at its last good point because the damped steps went uphill, or ran out of
+  /// passes, with a larger step still to take (nearly collinear terms: the point is where
+  /// it stopped, not a fit).
+  bool converged = false;
 };
 
 /// Fits the design's model parameters (candidates are not moved): Gauss-Newton,
