@@ -252,7 +252,8 @@ std::string candidates_table(const Explanation& ex, bool currents) {
     for (const auto& p : c.params) {
       values.push_back(fmt::format("{} = {:.4g} ± {:.2g} {}", p.name, p.value, p.std_error, report::bare_unit(p.unit)));
     }
-    std::vector<std::string> r = {"<code>" + escape(c.effect) + "</code>",
+    const std::string in_place = c.replaces.empty() ? std::string() : " in place of <code>" + escape(c.replaces) + "</code>";
+    std::vector<std::string> r = {"<code>" + escape(c.effect) + "</code>" + in_place,
                                   num_cell(escape(signal_value("position_error", c.residual_after_rad)))};
     if (currents) r.push_back(num_cell(g3(c.dq_residual_after)));
     r.insert(r.end(), {num_cell(fmt::format("{:.1f}", c.bic_drop)), num_cell(fmt::format("{:.3f}", c.err)),

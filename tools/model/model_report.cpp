@@ -135,6 +135,7 @@ std::string text_explanation(const Explanation& ex) {
   }
   for (const auto& c : ex.candidates) {
     const std::string dq = f.currents_used ? fmt::format(", i_dq {:.3g} A", c.dq_residual_after) : std::string();
+    if (!c.replaces.empty()) o += fmt::format("  {} in place of {}:\n", c.proposed ? '*' : ' ', c.replaces);
     o += fmt::format("  {} {:<26} residual {:.3g} rad ({:.2f}x floor){}  BIC {:.1f} (drop {:.1f}) ERR {:.3f}{}\n      {}\n",
                      c.proposed ? '*' : ' ', c.effect, c.residual_after_rad, c.residual_after_rad / f.noise_floor_rad,
                      dq, c.score, c.bic_drop, c.err, c.reaches_floor ? "  reaches the floor" : "", c.reason);
@@ -234,11 +235,12 @@ std::string json_breakdowns(const ModelFit& f) {
 std::string json_candidate(const Candidate& c) {
   return fmt::format("{{\"effect\":{},\"residual_after_rad\":{},\"dq_residual_after_a\":{},"
                      "\"score\":{},\"bic_drop\":{},\"err\":{},"
-                     "\"proposed\":{},\"reaches_floor\":{},\"one_step\":{},\"reason\":{},\"fits_as_well\":[{}],"
-                     "\"params\":{{",
+                     "\"proposed\":{},\"reaches_floor\":{},\"one_step\":{},\"replaces\":{},\"reason\":{},"
+                     "\"fits_as_well\":[{}],\"params\":{{",
                      json_str(c.effect), json_num(c.residual_after_rad), json_num(c.dq_residual_after),
                      json_num(c.score), json_num(c.bic_drop), json_num(c.err), c.proposed, c.reaches_floor, c.stepped,
-                     json_str(c.reason), json_items(c.fits_as_well, json_str)) +
+                     c.replaces.empty() ? std::string("null") : json_str(c.replaces), json_str(c.reason),
+                     json_items(c.fits_as_well, json_str)) +
          json_items(c.params,
                     [](const auto& p) {
                       return json_str(p.name) + ":{\"value\":" + json_num(p.value) +

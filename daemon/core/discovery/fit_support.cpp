@@ -1,6 +1,8 @@
 #include "daemon/core/discovery/fit_support.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -44,6 +46,23 @@ std::vector<int> term_columns(const Design& design, std::size_t term) {
   std::vector<int> out;
   for (std::size_t k = 0; k < design.terms()[term].params.size(); ++k) {
     out.push_back(design.term_column(term) + static_cast<int>(k));
+  }
+  return out;
+}
+
+std::vector<std::size_t> aliased_terms(const Design& design, std::span<const FitRow> rows, const GroupFloors& floors) {
+  PassStatistics stats(design.columns());
+  accumulate(design, rows, floors, stats);
+  const std::vector<int> all = model_columns(design);
+  if (solve_step(stats.all, floors, all).ok) return {};
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < design.terms().size(); ++i) {
+    if (design.terms()[i].candidate) continue;
+    const std::vector<int> own = term_columns(design, i);
+    std::vector<int> rest;
+    std::copy_if(all.begin(), all.end(), std::back_inserter(rest),
+                 [&](int c) { return std::find(own.begin(), own.end(), c) == own.end(); });
+    if (solve_step(stats.all, floors, rest).ok) out.push_back(i);
   }
   return out;
 }

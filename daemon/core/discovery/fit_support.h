@@ -34,6 +34,15 @@ inline constexpr std::string_view kNeedsAlignedReference =
 /// Columns of design term `term` (all of its fitted parameters).
 [[nodiscard]] std::vector<int> term_columns(const Design& design, std::size_t term);
 
+/// Where the design's model is not separable at its point (one pass over `rows`): the
+/// model terms without any one of which the rest are. Such terms are aliases of one
+/// another at first order (a mechanical harmonic at a whole electrical order lands on the
+/// same sin/cos and angle as the winding terms of that order), told apart only by their
+/// second-order terms, if at all. Empty where the model is separable there, or where
+/// leaving out no single term makes it so.
+[[nodiscard]] std::vector<std::size_t> aliased_terms(const Design& design, std::span<const FitRow> rows,
+                                                     const GroupFloors& floors);
+
 /// sqrt(rss / n), 0 for n = 0.
 [[nodiscard]] double rms(double rss, std::int64_t n);
 

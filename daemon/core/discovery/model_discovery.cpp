@@ -337,6 +337,26 @@ bool at_floor(const ModelFit& f, double explained_ratio) {
 }
 
 
+/// Why the model cannot be fitted to the log: which of its terms are aliases of one another
+/// at the start values (fit_support.h aliased_terms), so the user knows which to leave out.
+std::string not_separable_message(const ModelFit& f, const PreparedLog& log, const GroupFloors& floors) {
+  std::string out = fmt::format("the model's effects ({}) are not separable with the signals in this log",
+                                fmt::join(f.effects, ", "));
+  const std::vector<std::size_t> aliased = aliased_terms(design_for(f.model, log), log.rows, floors);
+  if (aliased.size() >= 2) {
+    std::vector<std::string> names;
+    for (const std::size_t i : aliased) names.push_back(f.model.spec().terms[i].reference());
+    const std::string last = names.back();
+    names.pop_back();
+    out += fmt::format(": {} and {} are aliases here (at first order each is a combination of the others: they land on "
+                       "the same harmonics of the angle{}); without any one of them the rest are separable, so leave "
+                       "one out",
+                       fmt::join(names, ", "), last, log.sincos ? " and of the sin/cos" : "");
+  }
+  if (!log.sincos) out += " (sin/cos would tell more effects apart: e.g. harmonics(k3) and amplitude_imbalance both land on 2 theta without them)";
+  return out;
+}
+
 }  // namespace
 
 std::vector<bool> apply_start_values(const FitStartValues& start, Model& model) {
@@ -378,10 +398,7 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
       settled);
   if (!fr.ok) {
     throw_if_custom_term_not_finite(f.effects, log, options);
-    throw std::invalid_argument(fmt::format(
-        "the model's effects ({}) are not separable with the signals in this log (e.g. harmonics(k3) and "
-        "amplitude_imbalance both land on 2 theta without sin/cos)",
-        fmt::join(f.effects, ", ")));
+    throw std::invalid_argument(not_separable_message(f, log, floors));
   }
   f.passes = fr.passes;
   f.model.take_values(d);
@@ -524,7 +541,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     ex.verdict = Verdict::kMissingEffect;
     ex.summary = "missing_effect: two effects are missing: " + ex.missing_pair[0] + " and " + ex.missing_pair[1] +
                  " together bring every signal to within " + num(options.explained_ratio) +
-                 "x its noise floor (neither does alone); add " + best->effect + " first. " + best->reason;
+                 "x its noise floor (neither does alone); " + (best->replaces.empty() ? "add " + best->effect : "put " + best->effect + " in place of " + best->replaces) + " first. " + best->reason;
   } else if (named) {
     ex.verdict = Verdict::kMissingEffect;
     struct Change {
@@ -541,7 +558,9 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     const Change& c = *std::max_element(changes.begin(), changes.end(), [](const Change& x, const Change& y) {
       return (x.before - x.after) / x.floor < (y.before - y.after) / y.floor;
     });
-    ex.summary = "missing_effect: adding " + best->effect + " brings the " + c.what + " residual from " +
+    const std::string change =
+        best->replaces.empty() ? "adding " + best->effect : best->effect + " in place of " + best->replaces;
+    ex.summary = "missing_effect: " + change + " brings the " + c.what + " residual from " +
                  num(c.before) + " to " + num(c.after) + c.unit + " (floor " + num(c.floor) + "); " + best->reason +
                  alternatives;
   } else {

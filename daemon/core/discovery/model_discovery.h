@@ -266,6 +266,11 @@ struct Candidate {
   /// Its values and score are one linearised step from neutral although its fit is not
   /// (ranking.h needs_exact_refit; beyond the refits' count): approximate, and said so.
   bool stepped = false;
+  /// The model term it goes in place of ("" = added to the model): the model with it added
+  /// is not separable from its start values, the two being aliases at first order
+  /// (fit_support.h aliased_terms; a mechanical harmonic at a whole electrical order and
+  /// the winding harmonics of that order). Its score is that of the model with the swap.
+  std::string replaces;
 };
 
 /// Whether a candidate that leaves `weighted_rss_after` (a row at its floor weighs 1)

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -11,6 +13,7 @@
 #include "daemon/core/effects/registry.h"
 #include "daemon/core/model/custom_effect.h"
 #include "daemon/core/model/least_squares.h"
+#include "daemon/core/model/model.h"
 
 namespace resolver {
 
@@ -22,6 +25,9 @@ constexpr int kOrdersTried = 3;
 constexpr double kSignificance = 4.0;
 /// Nonlinear candidates refitted to convergence (the best by their linearised score).
 constexpr int kNonlinearRefits = 3;
+/// Proposed candidates checked for being aliases of model terms (offer_swaps): one pass
+/// each, and a fit per alias found.
+constexpr int kSwapChecks = 2;
 /// Candidates within this BIC of each other, or whose residuals differ by less than
 /// this share of the smaller, are not told apart by the log (e.g. K_3 and a 6th mechanical
 /// harmonic with p_r = 3: the same 2 theta in the angle, and alpha takes up the
@@ -349,7 +355,9 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     if (own_term) settled[at] = warm;
     const FitResult fr = fit_design(dm, log.rows, floors, 12, {}, settled);
     out.passes += fr.passes;
-    if (!fr.ok) continue;
+    // A refit that stopped where its steps went uphill (a candidate nearly an alias of model
+    // terms) is no fit: the candidate keeps its linearised step, said so (flag_one_step).
+    if (!fr.ok || !fr.converged) continue;
     c.refitted = true;
     score_candidate(c, fr.last, log.rd, base, floors, options);
     // The candidate's own parameters, by name (a joined term has the model's too).
@@ -361,6 +369,81 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     }
     c.reason = reason_of(term, c.params);
   }
+}
+
+/// The model with `c` in place of its term `replaced`, fitted exactly (the model's other
+/// terms settled at their fit, the candidate started again); nullopt where that fit does
+/// not converge.
+std::optional<Candidate> swapped_fit(const Candidate& c, const ModelTerm& term, std::size_t replaced,
+                                     const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
+                                     const GroupFloors& floors, const DiscoveryOptions& options, int& passes) {
+  ModelSpec swapped = fit.model.spec();
+  std::vector<std::vector<double>> values = fit.model.values();
+  const std::string replaced_reference = swapped.terms[replaced].reference();
+  swapped.terms.erase(swapped.terms.begin() + static_cast<std::ptrdiff_t>(replaced));
+  values.erase(values.begin() + static_cast<std::ptrdiff_t>(replaced));
+  swapped.terms.push_back(term);
+  values.emplace_back();
+  Design dm(swapped, values, nuisances_for(log));
+  dm.set_parts(log.part_count());
+  std::vector<bool> settled(dm.terms().size(), true);
+  settled.back() = false;
+  const FitResult fr = fit_design(dm, log.rows, floors, 12, {}, settled);
+  passes += fr.passes;
+  if (!fr.ok || !fr.converged) return std::nullopt;
+  Candidate out;
+  out.effect = c.effect;
+  out.replaces = replaced_reference;
+  out.refitted = true;
+  score_candidate(out, fr.last, log.rd, base, floors, options);
+  out.params = term_params(dm, dm.terms().size() - 1, fr.last, false);
+  out.reason = reason_of(term, out.params) + " In place of " + replaced_reference +
+               ": with both in the model the fit cannot separate them (aliases at first order).";
+  return out;
+}
+
+/// Offline: a proposed candidate (of the first kSwapChecks listed) that the model cannot
+/// take beside its terms (the model with it is not separable from the start values, as
+/// the user's next fit would start) is an alias of some of them; it is offered in place of
+/// each such term instead, fitted exactly, and is no longer proposed as an addition (the
+/// fit would refuse it). A mechanical harmonic at a whole electrical order, named first
+/// where it absorbs more of a 2 theta residual than the winding terms, is the case met
+/// (docs/ACCURACY.md).
+void offer_swaps(Ranking& out, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
+                 const GroupFloors& floors, const DiscoveryOptions& options) {
+  if (!options.refit_proposed) return;
+  std::vector<Candidate> swaps;
+  int checked = 0;
+  for (Candidate& c : out.candidates) {
+    if (!c.proposed || c.family || !c.replaces.empty()) continue;
+    if (checked++ >= kSwapChecks) break;
+    const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
+    ModelSpec with = fit.model.spec();
+    with.add(one.terms.front());
+    if (with.terms.size() == fit.model.spec().terms.size()) continue;  // joins a term of the model
+    const std::vector<std::size_t> aliased = aliased_terms(design_for(Model(with, log.p_r, log.p), log), log.rows, floors);
+    ++out.passes;
+    const std::size_t own = with.terms.size() - 1;
+    if (std::find(aliased.begin(), aliased.end(), own) == aliased.end()) continue;
+    // Only with another term: a column that is zero at the start (a nonlinear parameter at
+    // its neutral value) makes the candidate alone "aliased", and the fit steps past it.
+    std::vector<std::size_t> others;
+    std::copy_if(aliased.begin(), aliased.end(), std::back_inserter(others), [&](std::size_t m) { return m != own; });
+    if (others.empty()) continue;
+    std::vector<std::string> names;
+    const std::size_t before = swaps.size();
+    for (const std::size_t m : others) {
+      names.push_back(with.terms[m].reference());
+      if (std::optional<Candidate> s = swapped_fit(c, one.terms.front(), m, log, fit, base, floors, options, out.passes)) {
+        swaps.push_back(std::move(*s));
+      }
+    }
+    c.proposed = false;
+    c.reason += fmt::format(" Not proposed as an addition: with the model it is not separable from {} (aliases at "
+                            "first order){}.",
+                            fmt::join(names, ", "), swaps.size() > before ? "; listed in place of it" : "");
+  }
+  for (Candidate& s : swaps) out.candidates.push_back(std::move(s));
 }
 
 /// Alike: what they leave differs by less than the BIC's resolution, or by less
@@ -501,6 +584,9 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   refit_nonlinear(out, log, fit, base, floors, options);
   order_ranked(out.candidates, options);
   for (Candidate& c : out.candidates) flag_one_step(c, options);
+  const std::size_t listed = out.candidates.size();
+  offer_swaps(out, log, fit, base, floors, options);
+  if (out.candidates.size() > listed) order_ranked(out.candidates, options);
   return out;
 }
 
