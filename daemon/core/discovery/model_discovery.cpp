@@ -345,6 +345,7 @@ std::string not_separable_message(const ModelFit& f, const PreparedLog& log, con
   const std::vector<std::size_t> aliased = aliased_terms(design_for(f.model, log), log.rows, floors);
   if (aliased.size() >= 2) {
     std::vector<std::string> names;
+    names.reserve(aliased.size());
     for (const std::size_t i : aliased) names.push_back(f.model.spec().terms[i].reference());
     const std::string last = names.back();
     names.pop_back();

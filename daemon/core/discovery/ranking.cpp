@@ -25,9 +25,12 @@ constexpr int kOrdersTried = 3;
 constexpr double kSignificance = 4.0;
 /// Nonlinear candidates refitted to convergence (the best by their linearised score).
 constexpr int kNonlinearRefits = 3;
-/// Proposed candidates checked for being aliases of model terms (offer_swaps): one pass
-/// each, and a fit per alias found.
-constexpr int kSwapChecks = 2;
+/// Candidates checked for being aliases of model terms (offer_swaps), on every
+/// kAliasRowStride-th row (an eighth of a pass each), and of those found the first
+/// kSwapFits fitted in place of the terms they alias (a fit each).
+constexpr int kAliasChecks = 16;
+constexpr std::size_t kAliasRowStride = 8;
+constexpr int kSwapFits = 2;
 /// Candidates within this BIC of each other, or whose residuals differ by less than
 /// this share of the smaller, are not told apart by the log (e.g. K_3 and a 6th mechanical
 /// harmonic with p_r = 3: the same 2 theta in the angle, and alpha takes up the
@@ -371,11 +374,10 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
   }
 }
 
-/// The model with `c` in place of its term `replaced`, fitted exactly (the model's other
+/// The model with candidate `term` in place of its term `replaced`, fitted exactly (the model's other
 /// terms settled at their fit, the candidate started again); nullopt where that fit does
 /// not converge.
-std::optional<Candidate> swapped_fit(const Candidate& c, const ModelTerm& term, std::size_t replaced,
-                                     const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
+std::optional<Candidate> swapped_fit(const ModelTerm& term, std::size_t replaced, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
                                      const GroupFloors& floors, const DiscoveryOptions& options, int& passes) {
   ModelSpec swapped = fit.model.spec();
   std::vector<std::vector<double>> values = fit.model.values();
@@ -392,7 +394,7 @@ std::optional<Candidate> swapped_fit(const Candidate& c, const ModelTerm& term, 
   passes += fr.passes;
   if (!fr.ok || !fr.converged) return std::nullopt;
   Candidate out;
-  out.effect = c.effect;
+  out.effect = term.reference();
   out.replaces = replaced_reference;
   out.refitted = true;
   score_candidate(out, fr.last, log.rd, base, floors, options);
@@ -402,46 +404,83 @@ std::optional<Candidate> swapped_fit(const Candidate& c, const ModelTerm& term, 
   return out;
 }
 
-/// Offline: a proposed candidate (of the first kSwapChecks listed) that the model cannot
-/// take beside its terms (the model with it is not separable from the start values, as
-/// the user's next fit would start) is an alias of some of them; it is offered in place of
-/// each such term instead, fitted exactly, and is no longer proposed as an addition (the
-/// fit would refuse it). A mechanical harmonic at a whole electrical order, named first
-/// where it absorbs more of a 2 theta residual than the winding terms, is the case met
-/// (docs/ACCURACY.md).
-void offer_swaps(Ranking& out, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
-                 const GroupFloors& floors, const DiscoveryOptions& options) {
+/// A candidate the model cannot take beside some of its terms.
+struct Alias {
+  std::optional<std::size_t> candidate;  ///< index in the ranking's candidates (none: not separable there)
+  ModelTerm term;                     ///< the candidate's
+  std::vector<std::string> replaced;  ///< the model terms it aliases, by reference
+  std::vector<std::size_t> at;        ///< and their indices in the model
+};
+
+/// The model terms candidate `c` aliases (fit_support.h aliased_terms on `rows`, the model
+/// with `c` at the start values, where the user's next fit starts); empty when none.
+std::optional<Alias> alias_of(const ModelTerm& term, std::optional<std::size_t> index, const PreparedLog& log,
+                              const ModelFit& fit, std::span<const FitRow> rows, const GroupFloors& floors) {
+  ModelSpec with = fit.model.spec();
+  with.add(term);
+  if (with.terms.size() == fit.model.spec().terms.size()) return std::nullopt;  // joins a term of the model
+  const std::vector<std::size_t> aliased = aliased_terms(design_for(Model(with, log.p_r, log.p), log), rows, floors);
+  const std::size_t own = with.terms.size() - 1;
+  // Only with another term: a column that is zero at the start (a nonlinear parameter at
+  // its neutral value) makes the candidate alone "aliased", and the fit steps past it.
+  if (std::find(aliased.begin(), aliased.end(), own) == aliased.end() || aliased.size() < 2) return std::nullopt;
+  Alias out{index, term, {}, {}};
+  for (const std::size_t m : aliased) {
+    if (m == own) continue;
+    out.replaced.push_back(with.terms[m].reference());
+    out.at.push_back(m);
+  }
+  return out;
+}
+
+/// Offline: a candidate that the model cannot take beside its terms (the model with it is
+/// not separable from the start values) is an alias of some of them at first order; the
+/// log tells them apart only at second order, where the wrong one of two aliases leaves a
+/// residual that draws further, spurious candidates. It is never proposed as an addition
+/// (the fit would refuse it), and the first kSwapFits such candidates as listed are fitted
+/// exactly in place of each term they alias, and offered so. A mechanical harmonic at a
+/// whole electrical order (the winding terms' alias) is the case met (docs/ACCURACY.md).
+void offer_swaps(Ranking& out, std::span<const ModelTerm> unseparated, const PreparedLog& log, const ModelFit& fit,
+                 const StepSolution& base, const GroupFloors& floors, const DiscoveryOptions& options) {
   if (!options.refit_proposed) return;
-  std::vector<Candidate> swaps;
+  // An alias is singular at the start values whatever the rows: a sample of them tells.
+  std::vector<FitRow> sample;
+  for (std::size_t i = 0; i < log.rows.size(); i += kAliasRowStride) sample.push_back(log.rows[i]);
+  std::vector<Alias> found;
   int checked = 0;
-  for (Candidate& c : out.candidates) {
-    if (!c.proposed || c.family || !c.replaces.empty()) continue;
-    if (checked++ >= kSwapChecks) break;
-    const ModelSpec one = ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs);
-    ModelSpec with = fit.model.spec();
-    with.add(one.terms.front());
-    if (with.terms.size() == fit.model.spec().terms.size()) continue;  // joins a term of the model
-    const std::vector<std::size_t> aliased = aliased_terms(design_for(Model(with, log.p_r, log.p), log), log.rows, floors);
-    ++out.passes;
-    const std::size_t own = with.terms.size() - 1;
-    if (std::find(aliased.begin(), aliased.end(), own) == aliased.end()) continue;
-    // Only with another term: a column that is zero at the start (a nonlinear parameter at
-    // its neutral value) makes the candidate alone "aliased", and the fit steps past it.
-    std::vector<std::size_t> others;
-    std::copy_if(aliased.begin(), aliased.end(), std::back_inserter(others), [&](std::size_t m) { return m != own; });
-    if (others.empty()) continue;
-    std::vector<std::string> names;
+  const auto check = [&](const ModelTerm& t, std::optional<std::size_t> index) {
+    ++checked;
+    if (std::optional<Alias> a = alias_of(t, index, log, fit, sample, floors)) found.push_back(std::move(*a));
+  };
+  for (std::size_t i = 0; i < out.candidates.size() && checked < kAliasChecks; ++i) {
+    const Candidate& c = out.candidates[i];
+    if (c.family || !c.replaces.empty()) continue;
+    check(ModelSpec::parse(std::vector<std::string>{c.effect}, options.customs).terms.front(), i);
+  }
+  // Those the ranking could not separate from the model at its fit: the aliases whose
+  // second-order difference is too small there to be a column of their own.
+  for (const ModelTerm& t : unseparated) {
+    if (!is_family(t)) check(t, std::nullopt);
+  }
+  const int stride = static_cast<int>(kAliasRowStride);
+  out.passes += (checked + stride - 1) / stride;
+  std::vector<Candidate> swaps;
+  int fitted = 0;
+  for (const Alias& a : found) {
     const std::size_t before = swaps.size();
-    for (const std::size_t m : others) {
-      names.push_back(with.terms[m].reference());
-      if (std::optional<Candidate> s = swapped_fit(c, one.terms.front(), m, log, fit, base, floors, options, out.passes)) {
-        swaps.push_back(std::move(*s));
+    if (fitted < kSwapFits) {
+      ++fitted;
+      for (const std::size_t m : a.at) {
+        if (std::optional<Candidate> s = swapped_fit(a.term, m, log, fit, base, floors, options, out.passes)) {
+          swaps.push_back(std::move(*s));
+        }
       }
     }
+    if (!a.candidate) continue;
+    Candidate& c = out.candidates[*a.candidate];
+    c.reason += fmt::format(" Not an addition: with the model it is not separable from {} (aliases at first order){}.",
+                            fmt::join(a.replaced, ", "), swaps.size() > before ? "; listed in place of it" : "");
     c.proposed = false;
-    c.reason += fmt::format(" Not proposed as an addition: with the model it is not separable from {} (aliases at "
-                            "first order){}.",
-                            fmt::join(names, ", "), swaps.size() > before ? "; listed in place of it" : "");
   }
   for (Candidate& s : swaps) out.candidates.push_back(std::move(s));
 }
@@ -552,10 +591,12 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   ++out.passes;
   const std::vector<int> base_cols = model_columns(d);
   const StepSolution base = solve_step(stats.all, floors, base_cols);
+  std::vector<ModelTerm> unseparated;
   for (std::size_t i = 0; i < terms.size(); ++i) {
     const std::size_t term = first_candidate + i;
     const StepSolution s = solve_candidate(stats.all, floors, base_cols, term_columns(d, term), terms[i]);
     if (!s.ok) {
+      unseparated.push_back(terms[i]);
       out.not_evaluated.push_back(terms[i].reference() + ": not separable from the model with the signals in this log" +
                                   (log.sincos ? std::string() : std::string(" (sin/cos would tell them apart)")));
       continue;
@@ -585,7 +626,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   order_ranked(out.candidates, options);
   for (Candidate& c : out.candidates) flag_one_step(c, options);
   const std::size_t listed = out.candidates.size();
-  offer_swaps(out, log, fit, base, floors, options);
+  offer_swaps(out, unseparated, log, fit, base, floors, options);
   if (out.candidates.size() > listed) order_ranked(out.candidates, options);
   return out;
 }
