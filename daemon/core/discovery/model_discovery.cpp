@@ -418,6 +418,18 @@ ModelFit fit_prepared(const PreparedLog& log, std::span<const std::string> effec
   const StepSolution& s = fr.last;
   fill_params(f, d, parameter_covariance(s, pass, cols, f));
   std::vector<std::string> convergence_notes = signal_residuals(log, fr, pass, raw_sol, floors, cols, f);
+  if (!fr.converged && f.converged) {
+    // The fit ended where its damped steps went uphill (or its passes ran out) with the
+    // undamped step still worth more than a tenth of a standard error's cost
+    // (least_squares.cpp step_negligible): the values are not a minimum the linearisation
+    // can vouch for, so their standard errors say nothing of how far off they are.
+    f.converged = false;
+    convergence_notes.push_back(fmt::format(
+        "the fit did not converge: it stopped after {} passes where its steps no longer lowered the cost, with "
+        "its linearised step still moving the values by ~{:.2g} standard errors: some of the model's terms are "
+        "nearly aliases here, or a parameter's valley is not smooth; the values may be off by that much",
+        fr.passes, step_in_standard_errors(fr.last, fr.cost)));
+  }
   if (const std::int64_t n = d.loop_balance_unconverged(log.rows); n > 0) {
     // The prediction at those rows is the balance's last iterate, not the loop's steady
     // state (loop_correction.h): whatever the residual, it is no evidence for the model.

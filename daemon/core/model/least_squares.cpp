@@ -190,6 +190,9 @@ constexpr double kShiftSettled = 1e-7;
 /// after an uphill step, and the last tried before the last good point is the answer.
 constexpr double kFirstDamping = 1.0;
 constexpr double kLastDamping = 100.0;
+/// The largest undamped step left at a fit's end, in standard errors, for the fit to be
+/// converged: a tenth of one standard error's cost (sqrt(0.1)).
+const double kNegligibleStepSe = std::sqrt(0.1);
 
 /// The columns of the position-error constant the frame shift follows, one per
 /// pooled part (design.h): the sin/cos angle's where the log has it (the windings'
@@ -271,17 +274,11 @@ int fit_frame_shift(Design& design, std::span<const FitRow> rows, const GroupFlo
 
 namespace {
 
-/// Whether the undamped step `s` from a point of weighted cost `cost` is too small to
-/// matter: it would lower the cost by less than a tenth of what one standard error's move
-/// of a parameter does (each row weighs 1 at its floor, so that is max(1, cost / rows): the
-/// standard errors scale with the residual). A fit that stopped where its damped steps went
-/// uphill is converged only so; with a larger step left it stopped on a slope (a candidate
+/// A fit that stopped where its damped steps went uphill is converged only where the
+/// undamped step left is too small to matter (step_in_standard_errors below 0.3, a tenth of
+/// a standard error's cost); with a larger step left it stopped on a slope (a candidate
 /// nearly an alias of model terms stayed at its start, reported as its fit).
-bool step_negligible(const StepSolution& s, double cost) {
-  const auto rows = static_cast<double>(s.n[0] + s.n[1] + s.n[2]);
-  const double per_standard_error = rows > 0.0 ? std::max(1.0, cost / rows) : 1.0;
-  return cost - s.rss_w <= 0.1 * per_standard_error;
-}
+bool step_negligible(const StepSolution& s, double cost) { return step_in_standard_errors(s, cost) <= kNegligibleStepSe; }
 
 FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
                          const std::function<void()>& progress) {
@@ -457,6 +454,15 @@ std::vector<double> other_starts(const ParamInfo& p, double start) {
 }
 
 }  // namespace
+
+double step_in_standard_errors(const StepSolution& s, double cost) {
+  // Each row weighs 1 at its floor, so a move of one standard error lowers the cost by
+  // max(1, cost / rows) (the standard errors scale with the residual); the step lowers
+  // it by cost - rss_w, a move of sqrt of their ratio.
+  const auto rows = static_cast<double>(s.n[0] + s.n[1] + s.n[2]);
+  const double per_standard_error = rows > 0.0 ? std::max(1.0, cost / rows) : 1.0;
+  return std::sqrt(std::max(0.0, cost - s.rss_w) / per_standard_error);
+}
 
 FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
                      const std::function<void()>& progress, const std::vector<bool>& settled) {

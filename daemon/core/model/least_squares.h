@@ -97,6 +97,11 @@ struct FitResult {
   bool converged = false;
 };
 
+/// How far the undamped step `s` from a point of weighted cost `cost` would move the
+/// parameters, in standard errors (from how much it lowers the cost); a fit is converged
+/// where this is below ~0.3 (FitResult::converged).
+[[nodiscard]] double step_in_standard_errors(const StepSolution& s, double cost);
+
 /// Fits the design's model parameters (candidates are not moved): Gauss-Newton,
 /// with Levenberg-Marquardt damping when a nonlinear step does not lower the
 /// cost; one pass for a linear design, at most `max_passes`. `progress` (may be
