@@ -317,6 +317,25 @@ std::vector<std::string> exact_refits(const std::vector<Candidate>& ranked, cons
 namespace {
 
 
+/// The index in `spec` of the term `term` is (or joins: a harmonic order beside the
+/// model's orders, ModelSpec::add).
+std::size_t term_index(const ModelSpec& spec, const ModelTerm& term) {
+  std::size_t at = spec.terms.size() - 1;
+  while (at > 0 && spec.terms[at].effect != term.effect) --at;
+  return at;
+}
+
+/// The candidate's own parameters among a fitted term's (a joined term has the model's too).
+std::vector<ModelParameter> own_params(const ModelTerm& term, std::vector<ModelParameter> fitted) {
+  std::erase_if(fitted, [&](const ModelParameter& q) {
+    for (std::size_t k = 0; k < term.params.size(); ++k) {
+      if (q.name == term.param_name(k)) return false;
+    }
+    return true;
+  });
+  return fitted;
+}
+
 /// Nonlinear candidates: the linearised step is only the start; the best proposed
 /// ones are refitted to convergence with the model. Envelope effects enter through
 /// atan2 too: at real magnitudes (a 15 % harmonic) one linearised step from zero
@@ -334,8 +353,7 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     // A candidate of an effect the model has (a harmonic order beside the model's orders)
     // joins that term (ModelSpec::add); any other is a term of its own, the last.
     const bool own_term = with.terms.size() > fit.model.spec().terms.size();
-    std::size_t at = with.terms.size() - 1;
-    while (!own_term && with.terms[at].effect != term.effect) --at;
+    const std::size_t at = term_index(with, term);
     // The model's terms start at its converged fit (their valleys chosen there, with
     // their other starts); the candidate's own parameters are started again, unless
     // the options settle it (a live window's refit starts where the last window's
@@ -363,33 +381,47 @@ void refit_nonlinear(Ranking& out, const PreparedLog& log, const ModelFit& fit, 
     if (!fr.ok || !fr.converged) continue;
     c.refitted = true;
     score_candidate(c, fr.last, log.rd, base, floors, options);
-    // The candidate's own parameters, by name (a joined term has the model's too).
-    c.params.clear();
-    for (const ModelParameter& q : term_params(dm, at, fr.last, false)) {
-      for (std::size_t k = 0; k < term.params.size(); ++k) {
-        if (q.name == term.param_name(k)) c.params.push_back(q);
-      }
-    }
+    c.params = own_params(term, term_params(dm, at, fr.last, false));
     c.reason = reason_of(term, c.params);
   }
 }
 
-/// The model with candidate `term` in place of its term `replaced`, fitted exactly (the model's other
-/// terms settled at their fit, the candidate started again); nullopt where that fit does
-/// not converge.
-std::optional<Candidate> swapped_fit(const ModelTerm& term, std::size_t replaced, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
+/// The model without `part` of its term `replaced` (the whole term, or the parameters of it
+/// that a candidate aliases: harmonics(k2,k2_q) of harmonics(k2,k3,k2_q,k3_q)), the taken
+/// parameters at their neutral values.
+void take_out(ModelSpec& spec, std::vector<std::vector<double>>& values, std::size_t replaced, const ModelTerm& part) {
+  ModelTerm& t = spec.terms[replaced];
+  if (part.params.size() >= t.params.size()) {
+    spec.terms.erase(spec.terms.begin() + static_cast<std::ptrdiff_t>(replaced));
+    values.erase(values.begin() + static_cast<std::ptrdiff_t>(replaced));
+    return;
+  }
+  for (const int p : part.params) {
+    std::erase(t.params, p);
+    const auto i = static_cast<std::size_t>(p);
+    if (i < values[replaced].size()) values[replaced][i] = t.effect->params()[i].neutral;
+  }
+}
+
+/// The model with candidate `term` in place of `part` of its term `replaced` (take_out),
+/// fitted exactly (the model's other terms settled at their fit, the candidate started
+/// again; one that joins a model term starts from zero beside that term's fitted orders);
+/// nullopt where that fit does not converge.
+std::optional<Candidate> swapped_fit(const ModelTerm& term, std::size_t replaced, const ModelTerm& part, const PreparedLog& log, const ModelFit& fit, const StepSolution& base,
                                      const GroupFloors& floors, const DiscoveryOptions& options, int& passes) {
   ModelSpec swapped = fit.model.spec();
   std::vector<std::vector<double>> values = fit.model.values();
-  const std::string replaced_reference = swapped.terms[replaced].reference();
-  swapped.terms.erase(swapped.terms.begin() + static_cast<std::ptrdiff_t>(replaced));
-  values.erase(values.begin() + static_cast<std::ptrdiff_t>(replaced));
-  swapped.terms.push_back(term);
-  values.emplace_back();
+  const std::string replaced_reference = part.reference();
+  take_out(swapped, values, replaced, part);
+  const std::size_t before = swapped.terms.size();
+  swapped.add(term);
+  const bool own_term = swapped.terms.size() > before;
+  if (own_term) values.emplace_back();
+  const std::size_t at = term_index(swapped, term);
   Design dm(swapped, values, nuisances_for(log));
   dm.set_parts(log.part_count());
   std::vector<bool> settled(dm.terms().size(), true);
-  settled.back() = false;
+  if (own_term) settled[at] = false;
   const FitResult fr = fit_design(dm, log.rows, floors, 12, {}, settled);
   passes += fr.passes;
   if (!fr.ok || !fr.converged) return std::nullopt;
@@ -398,7 +430,7 @@ std::optional<Candidate> swapped_fit(const ModelTerm& term, std::size_t replaced
   out.replaces = replaced_reference;
   out.refitted = true;
   score_candidate(out, fr.last, log.rd, base, floors, options);
-  out.params = term_params(dm, dm.terms().size() - 1, fr.last, false);
+  out.params = own_params(term, term_params(dm, at, fr.last, false));
   out.reason = reason_of(term, out.params) + " In place of " + replaced_reference +
                ": with both in the model the fit cannot separate them (aliases at first order).";
   return out;
@@ -408,8 +440,8 @@ std::optional<Candidate> swapped_fit(const ModelTerm& term, std::size_t replaced
 struct Alias {
   std::optional<std::size_t> candidate;  ///< index in the ranking's candidates (none: not separable there)
   ModelTerm term;                     ///< the candidate's
-  std::vector<std::string> replaced;  ///< the model terms it aliases, by reference
-  std::vector<std::size_t> at;        ///< and their indices in the model
+  std::vector<ModelTerm> replaced;  ///< what of the model it aliases: a term, or the part of it the candidate names
+  std::vector<std::size_t> at;     ///< the model's terms they are of
 };
 
 /// The model terms candidate `c` aliases (fit_support.h aliased_terms on `rows`, the model
@@ -418,16 +450,30 @@ std::optional<Alias> alias_of(const ModelTerm& term, std::optional<std::size_t> 
                               const ModelFit& fit, std::span<const FitRow> rows, const GroupFloors& floors) {
   ModelSpec with = fit.model.spec();
   with.add(term);
-  if (with.terms.size() == fit.model.spec().terms.size()) return std::nullopt;  // joins a term of the model
+  const std::size_t own = term_index(with, term);
+  const ModelTerm& joined = with.terms[own];
+  if (joined.params.size() == (own < fit.model.spec().terms.size() ? fit.model.spec().terms[own].params.size() : 0U)) {
+    return std::nullopt;  // the model has the candidate's parameters already
+  }
   const std::vector<std::size_t> aliased = aliased_terms(design_for(Model(with, log.p_r, log.p), log), rows, floors);
-  const std::size_t own = with.terms.size() - 1;
   // Only with another term: a column that is zero at the start (a nonlinear parameter at
   // its neutral value) makes the candidate alone "aliased", and the fit steps past it.
   if (std::find(aliased.begin(), aliased.end(), own) == aliased.end() || aliased.size() < 2) return std::nullopt;
   Alias out{index, term, {}, {}};
+  const std::vector<std::string> declared = term.effect->first_order_aliases(term.params, log.p_r);
   for (const std::size_t m : aliased) {
-    if (m == own) continue;
-    out.replaced.push_back(with.terms[m].reference());
+    if (m == own) continue;  // a term the candidate joins is kept, with it
+    ModelTerm part = with.terms[m];
+    // Of a term with more orders than the candidate aliases, only those it names
+    // (eccentricity at p_r = 1 takes k2 of harmonics(k2,k3,k2_q,k3_q), not k3).
+    for (const std::string& reference : declared) {
+      const ModelTerm d = ModelSpec::parse(std::vector<std::string>{reference}).terms.front();
+      const bool within = d.effect == part.effect && std::all_of(d.params.begin(), d.params.end(), [&](int p) {
+        return std::find(part.params.begin(), part.params.end(), p) != part.params.end();
+      });
+      if (within) part = d;
+    }
+    out.replaced.push_back(std::move(part));
     out.at.push_back(m);
   }
   return out;
@@ -462,6 +508,18 @@ void offer_swaps(Ranking& out, std::span<const ModelTerm> unseparated, const Pre
   for (const ModelTerm& t : unseparated) {
     if (!is_family(t)) check(t, std::nullopt);
   }
+  // Each model term's own aliases at the log's p_r (Effect::first_order_aliases): once the
+  // model's term took their orders the residual no longer asks for them, so they are not
+  // listed (at p_r = 1 a mechanical pair of order 2 stands for harmonics(k3,k3_q) and the
+  // quadrature).
+  for (const ModelTerm& m : fit.model.spec().terms) {
+    for (const std::string& reference : m.effect->first_order_aliases(m.params, log.p_r)) {
+      const ModelTerm t = ModelSpec::parse(std::vector<std::string>{reference}, options.customs).terms.front();
+      if (t.effect->needs_reference() && !log.reference) continue;
+      if (already_listed(out.candidates, reference)) continue;  // checked above, as listed
+      check(t, std::nullopt);
+    }
+  }
   const int stride = static_cast<int>(kAliasRowStride);
   out.passes += (checked + stride - 1) / stride;
   std::vector<Candidate> swaps;
@@ -470,16 +528,19 @@ void offer_swaps(Ranking& out, std::span<const ModelTerm> unseparated, const Pre
     const std::size_t before = swaps.size();
     if (fitted < kSwapFits) {
       ++fitted;
-      for (const std::size_t m : a.at) {
-        if (std::optional<Candidate> s = swapped_fit(a.term, m, log, fit, base, floors, options, out.passes)) {
+      for (std::size_t k = 0; k < a.at.size(); ++k) {
+        if (std::optional<Candidate> s = swapped_fit(a.term, a.at[k], a.replaced[k], log, fit, base, floors, options, out.passes)) {
           swaps.push_back(std::move(*s));
         }
       }
     }
     if (!a.candidate) continue;
     Candidate& c = out.candidates[*a.candidate];
+    std::vector<std::string> names;
+    names.reserve(a.replaced.size());
+    for (const ModelTerm& t : a.replaced) names.push_back(t.reference());
     c.reason += fmt::format(" Not an addition: with the model it is not separable from {} (aliases at first order){}.",
-                            fmt::join(a.replaced, ", "), swaps.size() > before ? "; listed in place of it" : "");
+                            fmt::join(names, ", "), swaps.size() > before ? "; listed in place of it" : "");
     c.proposed = false;
   }
   for (Candidate& s : swaps) out.candidates.push_back(std::move(s));
@@ -536,8 +597,14 @@ void family_first_only_alone(std::vector<Candidate>& candidates) {
   if (smaller != candidates.end()) std::rotate(candidates.begin(), smaller, smaller + 1);
 }
 
+/// By score, the proposed ones first: a candidate is unproposed below its score where the
+/// fit would refuse it beside the model (an alias of its terms: offer_swaps), and the swap
+/// that fits it in their place, a little worse by the BIC, is the change to make.
 void sort_by_score(std::vector<Candidate>& candidates) {
-  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) { return a.score < b.score; });
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    if (a.proposed != b.proposed) return a.proposed;
+    return a.score < b.score;
+  });
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "daemon/core/angles.h"
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
 
 namespace resolver {
 
@@ -39,6 +40,10 @@ class AmplitudeImbalanceEffect final : public BasicEffect {
                      "a gain error of the cos channel: position error at 2 theta in phase with sin 2 theta, "
                      "independent of speed, and a cos-envelope amplitude off by alpha"},
                     kAmplitudeImbalanceParams, EffectStage::kWindings) {}
+  // e^{-2i theta} of the envelopes: a 2 theta rotation's other side (first_order_aliases.h).
+  [[nodiscard]] std::vector<std::string> first_order_aliases(std::span<const int> /*params*/, int p_r) const override {
+    return rotation_terms_at_order(2, p_r);
+  }
   void validate(Values v) const override {
     if (!(AmplitudeImbalanceParams(v)["alpha"] > -1.0)) {
       throw std::invalid_argument("amplitude_imbalance.alpha must be > -1 (a cos gain 1 + alpha > 0)");

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
 
 namespace resolver {
 
@@ -49,6 +50,10 @@ class EccentricityEffect final : public BasicEffect {
                     kEccentricityParams, EffectStage::kMotion) {}
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta_m = 1}; }
   [[nodiscard]] bool needs_reference() const override { return true; }
+  // At p_r = 1 its 1x mechanical is 1 theta: the order-1 winding terms' alias.
+  [[nodiscard]] std::vector<std::string> first_order_aliases(std::span<const int> /*params*/, int p_r) const override {
+    return p_r == 1 ? winding_terms_at_order(1) : std::vector<std::string>{};
+  }
   [[nodiscard]] bool active(Values v) const override { return EccentricityParams(v)["e"] != 0.0; }
   void validate(Values v) const override {
     if (!(std::abs(EccentricityParams(v)["e"]) < 1.0)) {

@@ -195,6 +195,15 @@ class Effect {
       const ResidualSpectrum& /*residual*/, bool /*families*/) const {
     return std::nullopt;
   }
+  /// Terms of other effects that land, at first order and at this p_r, on the same
+  /// harmonics of the envelopes as the fitted parameters `params` (first_order_aliases.h:
+  /// a mechanical pair of a whole electrical order and that order's winding terms), as
+  /// effect references. Discovery fits each in place of the model's term, since the
+  /// residual no longer asks for the orders the model's alias took (ranking.cpp).
+  [[nodiscard]] virtual std::vector<std::string> first_order_aliases(std::span<const int> /*params*/,
+                                                                     int /*p_r*/) const {
+    return {};
+  }
   /// The harmonic orders the columns of the fitted parameters `params` use.
   /// Default by stage: windings/channels/converter 2 theta, motion 0, currents 1 theta_e.
   [[nodiscard]] virtual HarmonicOrders orders(std::span<const int> params) const;

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
 
 namespace resolver {
 
@@ -69,6 +70,24 @@ class HarmonicsEffect final : public BasicEffect {
       }
     }
     return {.theta = top};
+  }
+  // K_n lands on e^{i n theta} of the envelopes, K_n_opp on e^{-i n theta}: a rotation of
+  // the seen angle by (n - 1) theta, resp. (n + 1) theta, does too (first_order_aliases.h).
+  [[nodiscard]] std::vector<std::string> first_order_aliases(std::span<const int> params, int p_r) const override {
+    std::vector<std::string> out;
+    for (int p : params) {
+      const auto i = static_cast<std::size_t>(p);
+      for (int n = 2; n <= kHarmonicsMaxOrder; ++n) {
+        const HarmonicKeys& k = harmonic_keys(n);
+        const bool same = i == k.same.index() || i == k.same_q.index();
+        const bool opp = i == k.opp.index() || i == k.opp_q.index();
+        if (!same && !opp) continue;
+        for (std::string& r : rotation_terms_at_order(same ? n - 1 : n + 1, p_r)) {
+          if (std::find(out.begin(), out.end(), r) == out.end()) out.push_back(std::move(r));
+        }
+      }
+    }
+    return out;
   }
   // A residual at order m of theta is K_{m+1} (same sign) or K_{m-1} opposite
   // (m >= 3), K_0 / K_2 at m = 1 (Hanselman eq. 8-9). Each order alone (in phase

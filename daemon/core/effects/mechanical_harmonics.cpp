@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
 #include "daemon/core/effects/param_set.h"
 
 namespace resolver {
@@ -87,6 +88,22 @@ class MechanicalHarmonicsEffect final : public BasicEffect {
     return {.theta_m = top};
   }
   [[nodiscard]] bool needs_reference() const override { return true; }
+  // An order that is a whole electrical one, m = n / p_r, rotates the envelopes as that
+  // order's winding terms do at first order (first_order_aliases.h).
+  [[nodiscard]] std::vector<std::string> first_order_aliases(std::span<const int> params, int p_r) const override {
+    std::vector<std::string> out;
+    for (int n = 1; n <= kMaxMechanicalOrder; ++n) {
+      const OrderKeys& k = order_keys(n);
+      const bool fitted = std::any_of(params.begin(), params.end(), [&](int p) {
+        return static_cast<std::size_t>(p) == k.a.index() || static_cast<std::size_t>(p) == k.b.index();
+      });
+      if (!fitted || p_r < 1 || n % p_r != 0) continue;
+      for (std::string& r : winding_terms_at_order(n / p_r)) {
+        if (std::find(out.begin(), out.end(), r) == out.end()) out.push_back(std::move(r));
+      }
+    }
+    return out;
+  }
   // An order's (a_n, b_n) pair at the orders the residual shows over the mechanical
   // turn, from 2 (order 1 is eccentricity's, a candidate of its own); offline also
   // every significant order as one family.

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
 
 namespace resolver {
 
@@ -25,6 +26,10 @@ class OffsetsEffect final : public BasicEffect {
                     kOffsetsParams, EffectStage::kWindings) {}
   [[nodiscard]] bool envelope_only() const override { return true; }
   [[nodiscard]] HarmonicOrders orders(std::span<const int> /*p*/) const override { return {.theta = 1}; }
+  // The constant of a 1 theta rotation of the envelopes (first_order_aliases.h).
+  [[nodiscard]] std::vector<std::string> first_order_aliases(std::span<const int> /*params*/, int p_r) const override {
+    return rotation_terms_at_order(1, p_r);
+  }
   void windings(Values v, WindingStage stage, double /*theta*/, SinCos& env) const override {
     if (stage == WindingStage::kOffset) env = apply_offsets(OffsetsParams(v), env);
   }

@@ -5,6 +5,7 @@
 
 #include "daemon/core/angles.h"
 #include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
 
 namespace resolver {
 
@@ -27,6 +28,10 @@ class QuadratureEffect final : public BasicEffect {
                      "the cos winding is not at 90 degrees: position error at 2 theta in phase with cos 2 theta plus "
                      "a constant, independent of speed, seen by the R/D angle and the sin/cos signals alike"},
                     kQuadratureParams, EffectStage::kWindings) {}
+  // e^{-2i theta} of the envelopes: a 2 theta rotation's other side (first_order_aliases.h).
+  [[nodiscard]] std::vector<std::string> first_order_aliases(std::span<const int> /*params*/, int p_r) const override {
+    return rotation_terms_at_order(2, p_r);
+  }
   void windings(Values v, WindingStage stage, double theta, SinCos& env) const override {
     if (stage == WindingStage::kFundamental) env = quadrature_fundamental(QuadratureParams(v), theta);
   }

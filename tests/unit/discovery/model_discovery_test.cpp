@@ -15,6 +15,9 @@
 #include "daemon/core/discovery/model_discovery.h"
 #include "tests/unit/discovery/simulated_input.h"
 #include "daemon/core/effects/chain_values.h"
+#include "daemon/core/effects/effect.h"
+#include "daemon/core/effects/first_order_aliases.h"
+#include "daemon/core/model/model_spec.h"
 #include "daemon/decode/bench_layout.h"
 #include "tools/sim/bench_simulator.h"
 
@@ -330,6 +333,83 @@ TEST(ModelDiscovery, AModelOfAliasesNamesThem) {
   EXPECT_NO_THROW((void)fit_model(in, std::vector<std::string>(aliased.begin(), aliased.end() - 1), kAligned));
   EXPECT_NO_THROW((void)fit_model(in, std::vector<std::string>{"amplitude_imbalance", "quadrature", "harmonics(k3,k3_q)"},
                                   kAligned));
+}
+
+/// The aliases effect `reference` declares at p_r (Effect::first_order_aliases).
+std::vector<std::string> declared_aliases(const std::string& reference, int p_r) {
+  const ModelTerm t = ModelSpec::parse(std::vector<std::string>{reference}).terms.front();
+  return t.effect->first_order_aliases(t.params, p_r);
+}
+
+TEST(ModelDiscovery, EveryDeclaredAliasIsOneAtFirstOrder) {
+  // A rotation of the seen angle at a whole electrical order m is, at first order, a
+  // combination of that order's winding terms (first_order_aliases.h): the model of the
+  // rotation and all of them is not separable at its start values, and without the rotation
+  // it is. Checked through the fit on a log with sin/cos and the reference, at p_r 1 and
+  // 3, for every rotation term of orders 1 and 2; each winding term names the rotation
+  // back. The control is the same check at a p_r where the order is not whole.
+  for (const int p_r : {1, 3}) {
+    const auto in = simulate({"amplitude_imbalance:alpha=0.003"}, {{2.0, 200.0, 200.0}}, 0.0, 1, p_r);
+    for (const int m : {1, 2}) {
+      for (const std::string& rotation : rotation_terms_at_order(m, p_r)) {
+        const std::vector<std::string> windings = declared_aliases(rotation, p_r);
+        ASSERT_EQ(windings, winding_terms_at_order(m)) << rotation << " at p_r " << p_r;
+        std::vector<std::string> all = windings;
+        all.push_back(rotation);
+        try {
+          (void)fit_model(in, all, kAligned);
+          ADD_FAILURE() << rotation << " and its aliases were fitted at p_r " << p_r;
+        } catch (const std::invalid_argument& e) {
+          EXPECT_NE(std::string(e.what()).find("not separable"), std::string::npos) << e.what();
+        }
+        // Nor is the rotation the fault: beside all but one of the winding terms it fits.
+        std::vector<std::string> fewer(windings.begin() + 1, windings.end());
+        fewer.push_back(rotation);
+        EXPECT_NO_THROW((void)fit_model(in, fewer, kAligned)) << rotation << " at p_r " << p_r;
+        EXPECT_NO_THROW((void)fit_model(in, windings, kAligned)) << rotation << " at p_r " << p_r;
+        for (const std::string& w : windings) {
+          const std::vector<std::string> back = declared_aliases(w, p_r);
+          EXPECT_NE(std::find(back.begin(), back.end(), rotation), back.end()) << w << " does not name " << rotation;
+        }
+      }
+    }
+  }
+  // The control: order 1 mechanical at p_r 3 is a third of 1 theta, no winding term's.
+  EXPECT_TRUE(declared_aliases("mechanical_harmonics(a1,b1)", 3).empty());
+  const auto in3 = simulate({"amplitude_imbalance:alpha=0.003"}, {{2.0, 200.0, 200.0}}, 0.0, 1, 3);
+  std::vector<std::string> control = winding_terms_at_order(1);
+  control.emplace_back("mechanical_harmonics(a1,b1)");
+  EXPECT_NO_THROW((void)fit_model(in3, control, kAligned));
+}
+
+TEST(ModelDiscovery, AtPr1TheModelsWindingAliasOfAnEccentricityIsSwapped) {
+  // At p_r = 1 an eccentricity rotates the envelopes at 1 theta: at first order the offsets
+  // and harmonics(k2,k2_q) together (first_order_aliases.h). A model that took k2 for it
+  // (the residual asks for 1 theta and k2 is a winding term) is separable only at second
+  // order from the eccentricity, which is then never listed as an addition; it is offered
+  // in place of the k2 pair alone, not of the whole harmonics term (k3 stays).
+  const std::vector<std::string> sensor{"amplitude_imbalance:alpha=-0.08", "offsets:o_s=-0.01,o_c=0.025",
+                                        "harmonics:k3=-0.012,k3_q=0.015", "eccentricity:e=0.01,phase=2.2"};
+  const auto in = simulate(sensor, {{5.0, 200.0, 200.0}}, 0.0, 1, 1);
+  const std::vector<std::string> took_k2{"amplitude_imbalance", "offsets", "tracking_loop", "harmonics(k2,k3,k2_q,k3_q)"};
+  const Explanation ex = explain_model(in, took_k2, offline_aligned());
+  EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
+  ASSERT_FALSE(ex.candidates.empty());
+  const Candidate& first = ex.candidates.front();
+  EXPECT_EQ(first.effect, "eccentricity");
+  EXPECT_EQ(first.replaces, "harmonics(k2,k2_q)");
+  EXPECT_TRUE(first.reaches_floor);
+  ASSERT_EQ(first.params.size(), 2U);
+  // Within 4 standard errors of the truth (1 in 16,000 by chance each).
+  EXPECT_NEAR(first.params[0].value, 0.01, 4.0 * first.params[0].std_error);
+  EXPECT_NEAR(first.params[1].value, 2.2, 4.0 * first.params[1].std_error);
+  for (const Candidate& c : ex.candidates) EXPECT_FALSE(c.proposed && c.effect == "eccentricity" && c.replaces.empty());
+  // The control: a model that took no alias for it is offered the eccentricity as an addition.
+  const Explanation plain = explain_model(
+      in, std::vector<std::string>{"amplitude_imbalance", "offsets", "tracking_loop", "harmonics(k3,k3_q)"}, offline_aligned());
+  ASSERT_FALSE(plain.candidates.empty());
+  EXPECT_EQ(plain.candidates.front().effect, "eccentricity");
+  EXPECT_TRUE(plain.candidates.front().replaces.empty());
 }
 
 TEST(ModelDiscovery, AFitThatStopsOnASlopeIsNeverExplained) {

@@ -1,6 +1,6 @@
 // A log of the default bench simulated in memory (BenchSimulator: R/D loop
 // omega_n = 3000 rad/s, ADC noise 2 counts, 16-bit R/D) as discovery's input, with
-// the given effect specs ("amplitude_imbalance:alpha=0.003") and speed profile.
+// the given effect specs ("amplitude_imbalance:alpha=0.003"), speed profile and p_r.
 #pragma once
 
 #include <cstdint>
@@ -16,9 +16,10 @@
 namespace resolver {
 
 inline DiscoveryInput simulate(const std::vector<std::string>& specs, std::vector<SpeedSegment> profile = {{5.0, 200.0, 200.0}},
-                        double alpha_drift_per_s = 0.0, std::uint64_t seed = 1) {
+                        double alpha_drift_per_s = 0.0, std::uint64_t seed = 1, int p_r = 0) {
   SimConfig cfg;
   cfg.seed = seed;
+  if (p_r > 0) cfg.p_r = p_r;  // else the bench's (3)
   cfg.profile = std::move(profile);
   cfg.alpha_drift_per_s = alpha_drift_per_s;
   for (const auto& s : specs) {
