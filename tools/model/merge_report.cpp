@@ -73,7 +73,7 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
     const bool linear = !best->stepped;
     const bool held = std::find(m.held.begin(), m.held.end(), best->effect) != m.held.end();
     return {"missing_effect",
-            "adding " + best->effect +
+            best->change() +
                 (best->reaches_floor ? " brings every signal to within " + ratio + "x its floor: "
                                      : " removes most of the residual above the floor: ") +
                 best->reason +

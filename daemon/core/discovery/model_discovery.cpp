@@ -554,7 +554,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     ex.verdict = Verdict::kMissingEffect;
     ex.summary = "missing_effect: two effects are missing: " + ex.missing_pair[0] + " and " + ex.missing_pair[1] +
                  " together bring every signal to within " + num(options.explained_ratio) +
-                 "x its noise floor (neither does alone); " + (best->replaces.empty() ? "add " + best->effect : "put " + best->effect + " in place of " + best->replaces) + " first. " + best->reason;
+                 "x its noise floor (neither does alone); " + best->change(true) + " first. " + best->reason;
   } else if (named) {
     ex.verdict = Verdict::kMissingEffect;
     struct Change {
@@ -571,9 +571,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     const Change& c = *std::max_element(changes.begin(), changes.end(), [](const Change& x, const Change& y) {
       return (x.before - x.after) / x.floor < (y.before - y.after) / y.floor;
     });
-    const std::string change =
-        best->replaces.empty() ? "adding " + best->effect : best->effect + " in place of " + best->replaces;
-    ex.summary = "missing_effect: " + change + " brings the " + c.what + " residual from " +
+    ex.summary = "missing_effect: " + best->change() + " brings the " + c.what + " residual from " +
                  num(c.before) + " to " + num(c.after) + c.unit + " (floor " + num(c.floor) + "); " + best->reason +
                  alternatives;
   } else {

@@ -271,6 +271,13 @@ struct Candidate {
   /// (fit_support.h aliased_terms; a mechanical harmonic at a whole electrical order and
   /// the winding harmonics of that order). Its score is that of the model with the swap.
   std::string replaces;
+
+  /// The change to the model it stands for, as a summary names it: "adding X" or "X in
+  /// place of Y"; `imperative`: "add X" or "put X in place of Y".
+  [[nodiscard]] std::string change(bool imperative = false) const {
+    if (replaces.empty()) return (imperative ? "add " : "adding ") + effect;
+    return (imperative ? "put " : "") + effect + " in place of " + replaces;
+  }
 };
 
 /// Whether a candidate that leaves `weighted_rss_after` (a row at its floor weighs 1)
