@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -287,18 +288,25 @@ DiscoveryOptions offline_aligned() {
   return o;
 }
 
+/// The first candidate of `ex`, checked to be `effect` in place of `replaces`, reaching the
+/// floor, on a log the model does not explain.
+const Candidate& expect_swap_first(const Explanation& ex, const std::string& effect, const std::string& replaces) {
+  EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
+  if (ex.candidates.empty()) throw std::runtime_error("no candidates: " + ex.summary);
+  const Candidate& first = ex.candidates.front();
+  EXPECT_EQ(first.effect, effect);
+  EXPECT_EQ(first.replaces, replaces);
+  EXPECT_TRUE(first.reaches_floor);
+  return first;
+}
+
 TEST(ModelDiscovery, AnAliasOfTheModelIsOfferedInPlaceOfIt) {
   const auto in = simulate(kWindings);
   const Explanation ex =
       explain_model(in, std::vector<std::string>{"amplitude_imbalance", "quadrature", "tracking_loop",
                                                  "mechanical_harmonics(a6,b6)"},
                     offline_aligned());
-  EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
-  ASSERT_FALSE(ex.candidates.empty());
-  const Candidate& first = ex.candidates.front();
-  EXPECT_EQ(first.effect, "harmonics(k3,k3_q)");
-  EXPECT_EQ(first.replaces, "mechanical_harmonics(a6,b6)");
-  EXPECT_TRUE(first.reaches_floor);
+  const Candidate& first = expect_swap_first(ex, "harmonics(k3,k3_q)", "mechanical_harmonics(a6,b6)");
   EXPECT_NE(ex.summary.find("in place of mechanical_harmonics(a6,b6)"), std::string::npos) << ex.summary;
   ASSERT_EQ(first.params.size(), 2U);
   // Within 4 standard errors of the truth (1 in 16,000 by chance each).
@@ -393,12 +401,7 @@ TEST(ModelDiscovery, AtPr1TheModelsWindingAliasOfAnEccentricityIsSwapped) {
   const auto in = simulate(sensor, {{5.0, 200.0, 200.0}}, 0.0, 1, 1);
   const std::vector<std::string> took_k2{"amplitude_imbalance", "offsets", "tracking_loop", "harmonics(k2,k3,k2_q,k3_q)"};
   const Explanation ex = explain_model(in, took_k2, offline_aligned());
-  EXPECT_EQ(ex.verdict, Verdict::kMissingEffect) << ex.summary;
-  ASSERT_FALSE(ex.candidates.empty());
-  const Candidate& first = ex.candidates.front();
-  EXPECT_EQ(first.effect, "eccentricity");
-  EXPECT_EQ(first.replaces, "harmonics(k2,k2_q)");
-  EXPECT_TRUE(first.reaches_floor);
+  const Candidate& first = expect_swap_first(ex, "eccentricity", "harmonics(k2,k2_q)");
   ASSERT_EQ(first.params.size(), 2U);
   // Within 4 standard errors of the truth (1 in 16,000 by chance each).
   EXPECT_NEAR(first.params[0].value, 0.01, 4.0 * first.params[0].std_error);
@@ -410,6 +413,28 @@ TEST(ModelDiscovery, AtPr1TheModelsWindingAliasOfAnEccentricityIsSwapped) {
   ASSERT_FALSE(plain.candidates.empty());
   EXPECT_EQ(plain.candidates.front().effect, "eccentricity");
   EXPECT_TRUE(plain.candidates.front().replaces.empty());
+}
+
+bool says_not_needed(const ModelFit& f, const std::string& reference) {
+  return std::any_of(f.notes.begin(), f.notes.end(), [&](const std::string& n) {
+    return n.rfind(reference + " is not needed to explain this log", 0) == 0;
+  });
+}
+
+TEST(ModelDiscovery, AnExplainedModelSaysWhichTermTheLogDoesNotNeed) {
+  // A mechanical pair the sensor lacks, fitted beside the gain error it has: the model is
+  // explained, the pair fitted to noise; the note names it (and not the gain error).
+  const auto in = simulate({"amplitude_imbalance:alpha=0.003"});
+  const ModelFit f = fit_model(in, std::vector<std::string>{"amplitude_imbalance", "mechanical_harmonics(a6,b6)"}, kAligned);
+  ASSERT_TRUE(f.explained);
+  EXPECT_TRUE(says_not_needed(f, "mechanical_harmonics(a6,b6)"));
+  EXPECT_FALSE(says_not_needed(f, "amplitude_imbalance"));
+  // The control: a 0.2 % quadrature the sensor has is needed.
+  const auto with = simulate({"amplitude_imbalance:alpha=0.003", "quadrature:beta=0.002"});
+  const ModelFit g = fit_model(with, std::vector<std::string>{"amplitude_imbalance", "quadrature"}, kAligned);
+  ASSERT_TRUE(g.explained);
+  EXPECT_FALSE(says_not_needed(g, "quadrature"));
+  EXPECT_FALSE(says_not_needed(g, "amplitude_imbalance"));
 }
 
 TEST(ModelDiscovery, AFitThatStopsOnASlopeIsNeverExplained) {
