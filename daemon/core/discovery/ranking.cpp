@@ -450,11 +450,8 @@ std::optional<Alias> alias_of(const ModelTerm& term, std::optional<std::size_t> 
                               const ModelFit& fit, std::span<const FitRow> rows, const GroupFloors& floors) {
   ModelSpec with = fit.model.spec();
   with.add(term);
+  if (with.parameter_count() == fit.model.spec().parameter_count()) return std::nullopt;  // the model has them already
   const std::size_t own = term_index(with, term);
-  const ModelTerm& joined = with.terms[own];
-  if (joined.params.size() == (own < fit.model.spec().terms.size() ? fit.model.spec().terms[own].params.size() : 0U)) {
-    return std::nullopt;  // the model has the candidate's parameters already
-  }
   const std::vector<std::size_t> aliased = aliased_terms(design_for(Model(with, log.p_r, log.p), log), rows, floors);
   // Only with another term: a column that is zero at the start (a nonlinear parameter at
   // its neutral value) makes the candidate alone "aliased", and the fit steps past it.
