@@ -281,7 +281,7 @@ namespace {
 bool step_negligible(const StepSolution& s, double cost) { return step_in_standard_errors(s, cost) <= kNegligibleStepSe; }
 
 FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
-                         const std::function<void()>& progress) {
+                         const std::function<void()>& progress, bool settled_start) {
   FitResult out;
   // Model columns only: candidates are evaluated at the model's solution later.
   std::vector<int> model_cols;
@@ -300,14 +300,20 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   // columns are all zero at the neutral start, so a joint first step is a guess in
   // an ill-conditioned direction (a loop once jumped to omega_n = 13 rad/s, filtered
   // everything and stayed on that plateau at 364x the floor).
+  // From a settled start (every model term at a converged fit: a live window started
+  // where the last one ended) those columns are not zero and the joint step is the
+  // right one: holding the nonlinear parameters would only cost a pass.
   std::vector<int> warm_cols;
   for (int c : model_cols) {
-    if (!column_is_nonlinear(design, c)) warm_cols.push_back(c);
+    if (settled_start || !column_is_nonlinear(design, c)) warm_cols.push_back(c);
   }
   const std::vector<int> zero_cols = linear ? std::vector<int>{} : frame_constant_columns(design);
   // Start in the sensor's frame: the constant alone at the starting values (its
   // error is the windings' mean angle error, ~beta/2). From a frame half a turn
   // away the first step would fit every harmonic turned and could only go uphill.
+  // (A settled start still takes this pass: started at the last window's shift, a fit
+  // under a model far from the floor kept that point, whose cost was lower than where the
+  // constant's steps converge, and ended 0.75 standard errors from the cold fit.)
   if (!zero_cols.empty()) out.passes += fit_frame_shift(design, rows, floors, 1);
   double lambda = 0.0;
   double cost = std::numeric_limits<double>::infinity();
@@ -315,6 +321,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
   PassStatistics good_stats(design.columns());  // at last_good: a step back costs no pass
   bool back = false;
   bool stepped = false;  // design is a step from last_good, not yet taken as good
+  double last_step_se = std::numeric_limits<double>::infinity();  // that step's move, undamped
   for (int pass = 0; pass < max_passes; ++pass) {
     PassStatistics stats(design.columns());
     if (back) {
@@ -342,7 +349,11 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       // the floor).
       design = last_good;
       stepped = false;
-      if (lambda >= kLastDamping) {
+      // An undamped step worth less than the negligible move (step_negligible) that went
+      // uphill all the same is the linearisation's own error at the solution (numeric
+      // derivatives, curvature): a damped one could gain less still, so the last good
+      // point is the fit (the damping took 3-4 more passes to end there).
+      if (lambda >= kLastDamping || (lambda == 0.0 && last_step_se <= kNegligibleStepSe)) {
         out.last = solve_step(good_stats.all, floors, model_cols, 0.0);
         out.stats = std::move(good_stats);
         out.cost = cost;
@@ -404,6 +415,7 @@ FitResult fit_from_start(Design& design, std::span<const FitRow> rows, const Gro
       }
     }
     out.last = sol;
+    last_step_se = step_in_standard_errors(sol, here);
     out.stats = std::move(stats);
     design.step(sol.dz);
     stepped = true;
@@ -467,7 +479,11 @@ double step_in_standard_errors(const StepSolution& s, double cost) {
 FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors, int max_passes,
                      const std::function<void()>& progress, const std::vector<bool>& settled) {
   const Design start = design;
-  FitResult best = fit_from_start(design, rows, floors, max_passes, progress);
+  bool settled_start = !settled.empty();
+  for (std::size_t i = 0; i < start.terms().size(); ++i) {
+    if (!start.terms()[i].candidate) settled_start = settled_start && i < settled.size() && settled[i];
+  }
+  FitResult best = fit_from_start(design, rows, floors, max_passes, progress, settled_start);
   // Several starts for the parameters whose cost is multimodal: keep the lowest cost
   // among the fits that ended (issue 21: a single start diverged into a far valley).
   for (std::size_t i = 0; i < start.terms().size(); ++i) {
@@ -479,7 +495,7 @@ FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFl
       for (double v : other_starts(info, t.values[static_cast<std::size_t>(p)])) {
         Design trial = start;
         trial.terms()[i].values[static_cast<std::size_t>(p)] = v;
-        FitResult r = fit_from_start(trial, rows, floors, max_passes, progress);
+        FitResult r = fit_from_start(trial, rows, floors, max_passes, progress, false);
         r.passes += best.passes;
         if (r.ok && (!best.ok || r.cost < best.cost)) {
           best = std::move(r);

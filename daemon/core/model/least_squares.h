@@ -109,7 +109,8 @@ struct FitResult {
 /// valleys is fitted from other starts too, unless its term is `settled` (one flag per
 /// design term; empty = none): its values are already a converged fit, whose valley
 /// was chosen then (the model's terms when one more effect is refitted with them, a
-/// chunk started from the merged fit of the log).
+/// chunk started from the merged fit of the log). With every model term settled the
+/// first step moves the nonlinear parameters too (from a neutral start it holds them).
 [[nodiscard]] FitResult fit_design(Design& design, std::span<const FitRow> rows, const GroupFloors& floors,
                                    int max_passes = 12, const std::function<void()>& progress = {},
                                    const std::vector<bool>& settled = {});

@@ -72,40 +72,52 @@ TEST(ModelDiscovery, HiddenQuadratureIsNamedFirstAndExplainedWhenAdded) {
 }
 
 // resolverd's next window starts where the last converged (live_model_fit.h): the model
-// and the exactly refitted candidates settled. At real magnitudes (alpha 5 %, beta 20 mrad:
-// one linearised step leaves beta^2 terms far above the floor, so quadrature is refitted)
-// the warm start must end where a cold fit of the same window does, in fewer passes.
+// and the exactly refitted candidates settled (the first step moves every parameter). At
+// real magnitudes (alpha 5 %, beta 20 mrad: one linearised step leaves beta^2 terms far
+// above the floor, so quadrature is refitted) the warm start must end where a cold fit of
+// the same window does, in fewer passes; with the reference aligned and with its zero
+// left to the fit.
 TEST(ModelDiscovery, AWindowStartedWhereTheLastConvergedEndsWhereAColdFitDoes) {
   const std::vector<std::string> hidden{"amplitude_imbalance:alpha=0.05", "quadrature:beta=0.02"};
-  const Explanation last = explain_model(simulate(hidden, {{5.0, 200.0, 200.0}}, 0.0, 1), kDefault, kAligned);
-  ASSERT_FALSE(last.candidates.empty());
-  ASSERT_EQ(last.candidates.front().effect, "quadrature");
-  ASSERT_TRUE(last.candidates.front().refitted);
-  DiscoveryOptions warm = kAligned;
-  warm.start.values = last.fit.model.parameters();
-  warm.start.settled = last.fit.effects;
-  for (const Candidate& c : last.candidates) {
-    if (!c.refitted) continue;
-    warm.start.values.insert(warm.start.values.end(), c.params.begin(), c.params.end());
-    warm.start.settled.push_back(c.effect);
+  for (const DiscoveryOptions& options : {kAligned, DiscoveryOptions{}}) {
+    SCOPED_TRACE(options.prepare.reference_aligned ? "reference aligned" : "reference's zero fitted");
+    const Explanation last = explain_model(simulate(hidden, {{5.0, 200.0, 200.0}}, 0.0, 1), kDefault, options);
+    ASSERT_FALSE(last.candidates.empty());
+    ASSERT_EQ(last.candidates.front().effect, "quadrature");
+    ASSERT_TRUE(last.candidates.front().refitted);
+    DiscoveryOptions warm = options;
+    warm.start.values = last.fit.model.parameters();
+    warm.start.settled = last.fit.effects;
+    for (const Candidate& c : last.candidates) {
+      if (!c.refitted) continue;
+      warm.start.values.insert(warm.start.values.end(), c.params.begin(), c.params.end());
+      warm.start.settled.push_back(c.effect);
+    }
+    const DiscoveryInput next = simulate(hidden, {{5.0, 200.0, 200.0}}, 0.0, 2);  // other noise
+    const Explanation cold_fit = explain_model(next, kDefault, options);
+    const Explanation warm_fit = explain_model(next, kDefault, warm);
+    EXPECT_EQ(warm_fit.verdict, cold_fit.verdict);
+    ASSERT_FALSE(warm_fit.candidates.empty());
+    ASSERT_EQ(warm_fit.candidates.front().effect, cold_fit.candidates.front().effect);
+    const auto beta = [](const Candidate& c) {
+      return *std::find_if(c.params.begin(), c.params.end(),
+                           [](const ModelParameter& p) { return p.name == "quadrature.beta"; });
+    };
+    const ModelParameter w = beta(warm_fit.candidates.front()), c = beta(cold_fit.candidates.front());
+    // Both end where a step lowers the cost by < 1e-9 of it, or where a step worth less
+    // than 0.3 standard errors goes uphill (least_squares.cpp): the same valley to a
+    // small share of a standard error.
+    EXPECT_NEAR(w.value, c.value, 0.05 * c.std_error);
+    // Against the truth with the reference aligned only: with its zero left to the fit the
+    // cold fit's beta is 0.02003, 45 formal standard errors off (the sim's converter loop,
+    // which this model lacks, and the frame's constant share quadrature's mean angle
+    // error; not diagnosed): this test is about warm = cold.
+    if (options.prepare.reference_aligned) {
+      EXPECT_NEAR(c.value, 0.02, 5.0 * c.std_error + 2e-5);
+    }
+    EXPECT_NEAR(warm_fit.fit.params[0].value, cold_fit.fit.params[0].value, 0.05 * cold_fit.fit.params[0].std_error);
+    EXPECT_LT(warm_fit.fit.passes, cold_fit.fit.passes);
   }
-  const DiscoveryInput next = simulate(hidden, {{5.0, 200.0, 200.0}}, 0.0, 2);  // other noise
-  const Explanation cold_fit = explain_model(next, kDefault, kAligned);
-  const Explanation warm_fit = explain_model(next, kDefault, warm);
-  EXPECT_EQ(warm_fit.verdict, cold_fit.verdict);
-  ASSERT_FALSE(warm_fit.candidates.empty());
-  ASSERT_EQ(warm_fit.candidates.front().effect, cold_fit.candidates.front().effect);
-  const auto beta = [](const Candidate& c) {
-    return *std::find_if(c.params.begin(), c.params.end(),
-                         [](const ModelParameter& p) { return p.name == "quadrature.beta"; });
-  };
-  const ModelParameter w = beta(warm_fit.candidates.front()), c = beta(cold_fit.candidates.front());
-  // Both end where a step lowers the cost by < 1e-9 of it (least_squares.cpp): the same
-  // valley to a small share of a standard error.
-  EXPECT_NEAR(w.value, c.value, 0.05 * c.std_error);
-  EXPECT_NEAR(c.value, 0.02, 5.0 * c.std_error + 2e-5);
-  EXPECT_NEAR(warm_fit.fit.params[0].value, cold_fit.fit.params[0].value, 0.05 * cold_fit.fit.params[0].std_error);
-  EXPECT_LT(warm_fit.fit.passes, cold_fit.fit.passes);
 }
 
 // A candidate's polar pair (eccentricity's e and phase: the design fits their Cartesian
