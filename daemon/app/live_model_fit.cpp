@@ -1,6 +1,8 @@
 #include "daemon/app/live_model_fit.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -15,15 +17,23 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr std::uint32_t kPollEvery = 64;
 /// The fit needs two revolutions (model_discovery.h); a shorter tail is not fitted.
 constexpr double kMinTailRevolutions = 2.0;
-/// Every this many windows one starts cold (header): a speed step moves the valleys of a
-/// loop's omega_n and a delay's phase; a warm start may stay in the old one this long.
-constexpr std::int64_t kColdEvery = 8;
+/// At most this many windows in a row start warm (header): a safety net for a valley that
+/// moved with the operating point held (every 8th window started cold before; a cold
+/// window of a tracking-loop model costs ~8 warm ones: its five omega_n starts).
+constexpr std::int64_t kColdEvery = 32;
+/// A window whose mean speed is this share of the last one's away (or the other way)
+/// starts cold: the valleys of a loop's omega_n and of a delay's phase sit where the
+/// ripple's frequencies (whole multiples of the speed) meet the loop's response and wrap
+/// the delay's phase, so a speed step moves them; a play's take-up flips with direction.
+constexpr double kSpeedMoved = 0.1;
 
-/// Where the next window's fit starts: this one's converged model and the candidates
-/// it refitted to convergence, all settled. Linearised candidates are one step from
-/// neutral, not a fit: they start again from their defaults.
+/// Where the next window's fit starts: this one's converged model and the candidates it
+/// refitted to convergence, all settled. Linearised candidates are one step from
+/// neutral, not a fit: they start again from their defaults. A model fit that did
+/// not converge is no start: the next window starts cold.
 FitStartValues start_after(const Explanation& ex) {
   FitStartValues s;
+  if (!ex.fit.converged) return s;
   s.values = ex.fit.model.parameters();
   s.settled = ex.fit.effects;
   for (const Candidate& c : ex.candidates) {
@@ -35,6 +45,11 @@ FitStartValues start_after(const Explanation& ex) {
 }
 
 }  // namespace
+
+bool operating_point_held(double last_speed, double speed) {
+  if (!std::isfinite(last_speed) || !std::isfinite(speed)) return false;
+  return std::abs(speed - last_speed) <= kSpeedMoved * std::max(std::abs(speed), std::abs(last_speed));
+}
 
 model_fit_t make_model_fit_message(const Explanation* ex, bool candidates, const std::vector<std::string>& effects) {
   model_fit_t m{};
@@ -92,6 +107,7 @@ void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp,
   ++window_samples_;
   for (std::size_t i = 0; i < kSignalFaultCount; ++i) window_faults_[i] += (active_faults >> i) & 1U;
   if (window_.add(sample, p_r, p)) {
+    const double speed = window_.mean_speed();
     DiscoveryInput w = window_.take();
     std::vector<std::string> untrusted = take_window_faults();
     if (running_.valid()) {
@@ -101,7 +117,7 @@ void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp,
       }
       publish_ready(true);
     }
-    start(std::move(w), stamp, std::move(untrusted));
+    start(std::move(w), speed, stamp, std::move(untrusted));
     return;
   }
   if (++since_poll_ >= kPollEvery) {
@@ -113,7 +129,8 @@ void LiveModelFit::add(const Sample& sample, int p_r, int p, const Stamp& stamp,
 void LiveModelFit::finish() {
   publish_ready(true);
   if (window_.revolutions() >= kMinTailRevolutions) {
-    start(window_.take(), last_stamp_, take_window_faults());
+    const double speed = window_.mean_speed();
+    start(window_.take(), speed, last_stamp_, take_window_faults());
     publish_ready(true);
   } else if (window_.size() > 0 && counters_.windows_fitted + counters_.windows_insufficient == 0) {
     // Nothing was published in the whole run (a stopped motor): say so, with the reason.
@@ -132,12 +149,16 @@ void LiveModelFit::finish() {
   }
 }
 
-void LiveModelFit::start(DiscoveryInput window, const Stamp& stamp, std::vector<std::string> untrusted) {
+void LiveModelFit::start(DiscoveryInput window, double speed, const Stamp& stamp, std::vector<std::string> untrusted) {
   const ModelFitOptions opt = options_;
-  FitStartValues from = windows_started_++ % kColdEvery == 0 ? FitStartValues{} : warm_start_;
-  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window), untrusted = std::move(untrusted),
-                                             from = std::move(from)]() {
+  const bool warm = !warm_start_.values.empty() && warm_in_a_row_ + 1 < kColdEvery &&
+                    operating_point_held(warm_speed_, speed);
+  warm_in_a_row_ = warm ? warm_in_a_row_ + 1 : 0;
+  FitStartValues from = warm ? warm_start_ : FitStartValues{};
+  running_ = std::async(std::launch::async, [opt, stamp, speed, w = std::move(window),
+                                             untrusted = std::move(untrusted), from = std::move(from)]() {
     Result r;
+    r.speed = speed;
     model_fit_t& m = r.message;
     try {
       DiscoveryOptions dopt;
@@ -184,6 +205,7 @@ void LiveModelFit::publish_ready(bool wait) {
   }
   last_error_ = r.error;
   warm_start_ = std::move(r.next_start);  // a window that could not be fitted leaves the next one cold
+  warm_speed_ = r.speed;
   if (r.fitted) pending_model_ = std::move(r.fitted);
   sink_.publish(r.message);
   last_ = std::move(r.message);

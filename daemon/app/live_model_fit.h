@@ -13,8 +13,10 @@
 //    while the previous fit still runs is dropped and counted (windows_skipped).
 // A window's fit starts where the last one converged (its model and the candidates it
 // refitted exactly, settled: no other starts), which takes most of the passes off a
-// window whose operating point has not moved; every kColdEvery-th window starts cold
-// (the effects' defaults, every start), so a valley that moved is found again.
+// window whose operating point has not moved. A window whose mean speed moved
+// (operating_point_held) starts cold (the effects' defaults, every start), so a valley
+// that moved with it is found again; so does one after a fit that did not converge, and
+// at least every kColdEvery-th.
 #pragma once
 
 #include <cstdint>
@@ -36,6 +38,10 @@ namespace resolver {
 /// revolutions, no R/D angle...): verdict "insufficient_data" and NaN residuals.
 [[nodiscard]] model_fit_t make_model_fit_message(const Explanation* ex, bool candidates,
                                                  const std::vector<std::string>& effects);
+
+/// Whether a window at mean speed `speed` [rad/s electrical, signed] may start where the
+/// fit of a window at `last_speed` converged: within 10 % of the faster, the same way.
+[[nodiscard]] bool operating_point_held(double last_speed, double speed);
 
 class LiveModelFit {
  public:
@@ -93,8 +99,9 @@ class LiveModelFit {
     std::string error;  ///< why the window could not be fitted ("" = fitted)
     std::optional<FittedModel> fitted;
     FitStartValues next_start;  ///< where the next window's fit starts (empty: cold)
+    double speed = 0.0;         ///< [rad/s] the window's mean speed (ModelWindow::mean_speed)
   };
-  void start(DiscoveryInput window, const Stamp& stamp, std::vector<std::string> untrusted);
+  void start(DiscoveryInput window, double speed, const Stamp& stamp, std::vector<std::string> untrusted);
   void publish_ready(bool wait);
 
   ModelFitOptions options_;
@@ -115,7 +122,8 @@ class LiveModelFit {
   std::string taken_std_error_basis_;
   std::optional<FittedModel> pending_model_;
   FitStartValues warm_start_;        ///< the last fitted window's (Result::next_start)
-  std::int64_t windows_started_ = 0;
+  double warm_speed_ = 0.0;          ///< [rad/s] that window's mean speed
+  std::int64_t warm_in_a_row_ = 0;   ///< windows started warm since the last cold one
 };
 
 }  // namespace resolver

@@ -19,8 +19,12 @@ bool ModelWindow::add(const Sample& sample, int p_r, int p) {
     const double a = unwrap_.update(sample.has_rd ? sample.theta_rd : std::atan2(sample.sin, sample.cos));
     if (!have_angle_) {
       anchor_ = a;
+      first_angle_ = a;
+      first_t_ = sample.t;
       have_angle_ = true;
     }
+    last_angle_ = a;
+    last_t_ = sample.t;
     while (std::abs(a - anchor_) >= kTwoPi) {
       anchor_ += a > anchor_ ? kTwoPi : -kTwoPi;
       ++turns_;
@@ -32,6 +36,11 @@ bool ModelWindow::add(const Sample& sample, int p_r, int p) {
 
 double ModelWindow::revolutions() const { return static_cast<double>(turns_) + partial_; }
 
+double ModelWindow::mean_speed() const {
+  const double dt = last_t_ - first_t_;
+  return have_angle_ && dt > 0.0 ? (last_angle_ - first_angle_) / dt : 0.0;
+}
+
 DiscoveryInput ModelWindow::take() {
   DiscoveryInput out = std::move(input_);
   input_ = DiscoveryInput{};
@@ -41,6 +50,7 @@ DiscoveryInput ModelWindow::take() {
   anchor_ = 0.0;
   turns_ = 0;
   partial_ = 0.0;
+  first_angle_ = first_t_ = last_angle_ = last_t_ = 0.0;
   return out;
 }
 

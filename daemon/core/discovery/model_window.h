@@ -33,6 +33,10 @@ class ModelWindow {
   [[nodiscard]] std::size_t size() const { return input_.samples.size(); }
   /// [rev] resolver electrical revolutions travelled so far, either way.
   [[nodiscard]] double revolutions() const;
+  /// [rad/s] resolver electrical, signed: the net angle travelled over the time it took,
+  /// first to last sample with an angle (0 before two such samples). An out-and-back
+  /// window's is near zero: its operating point is no one speed.
+  [[nodiscard]] double mean_speed() const;
 
  private:
   ModelWindowConfig config_;
@@ -42,6 +46,8 @@ class ModelWindow {
   double anchor_ = 0.0;  ///< [rad] unwrapped angle where the last counted turn ended
   std::int64_t turns_ = 0;
   double partial_ = 0.0;  ///< [rev] of the turn in progress
+  double first_angle_ = 0.0, first_t_ = 0.0;  ///< [rad], [s] of the first sample with an angle
+  double last_angle_ = 0.0, last_t_ = 0.0;    ///< [rad] unwrapped, [s] of the last
 };
 
 }  // namespace resolver

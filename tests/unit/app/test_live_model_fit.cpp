@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/app/live_model_fit.h"
 #include "daemon/app/pipeline.h"
 #include "daemon/core/discovery/model_window.h"
 #include "daemon/core/effects/chain_values.h"
@@ -106,6 +107,43 @@ TEST(LiveModelFit, DisabledPublishesNothingAndAStoppedMotorSaysInsufficientData)
   const model_fit_t m = make_model_fit_message(nullptr, true, {"amplitude_imbalance"});
   EXPECT_EQ(m.verdict, "insufficient_data");
   EXPECT_TRUE(std::isnan(m.residual_rms_rad));
+}
+
+// A window's fit starts where the last converged only while its operating point held
+// (live_model_fit.h): the window's signed mean speed, compared with the last one's.
+TEST(LiveModelFit, AWindowsMeanSpeedSaysWhenItsOperatingPointMoved) {
+  SimConfig cfg;  // p_r 3, 2 kHz: 200 r/min is 20 pi rad/s electrical
+  cfg.profile = {{5.0, 200.0, 200.0}, {0.5, 200.0, -200.0}, {5.0, -200.0, -200.0}};
+  BenchSimulator sim(cfg);
+  ModelWindow w(ModelWindowConfig{16.0, 100000});
+  std::vector<double> speeds;
+  SimSample s{};
+  while (sim.next(s)) {
+    Sample d;
+    d.t = static_cast<double>(s.t_us) * 1e-6;
+    d.has_rd = true;
+    d.theta_rd = s.rd_angle;
+    if (w.add(d, cfg.p_r, cfg.p)) {
+      speeds.push_back(w.mean_speed());
+      (void)w.take();
+    }
+  }
+  ASSERT_GE(speeds.size(), 4U);
+  const double electrical = 200.0 / 60.0 * 2.0 * M_PI * cfg.p_r;
+  // The R/D angle lags and quantizes (16 bits): a window's net angle is exact to ~1e-4 rad
+  // over 16 revolutions, so its mean speed to far better than 0.1 %.
+  EXPECT_NEAR(speeds.front(), electrical, 1e-3 * electrical);
+  EXPECT_NEAR(speeds.back(), -electrical, 1e-3 * electrical);
+  EXPECT_TRUE(operating_point_held(speeds[0], speeds[1]));
+  int moved = 0;
+  for (std::size_t i = 1; i < speeds.size(); ++i) moved += operating_point_held(speeds[i - 1], speeds[i]) ? 0 : 1;
+  // The reversal: the window that holds it, and the first after it (the other way).
+  EXPECT_GE(moved, 1);
+  EXPECT_LE(moved, 3);
+  EXPECT_FALSE(operating_point_held(electrical, -electrical));
+  EXPECT_TRUE(operating_point_held(electrical, 1.05 * electrical));
+  EXPECT_FALSE(operating_point_held(electrical, 1.2 * electrical));
+  EXPECT_FALSE(operating_point_held(std::nan(""), electrical));
 }
 
 TEST(LiveModelFit, ConfigRejectsUnknownEffectsAndShortWindows) {
