@@ -21,10 +21,10 @@ constexpr double kMinTailRevolutions = 2.0;
 /// moved with the operating point held (every 8th window started cold before; a cold
 /// window of a tracking-loop model costs ~8 warm ones: its five omega_n starts).
 constexpr std::int64_t kColdEvery = 32;
-/// A window whose mean speed is this share of the last one's away (or the other way)
-/// starts cold: the valleys of a loop's omega_n and of a delay's phase sit where the
-/// ripple's frequencies (whole multiples of the speed) meet the loop's response and wrap
-/// the delay's phase, so a speed step moves them; a play's take-up flips with direction.
+/// A speed this share of another's away (or the other way) is another operating point: the
+/// valleys of a loop's omega_n and of a delay's phase sit where the ripple's frequencies
+/// (whole multiples of the speed) meet the loop's response and wrap the delay's phase, so
+/// a speed step moves them; a play's take-up flips with direction.
 constexpr double kSpeedMoved = 0.1;
 
 /// Where the next window's fit starts: this one's converged model and the candidates it
@@ -49,6 +49,10 @@ FitStartValues start_after(const Explanation& ex) {
 bool operating_point_held(double last_speed, double speed) {
   if (!std::isfinite(last_speed) || !std::isfinite(speed)) return false;
   return std::abs(speed - last_speed) <= kSpeedMoved * std::max(std::abs(speed), std::abs(last_speed));
+}
+
+bool settled_at_a_new_operating_point(double cold_speed, double previous_speed, double speed) {
+  return !operating_point_held(cold_speed, speed) && operating_point_held(previous_speed, speed);
 }
 
 model_fit_t make_model_fit_message(const Explanation* ex, bool candidates, const std::vector<std::string>& effects) {
@@ -152,13 +156,14 @@ void LiveModelFit::finish() {
 void LiveModelFit::start(DiscoveryInput window, double speed, const Stamp& stamp, std::vector<std::string> untrusted) {
   const ModelFitOptions opt = options_;
   const bool warm = !warm_start_.values.empty() && warm_in_a_row_ + 1 < kColdEvery &&
-                    operating_point_held(warm_speed_, speed);
+                    !settled_at_a_new_operating_point(cold_speed_, previous_speed_, speed);
   warm_in_a_row_ = warm ? warm_in_a_row_ + 1 : 0;
+  if (!warm) cold_speed_ = speed;
+  previous_speed_ = speed;
   FitStartValues from = warm ? warm_start_ : FitStartValues{};
-  running_ = std::async(std::launch::async, [opt, stamp, speed, w = std::move(window),
-                                             untrusted = std::move(untrusted), from = std::move(from)]() {
+  running_ = std::async(std::launch::async, [opt, stamp, w = std::move(window), untrusted = std::move(untrusted),
+                                             from = std::move(from)]() {
     Result r;
-    r.speed = speed;
     model_fit_t& m = r.message;
     try {
       DiscoveryOptions dopt;
@@ -205,7 +210,6 @@ void LiveModelFit::publish_ready(bool wait) {
   }
   last_error_ = r.error;
   warm_start_ = std::move(r.next_start);  // a window that could not be fitted leaves the next one cold
-  warm_speed_ = r.speed;
   if (r.fitted) pending_model_ = std::move(r.fitted);
   sink_.publish(r.message);
   last_ = std::move(r.message);

@@ -144,6 +144,13 @@ TEST(LiveModelFit, AWindowsMeanSpeedSaysWhenItsOperatingPointMoved) {
   EXPECT_TRUE(operating_point_held(electrical, 1.05 * electrical));
   EXPECT_FALSE(operating_point_held(electrical, 1.2 * electrical));
   EXPECT_FALSE(operating_point_held(std::nan(""), electrical));
+  // Cold at the first steady window at the new speed, not in the transition (wide spread
+  // of speeds, the costliest to fit from every start) nor at the old speed.
+  EXPECT_FALSE(settled_at_a_new_operating_point(electrical, electrical, electrical));
+  EXPECT_FALSE(settled_at_a_new_operating_point(electrical, electrical, 0.3 * electrical));
+  EXPECT_FALSE(settled_at_a_new_operating_point(electrical, 0.3 * electrical, -electrical));
+  EXPECT_TRUE(settled_at_a_new_operating_point(electrical, -electrical, -electrical));
+  EXPECT_TRUE(settled_at_a_new_operating_point(electrical, 2.0 * electrical, 2.05 * electrical));
 }
 
 TEST(LiveModelFit, ConfigRejectsUnknownEffectsAndShortWindows) {
