@@ -210,15 +210,16 @@ void LiveModelFit::publish_ready(bool wait) {
   }
   last_error_ = r.error;
   warm_start_ = std::move(r.next_start);  // a window that could not be fitted leaves the next one cold
-  if (r.fitted) pending_model_ = std::move(r.fitted);
+  if (r.fitted) pending_models_.push_back(std::move(*r.fitted));
   sink_.publish(r.message);
   last_ = std::move(r.message);
 }
 
 std::optional<LiveModelFit::FittedModel> LiveModelFit::take_model() {
-  std::optional<FittedModel> out = std::move(pending_model_);
-  pending_model_.reset();
-  if (out) taken_std_error_basis_ = out->std_error_basis;
+  if (pending_models_.empty()) return std::nullopt;
+  std::optional<FittedModel> out = std::move(pending_models_.front());
+  pending_models_.pop_front();
+  taken_std_error_basis_ = out->std_error_basis;
   return out;
 }
 

@@ -23,6 +23,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <future>
 #include <optional>
 #include <ostream>
@@ -88,8 +89,11 @@ class LiveModelFit {
   /// The last published message (verdict empty before the first window).
   [[nodiscard]] const model_fit_t& last() const { return last_; }
 
-  /// The model a window fitted since the last call (nullopt: none new). The
-  /// pipeline hands it to the processor, which compensates with it.
+  /// The oldest model a window fitted that was not taken yet (nullopt: none new). The
+  /// pipeline hands each to the processor, which compensates with it, and to the run's
+  /// combined estimate: finish() may publish two (the window that was running and the
+  /// tail), and neither may be lost (the run's estimate would then depend on how fast
+  /// the fit ran).
   struct FittedModel {
     Model model;
     std::int64_t samples = 0;
@@ -126,7 +130,7 @@ class LiveModelFit {
   std::uint32_t since_poll_ = 0;
   Counters counters_;
   std::string taken_std_error_basis_;
-  std::optional<FittedModel> pending_model_;
+  std::deque<FittedModel> pending_models_;  ///< fitted, not taken yet, oldest first
   FitStartValues warm_start_;        ///< the last fitted window's (Result::next_start)
   double cold_speed_ = 0.0;          ///< [rad/s] mean speed of the last window started cold
   double previous_speed_ = 0.0;      ///< [rad/s] of the last window started (ModelWindow::mean_speed)

@@ -300,13 +300,17 @@ void Pipeline::tick(std::int64_t now_us) {
 }
 
 bool Pipeline::adopt_live_fit() {
-  auto fitted = model_fit_->take_model();
-  // With an older method the live fit is a diagnostic (model_fit_t): the method's
-  // own estimate compensates.
-  if (!fitted || processor_.config().method != EstimatorMethod::kModel) return false;
-  run_estimate_.add(fitted->model, fitted->samples, fitted->revolutions);
-  processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
-  return true;
+  bool adopted = false;
+  // Every window fitted since the last call, oldest first (finish() may leave two).
+  while (auto fitted = model_fit_->take_model()) {
+    // With an older method the live fit is a diagnostic (model_fit_t): the method's
+    // own estimate compensates.
+    if (processor_.config().method != EstimatorMethod::kModel) continue;
+    run_estimate_.add(fitted->model, fitted->samples, fitted->revolutions);
+    processor_.set_model(std::move(fitted->model), fitted->samples, fitted->revolutions);
+    adopted = true;
+  }
+  return adopted;
 }
 
 void Pipeline::finish() {

@@ -164,7 +164,8 @@ class Pipeline {
  private:
   void on_sample(const Sample& sample, std::uint8_t counter);
   void on_bench_info(const BenchInfo& info);
-  /// Takes the live fit's newest model, if any; method kModel compensates with it (true).
+  /// Takes every model the live fit finished since the last call, oldest first; method
+  /// kModel adds each to the run's estimate and compensates with the newest (true).
   bool adopt_live_fit();
   void publish_estimate(const Sample& sample, std::uint8_t counter);
   void advance_health_clock(std::int64_t now_us);
