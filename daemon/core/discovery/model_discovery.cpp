@@ -530,6 +530,23 @@ ModelFit fit_model(const DiscoveryInput& input, std::span<const std::string> eff
 
 namespace {
 
+/// What a missing pair's summary adds where the log cannot tell a member of the pair from
+/// other candidates (Candidate::fits_as_well): each such pair fits as well, so naming one
+/// alone would be a confident answer the data does not support ("" where none).
+std::string pair_alternatives(const std::vector<std::string>& pair, const std::vector<Candidate>& candidates,
+                              bool sincos) {
+  std::vector<std::string> alike;
+  for (const std::string& member : pair) {
+    const auto c = std::find_if(candidates.begin(), candidates.end(),
+                                [&member](const Candidate& x) { return x.effect == member; });
+    if (c == candidates.end() || c->fits_as_well.empty()) continue;
+    alike.push_back(fmt::format("{} from {}", member, fmt::join(c->fits_as_well, " or ")));
+  }
+  if (alike.empty()) return {};
+  return fmt::format(" This log cannot tell {} (they fit as well here{}).", fmt::join(alike, ", nor "),
+                     sincos ? "" : "; sin/cos envelopes would tell them apart");
+}
+
 Explanation explain_steps(const PreparedLog& log, std::span<const std::string> effects,
                           const DiscoveryOptions& options) {
   Explanation ex;
@@ -607,9 +624,13 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
                         log.sincos ? "" : "; sin/cos envelopes would tell them apart");
   if (!ex.missing_pair.empty()) {
     ex.verdict = Verdict::kMissingEffect;
+    // The pair's first, not the ranking's: a family or an alike candidate may rank above it.
+    const Candidate& first = *std::find_if(ex.candidates.begin(), ex.candidates.end(),
+                                           [&ex](const Candidate& c) { return c.effect == ex.missing_pair[0]; });
     ex.summary = "missing_effect: two effects are missing: " + ex.missing_pair[0] + " and " + ex.missing_pair[1] +
                  " together bring every signal to within " + num(options.explained_ratio) +
-                 "x its noise floor (neither does alone); " + best->change(true) + " first. " + best->reason;
+                 "x its noise floor (neither does alone); " + first.change(true) + " first. " + first.reason +
+                 pair_alternatives(ex.missing_pair, ex.candidates, log.sincos);
   } else if (named) {
     ex.verdict = Verdict::kMissingEffect;
     struct Change {

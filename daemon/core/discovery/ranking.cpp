@@ -695,25 +695,76 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   return out;
 }
 
+namespace {
+
+/// Whether the log cannot tell `a` from `b` (either lists the other: Candidate::fits_as_well).
+bool told_alike(const Candidate& a, const Candidate& b) {
+  const auto lists = [](const Candidate& x, const std::string& e) {
+    return std::find(x.fits_as_well.begin(), x.fits_as_well.end(), e) != x.fits_as_well.end();
+  };
+  return lists(a, b.effect) || lists(b, a.effect);
+}
+
+/// Pairs beyond the best three the two-effect search fits at most (each a fit of the whole
+/// log: only where no pair of the best three explains it).
+constexpr int kMaxAlikePairFits = 9;
+/// Members of each of the three best classes of alike candidates the search pairs.
+constexpr std::size_t kAlikeClassMembers = 3;
+
+}  // namespace
+
 std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
                                            const std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
-  std::vector<const Candidate*> top;
+  // Effects, not families: a pair is two findings, a family already many orders.
+  std::vector<const Candidate*> pool;
   for (const Candidate& c : candidates) {
-    // Effects, not families: a pair is two findings, a family already many orders.
-    if (c.proposed && !c.family && top.size() < 3) top.push_back(&c);
+    if (c.proposed && !c.family) pool.push_back(&c);
   }
-  for (std::size_t i = 0; i < top.size(); ++i) {
-    for (std::size_t j = i + 1; j < top.size(); ++j) {
-      std::vector<std::string> refs = fit.model.spec().references();
-      refs.push_back(top[i]->effect);
-      refs.push_back(top[j]->effect);
-      try {
-        const ModelFit f = fit_prepared(log, refs, options);
-        if (f.explained) return {top[i]->effect, top[j]->effect};
-      } catch (const std::invalid_argument&) {
-        // not separable together: not the pair
-      }
+  const auto explains = [&](const Candidate& a, const Candidate& b) {
+    std::vector<std::string> refs = fit.model.spec().references();
+    refs.push_back(a.effect);
+    refs.push_back(b.effect);
+    try {
+      return fit_prepared(log, refs, options).explained;
+    } catch (const std::invalid_argument&) {
+      return false;  // not separable together: not the pair
     }
+  };
+  const std::size_t best = std::min<std::size_t>(pool.size(), 3);
+  for (std::size_t i = 0; i < best; ++i) {
+    for (std::size_t j = i + 1; j < best; ++j) {
+      if (explains(*pool[i], *pool[j])) return {pool[i]->effect, pool[j]->effect};
+    }
+  }
+  // Candidates the log cannot tell apart score alike at first order, and the one a linearised
+  // step ranks first may be the wrong one at second order, where the pair's exact fit differs
+  // (an R/D angle alone at p_r = 1: offsets beside eccentricity, quadrature beside a
+  // mechanical 2x). So the members of the three best classes of alike candidates pair across
+  // classes too, the pairs of the best-ranked members first. A candidate in place of a model
+  // term (Candidate::replaces) is not an addition.
+  std::vector<int> cls(pool.size(), -1);
+  std::vector<std::size_t> members;
+  int classes = 0;
+  for (std::size_t i = 0; i < pool.size(); ++i) {
+    for (std::size_t j = 0; j < i && cls[i] < 0; ++j) {
+      if (told_alike(*pool[i], *pool[j])) cls[i] = cls[j];
+    }
+    if (cls[i] < 0) cls[i] = classes++;
+    if (cls[i] >= 3 || !pool[i]->replaces.empty()) continue;
+    const auto in_class = std::count_if(members.begin(), members.end(), [&](std::size_t m) { return cls[m] == cls[i]; });
+    if (static_cast<std::size_t>(in_class) < kAlikeClassMembers) members.push_back(i);
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  for (std::size_t a = 0; a < members.size(); ++a) {
+    for (std::size_t b = a + 1; b < members.size(); ++b) {
+      const std::size_t i = members[a], j = members[b];
+      if (cls[i] != cls[j] && j >= best) pairs.emplace_back(i, j);
+    }
+  }
+  std::stable_sort(pairs.begin(), pairs.end(), [](const auto& x, const auto& y) { return x.first + x.second < y.first + y.second; });
+  if (pairs.size() > static_cast<std::size_t>(kMaxAlikePairFits)) pairs.resize(kMaxAlikePairFits);
+  for (const auto& [i, j] : pairs) {
+    if (explains(*pool[i], *pool[j])) return {pool[i]->effect, pool[j]->effect};
   }
   return {};
 }

@@ -93,8 +93,10 @@ void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& op
 /// Ranks the candidates for the fitted model `fit` on `log`.
 [[nodiscard]] Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options);
 
-/// The two-effect search: the first pair of proposed candidates (best three)
-/// that together bring every signal to its floor; empty when none does.
+/// The two-effect search: the first pair of proposed candidates that together bring
+/// every signal to its floor; empty when none does. The best three are paired first;
+/// then, where the log cannot tell candidates apart (fits_as_well: the best three may be
+/// one class of aliases), the first members of the three best classes across classes.
 [[nodiscard]] std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
                                                          const std::vector<Candidate>& candidates,
                                                          const DiscoveryOptions& options);
