@@ -129,17 +129,36 @@ bool SignalHealthMonitor::is_outlier(const Sample& s, double r, double angle) {
   // radius can be known; the MAD of quantized, noise-free data can be smaller.
   const double quantum = std::max(2.0 * config_.clip_margin, 1e-12);
   bool outlier = false;
+  // The radius: beyond its running level's spread AND off the line through the last two
+  // good samples. The level alone is not enough: a real sensor's radius swings with
+  // 2 theta by its gain error (alpha / 2 of the amplitude), and where the rotor lingers
+  // (a reversal, a creep) the last 128 samples span a sliver of that swing, so the
+  // level's spread collapses and the swing's slow return read as impulsive (every
+  // reversal of a 5 % or 13 % imbalance raised 7 outliers, and resolverd's windows
+  // around it were called faulty). On the line, what is left is the swing's curvature
+  // (alpha r (2 step)^2: a few counts where the rotor lingers) and the noise. The line
+  // alone is not enough either: a spike it misses at speed (the curvature is hundreds
+  // of counts there) would bend the next predictions; the level keeps those normal.
+  const std::int64_t gap = s.index - good_index_;
+  if (have_good_angle_ && (gap < 1 || gap > kMaxStepGap)) have_good_angle_ = false;
   if (radius_.size() >= kMinHistory) {
     const double sigma = std::max(radius_.robust_sigma(), quantum);
     outlier = std::abs(r - radius_.median()) > config_.outlier_sigmas * sigma;
+  }
+  double off_line = 0.0;
+  const bool have_off_line = have_good_angle_ && have_radius_slope_;
+  if (have_off_line) {
+    off_line = r - (good_radius_ + radius_slope_ * static_cast<double>(gap));
+    if (off_line_.size() >= kMinHistory) {
+      const double sigma = std::max(off_line_.robust_sigma(), quantum);
+      outlier = outlier && std::abs(off_line - off_line_.median()) > config_.outlier_sigmas * sigma;
+    }
   }
   // The angle: predicted from the last good sample and the median step; the
   // residual is tested against its own running median, so a steady lag under
   // acceleration is not an outlier, only a jump against the neighbours is.
   double residual = 0.0;
   bool have_residual = false;
-  const std::int64_t gap = s.index - good_index_;
-  if (have_good_angle_ && (gap < 1 || gap > kMaxStepGap)) have_good_angle_ = false;
   if (have_good_angle_ && step_.size() >= kMinHistory) {
     const double step = step_.median();
     if (std::abs(step) < config_.overspeed_rad_per_sample) {  // near pi per sample the prediction aliases
@@ -155,17 +174,23 @@ bool SignalHealthMonitor::is_outlier(const Sample& s, double r, double angle) {
   if (outlier) {
     // A new level: restart the histories from this sample (the run so far stays counted).
     radius_.clear();
+    off_line_.clear();
     step_.clear();
     angle_residual_.clear();
     have_residual = false;
+    have_radius_slope_ = false;
     have_good_angle_ = false;
   }
   outlier_run_ = 0;
   radius_.add(r);
+  if (have_off_line) off_line_.add(off_line);
   if (have_good_angle_) step_.add(wrap_pi(angle - good_angle_) / static_cast<double>(gap));
   if (have_residual) angle_residual_.add(residual);
+  have_radius_slope_ = have_good_angle_;
+  if (have_radius_slope_) radius_slope_ = (r - good_radius_) / static_cast<double>(gap);
   have_good_angle_ = true;
   good_angle_ = angle;
+  good_radius_ = r;
   good_index_ = s.index;
   return false;
 }
@@ -279,6 +304,8 @@ void SignalHealthMonitor::new_pass() {
   // in angle and in speed (a log ending at 1000 r/min starts again at 200).
   have_good_angle_ = false;
   step_.clear();
+  off_line_.clear();
+  have_radius_slope_ = false;
   angle_residual_.clear();
   outlier_run_ = 0;
   have_angle_ = false;  // no speed step across the joint

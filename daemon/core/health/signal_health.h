@@ -14,8 +14,9 @@
 //   stopped                electrical speed over the block below the stop line
 //   overspeed              electrical travel per sample beyond the overspeed line (pi per sample
 //                          aliases; the line sits well before that)
-//   outliers               a sample whose radius or angle is impulsive against a running
-//                          median/MAD of its neighbours (robust z-score)
+//   outliers               a sample whose radius (against its running level and off the line
+//                          of its last two good samples) or angle is impulsive against a
+//                          running median/MAD (robust z-score)
 //
 // Samples are evaluated in blocks of `block_s` of sample time. A fault starts at
 // the first block (or, for the per-sample faults clipping and outliers, the first
@@ -264,14 +265,19 @@ class SignalHealthMonitor {
   bool have_grid_ = false;
   double grid_t0_ = 0.0;           ///< [s] blocks cover [grid_t0 + k block_s, grid_t0 + (k+1) block_s)
   std::int64_t block_number_ = 0;
-  // Outlier tests: the radius against its running median; the sin/cos angle
-  // against the last good angle advanced by the running median step.
+  // Outlier tests: the radius against its running median and, too, off the line
+  // through the last two good samples; the sin/cos angle against the last good angle advanced
+  // by the running median step.
   RunningMedian radius_;
+  RunningMedian off_line_;  ///< the radius's residuals off that line
   RunningMedian step_;
   RunningMedian angle_residual_;
   int outlier_run_ = 0;
   bool have_good_angle_ = false;
   double good_angle_ = 0.0;
+  double good_radius_ = 0.0;  ///< the last good sample's sin/cos radius
+  double radius_slope_ = 0.0;  ///< [counts/sample] from the good sample before it
+  bool have_radius_slope_ = false;
   std::int64_t good_index_ = 0;
   // The angle speed is measured on (see add_speed).
   bool have_angle_ = false;
