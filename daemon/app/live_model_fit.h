@@ -8,7 +8,9 @@
 // thread while the pipeline keeps reading; its result is published from the
 // pipeline's thread (the sink is not thread-safe), one window late.
 //  - Replay (`realtime = false`): a finished window waits for the previous fit,
-//    so every window is fitted and the output is the same on every run.
+//    so every window is fitted, and a fit's result is published (its model compensates)
+//    where the next window completes or the input ends, never at whichever sample a
+//    poll found it done: the output is the same on every run, whatever the load.
 //  - Live (`realtime = true`): the reader never waits; a window that completes
 //    while the previous fit still runs is dropped and counted (windows_skipped).
 // A window's fit starts where the last one converged (its model and the candidates it

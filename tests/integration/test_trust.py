@@ -516,7 +516,10 @@ class SighupInReplay(unittest.TestCase):
         self.assertTrue(before and after, "estimates on both sides of the reload")
         self.assertTrue(before[-1]["converged"])
         self.assertTrue(after[0]["converged"], "no restart: still converged right after the reload")
-        self.assertGreaterEqual(after[0]["revolutions_used"], before[-1]["revolutions_used"])
+        # A replay hands a window's model over where the next window completes (live_model_fit.h),
+        # so the first estimate after the reload may be the same window's, summed again (equal to
+        # rounding: 1e-9 of a revolution is far below any restart, which would drop to 0).
+        self.assertGreaterEqual(after[0]["revolutions_used"] + 1e-9, before[-1]["revolutions_used"])
 
     def test_reload_of_a_clean_log_with_rejects_keeps_them(self):
         # The rejects before a reload stay in the report: a log with a CRC error early on.
