@@ -149,9 +149,11 @@ bool SignalHealthMonitor::is_outlier(const Sample& s, double r, double angle) {
   const bool have_off_line = have_good_angle_ && have_radius_slope_;
   if (have_off_line) {
     off_line = r - (good_radius_ + radius_slope_ * static_cast<double>(gap));
-    if (off_line_.size() >= kMinHistory) {
+    // Asked only of a sample the level calls impulsive: the history's median and spread
+    // are re-sorted when asked, and every sample passes here.
+    if (outlier && off_line_.size() >= kMinHistory) {
       const double sigma = std::max(off_line_.robust_sigma(), quantum);
-      outlier = outlier && std::abs(off_line - off_line_.median()) > config_.outlier_sigmas * sigma;
+      outlier = std::abs(off_line - off_line_.median()) > config_.outlier_sigmas * sigma;
     }
   }
   // The angle: predicted from the last good sample and the median step; the
@@ -178,7 +180,6 @@ bool SignalHealthMonitor::is_outlier(const Sample& s, double r, double angle) {
     step_.clear();
     angle_residual_.clear();
     have_residual = false;
-    have_radius_slope_ = false;
     have_good_angle_ = false;
   }
   outlier_run_ = 0;
