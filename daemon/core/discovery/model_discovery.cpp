@@ -578,6 +578,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     return ex;
   }
   Ranking ranking = rank_candidates(log, ex.fit, options);
+  const std::vector<std::pair<std::string, std::string>> screened_pairs = std::move(ranking.screened_pairs);
   ex.candidates = std::move(ranking.candidates);
   ex.not_evaluated = std::move(ranking.not_evaluated);
   ex.fit.passes += ranking.passes;
@@ -616,7 +617,14 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
   if (best != nullptr) {
     named = best->reaches_floor || removes_most_excess(ex.fit.signals, ex.fit.rows, log.rd, best->weighted_rss);
   }
-  if (!named && best != nullptr) ex.missing_pair = find_missing_pair(log, ex.fit, ex.candidates, options);
+  // A best candidate that removes most of the excess but does not reach the floor may be
+  // the wrong one: two effects at real magnitudes (a 2.5 % quadrature and a phased K_3 under
+  // a 12 % imbalance at p_r = 3) leave 2 theta where one mechanical order fits most of it
+  // (12.6x the floor, the envelopes 21x) while the two reach it. A pair that does wins.
+  if (best != nullptr && !best->reaches_floor) {
+    ex.missing_pair = find_missing_pair(log, ex.fit, ex.candidates, options, screened_pairs,
+                                        named ? PairSearch::kScreened : PairSearch::kEvery);
+  }
   const std::string alternatives =
       best == nullptr || best->fits_as_well.empty()
           ? std::string()

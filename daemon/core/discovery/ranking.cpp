@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <functional>
+#include <map>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -637,6 +640,65 @@ void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& op
   family_first_only_alone(candidates);
 }
 
+namespace {
+
+/// Proposed candidates the pair screen pairs: the best of them as ranked.
+constexpr std::size_t kScreenedCandidates = 8;
+/// Screened pairs kept: those whose joint step leaves at most this times the best pair's
+/// weighted residual (10x in RMS). A step's error is second order in the pair's values,
+/// alike for pairs that fit the same residual: a pair that far behind would need it ten
+/// times the best pair's whole residual. The right pair of 2 % offsets and a 3 % quadrature
+/// under a 10 % imbalance: its step leaves 1/97 of the next pair's, still far above the
+/// floor, and its fit reaches the floor (tests/integration/test_real_inputs.py, TwoMissing).
+constexpr double kScreenedResidualRatio = 100.0;
+/// And those whose step leaves at most this share of what the best candidate alone leaves:
+/// a pair that adds less than a fifth is no second effect found (a drifting gain, which no
+/// catalog pair describes: the best pairs' steps leave 99.7 % of it, and three fits went for
+/// nothing). The true pair of a quadrature and a phased K_3 leaves 53 % of what the
+/// mechanical 6x alone leaves, linearised, and reaches the floor fitted.
+constexpr double kScreenedGain = 0.8;
+
+/// Ranking::screened_pairs: each pair's joint linearised step, solved from the ranking
+/// pass's statistics on the pair's columns (no pass over the rows: 28 small solves);
+/// pairs far behind the best, or little better than the best candidate alone, are left out
+/// (kScreenedResidualRatio, kScreenedGain).
+/// Linearised, so only an order of which pairs to fit exactly: at real magnitudes an
+/// envelope effect's step from zero leaves its second-order terms far above the floor.
+std::vector<std::pair<std::string, std::string>> screen_pairs(const std::vector<Candidate>& ranked,
+                                                              const std::map<std::string, std::vector<int>>& columns_of,
+                                                              const PassStatistics& stats, const GroupFloors& floors,
+                                                              const std::vector<int>& base_cols) {
+  std::vector<const Candidate*> pool;
+  for (const Candidate& c : ranked) {
+    if (pool.size() == kScreenedCandidates) break;
+    if (c.proposed && !c.family && c.replaces.empty() && columns_of.count(c.effect) > 0) pool.push_back(&c);
+  }
+  std::vector<std::pair<double, std::pair<std::string, std::string>>> scored;
+  for (std::size_t i = 0; i < pool.size(); ++i) {
+    for (std::size_t j = i + 1; j < pool.size(); ++j) {
+      std::vector<int> cols = base_cols;
+      for (const Candidate* c : {pool[i], pool[j]}) {
+        const std::vector<int>& own = columns_of.at(c->effect);
+        cols.insert(cols.end(), own.begin(), own.end());
+      }
+      const StepSolution s = solve_step(stats.all, floors, cols);
+      if (s.ok) scored.push_back({s.rss_w, {pool[i]->effect, pool[j]->effect}});
+    }
+  }
+  std::stable_sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::pair<std::string, std::string>> out;
+  out.reserve(scored.size());
+  const double best_alone = ranked.empty() ? 0.0 : ranked.front().weighted_rss;
+  for (auto& [rss, pair] : scored) {
+    if (rss > kScreenedResidualRatio * scored.front().first) break;
+    if (rss > kScreenedGain * best_alone) break;
+    out.push_back(std::move(pair));
+  }
+  return out;
+}
+
+}  // namespace
+
 Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
   Ranking out;
   std::vector<ModelTerm> terms = candidate_terms(log, fit, options, out.not_evaluated);
@@ -656,9 +718,12 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   const std::vector<int> base_cols = model_columns(d);
   const StepSolution base = solve_step(stats.all, floors, base_cols);
   std::vector<ModelTerm> unseparated;
+  std::map<std::string, std::vector<int>> columns_of;  // each scored candidate's columns (narrowed ones too)
   for (std::size_t i = 0; i < terms.size(); ++i) {
     const std::size_t term = first_candidate + i;
-    const StepSolution s = solve_candidate(stats.all, floors, base_cols, term_columns(d, term), terms[i]);
+    const std::vector<int> all_cols = term_columns(d, term);
+    const ModelTerm asked = terms[i];
+    const StepSolution s = solve_candidate(stats.all, floors, base_cols, all_cols, terms[i]);
     if (!s.ok) {
       unseparated.push_back(terms[i]);
       out.not_evaluated.push_back(terms[i].reference() + ": not separable from the model with the signals in this log" +
@@ -667,6 +732,12 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
     }
     const std::string reference = terms[i].reference();
     if (already_listed(out.candidates, reference)) continue;
+    std::vector<int>& own = columns_of[reference];
+    for (std::size_t k = 0; k < asked.params.size() && k < all_cols.size(); ++k) {
+      if (std::find(terms[i].params.begin(), terms[i].params.end(), asked.params[k]) != terms[i].params.end()) {
+        own.push_back(all_cols[k]);
+      }
+    }
     Candidate c;
     c.effect = reference;
     c.family = is_family(terms[i]);
@@ -692,6 +763,7 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   const std::size_t listed = out.candidates.size();
   offer_swaps(out, unseparated, log, fit, base, floors, options);
   if (out.candidates.size() > listed) order_ranked(out.candidates, options);
+  out.screened_pairs = screen_pairs(out.candidates, columns_of, stats, floors, base_cols);
   return out;
 }
 
@@ -710,26 +782,19 @@ bool told_alike(const Candidate& a, const Candidate& b) {
 constexpr int kMaxAlikePairFits = 9;
 /// Members of each of the three best classes of alike candidates the search pairs.
 constexpr std::size_t kAlikeClassMembers = 3;
+/// Screened pairs (Ranking::screened_pairs) the search fits at most after those; one where a
+/// best candidate is named already (PairSearch::kScreened: does the screen's first pair do
+/// better?).
+constexpr int kMaxScreenedPairFits = 3;
+constexpr int kMaxScreenedPairFitsNamed = 1;
 
-}  // namespace
+/// Whether the model with both candidates added explains the log (an exact fit of it).
+using PairExplains = std::function<bool(const Candidate&, const Candidate&)>;
 
-std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
-                                           const std::vector<Candidate>& candidates, const DiscoveryOptions& options) {
-  // Effects, not families: a pair is two findings, a family already many orders.
-  std::vector<const Candidate*> pool;
-  for (const Candidate& c : candidates) {
-    if (c.proposed && !c.family) pool.push_back(&c);
-  }
-  const auto explains = [&](const Candidate& a, const Candidate& b) {
-    std::vector<std::string> refs = fit.model.spec().references();
-    refs.push_back(a.effect);
-    refs.push_back(b.effect);
-    try {
-      return fit_prepared(log, refs, options).explained;
-    } catch (const std::invalid_argument&) {
-      return false;  // not separable together: not the pair
-    }
-  };
+
+/// The first explaining pair of the best three, then across the best classes of alike
+/// candidates (find_missing_pair).
+std::vector<std::string> best_or_alike_pair(const std::vector<const Candidate*>& pool, const PairExplains& explains) {
   const std::size_t best = std::min<std::size_t>(pool.size(), 3);
   for (std::size_t i = 0; i < best; ++i) {
     for (std::size_t j = i + 1; j < best; ++j) {
@@ -767,6 +832,74 @@ std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFi
     if (explains(*pool[i], *pool[j])) return {pool[i]->effect, pool[j]->effect};
   }
   return {};
+}
+
+/// Pairs the search has fitted.
+using TriedPairs = std::vector<std::pair<const Candidate*, const Candidate*>>;
+
+/// Whether the pair `a` + `b` is one tried, or the same but for members the log cannot tell
+/// apart (told_alike): those the alike classes' search chose among already.
+bool tried_or_alike(const Candidate& a, const Candidate& b, const TriedPairs& tried) {
+  const auto same = [](const Candidate& x, const Candidate& y) { return x.effect == y.effect || told_alike(x, y); };
+  return std::any_of(tried.begin(), tried.end(), [&](const auto& t) {
+    return (same(a, *t.first) && same(b, *t.second)) || (same(a, *t.second) && same(b, *t.first));
+  });
+}
+
+/// The first explaining pair of the best `budget` screened pairs not `tried`
+/// (tried_or_alike).
+std::vector<std::string> screened_pair(const std::vector<const Candidate*>& pool,
+                                       std::span<const std::pair<std::string, std::string>> screened,
+                                       const TriedPairs& tried, int budget,
+                                       const PairExplains& explains) {
+  // Last, the pairs whose joint linearised step fits best, wherever each ranks alone: two
+  // effects that share an order of the error (offsets 2 % and a 3 % quadrature under a 10 %
+  // imbalance) each take part of the other's signature, so the second ranks below the
+  // aliases of the first and outside the classes above.
+  const auto in_pool = [&](const std::string& e) -> const Candidate* {
+    const auto it = std::find_if(pool.begin(), pool.end(), [&](const Candidate* c) { return c->effect == e; });
+    return it == pool.end() ? nullptr : *it;
+  };
+  int fits = 0;
+  for (const auto& [a, b] : screened) {
+    if (fits == budget) break;
+    const Candidate* ca = in_pool(a);
+    const Candidate* cb = in_pool(b);
+    if (ca == nullptr || cb == nullptr || tried_or_alike(*ca, *cb, tried)) continue;
+    ++fits;
+    if (explains(*ca, *cb)) return {a, b};
+  }
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
+                                           const std::vector<Candidate>& candidates, const DiscoveryOptions& options,
+                                           std::span<const std::pair<std::string, std::string>> screened,
+                                           PairSearch search) {
+  // Effects, not families: a pair is two findings, a family already many orders.
+  std::vector<const Candidate*> pool;
+  for (const Candidate& c : candidates) {
+    if (c.proposed && !c.family) pool.push_back(&c);
+  }
+  TriedPairs tried;
+  const auto explains = [&](const Candidate& a, const Candidate& b) {
+    tried.emplace_back(&a, &b);
+    std::vector<std::string> refs = fit.model.spec().references();
+    refs.push_back(a.effect);
+    refs.push_back(b.effect);
+    try {
+      return fit_prepared(log, refs, options).explained;
+    } catch (const std::invalid_argument&) {
+      return false;  // not separable together: not the pair
+    }
+  };
+  if (search == PairSearch::kEvery) {
+    if (std::vector<std::string> found = best_or_alike_pair(pool, explains); !found.empty()) return found;
+  }
+  return screened_pair(pool, screened, tried,
+                       search == PairSearch::kEvery ? kMaxScreenedPairFits : kMaxScreenedPairFitsNamed, explains);
 }
 
 }  // namespace resolver

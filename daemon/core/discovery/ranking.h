@@ -12,6 +12,7 @@
 
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "daemon/core/discovery/model_discovery.h"
@@ -24,6 +25,10 @@ struct Ranking {
   std::vector<Candidate> candidates;     ///< best first
   std::vector<std::string> not_evaluated;
   int passes = 0;
+  /// Pairs of the first proposed candidates (effects, not families; none in place of a model
+  /// term), the pair whose joint linearised step leaves the least weighted residual first:
+  /// the two-effect search's last resort (find_missing_pair).
+  std::vector<std::pair<std::string, std::string>> screened_pairs;
 };
 
 /// What the log's motion (or signals) lacks for `e` to be identifiable, as advice
@@ -96,9 +101,15 @@ void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& op
 /// The two-effect search: the first pair of proposed candidates that together bring
 /// every signal to its floor; empty when none does. The best three are paired first;
 /// then, where the log cannot tell candidates apart (fits_as_well: the best three may be
-/// one class of aliases), the first members of the three best classes across classes.
+/// one class of aliases), the first members of the three best classes across classes;
+/// then the best `screened` pairs (Ranking::screened_pairs) not tried yet. With
+/// PairSearch::kScreened only those: a best candidate is named already, and the search asks
+/// only whether the pair the screen puts first does better (one fit).
+enum class PairSearch { kEvery, kScreened };
 [[nodiscard]] std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
                                                          const std::vector<Candidate>& candidates,
-                                                         const DiscoveryOptions& options);
+                                                         const DiscoveryOptions& options,
+                                                         std::span<const std::pair<std::string, std::string>> screened = {},
+                                                         PairSearch search = PairSearch::kEvery);
 
 }  // namespace resolver
