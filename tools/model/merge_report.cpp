@@ -63,6 +63,18 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
                                        "make the statistics with the model in --effects and merge again",
                                        fmt::join(m.linearised, ", "))};
   }
+  if (m.missing_pair.size() == 2) {
+    std::vector<std::string> values;
+    for (const ModelParameter& p : m.missing_pair_params) {
+      values.push_back(fmt::format("{} = {:.3g} +- {:.2g}", p.name, p.value, p.std_error));
+    }
+    // As explain's pair (model_discovery.cpp): named only when the two together reach the floor.
+    return {"missing_effect",
+            fmt::format("two effects are missing: {} and {} together bring every signal to within {}x its pooled "
+                        "floor, on held-back samples too (neither does alone). Fitted to convergence on every run "
+                        "(the statistics made again with both in the model): {}.",
+                        m.missing_pair[0], m.missing_pair[1], ratio, fmt::join(values, ", "))};
+  }
   const Candidate* best = m.candidates.empty() || !m.candidates.front().proposed ? nullptr : &m.candidates.front();
   std::int64_t rows = 0;
   for (const SignalResidual& r : m.signals) rows += r.rows;
@@ -83,7 +95,11 @@ MergeVerdict merge_verdict(const MergedFit& m, double explained_ratio) {
                  : exact  ? " Fitted to convergence on every run (the statistics made again with it in the model)."
                  : linear ? " Its parameters enter linearly: the step from the statistics is its fit."
                           : " Its value is one step linearised from zero: make the statistics again with it in "
-                            "--effects (or fit the logs) for the exact fit.")};
+                            "--effects (or fit the logs) for the exact fit.") +
+                (m.pair_search_skipped && !best->reaches_floor
+                     ? " It does not reach the floor, and two effects together may (see the note): "
+                       "not searched without the logs."
+                     : "")};
   }
   return {"unexplained", best == nullptr ? "no candidate in the statistics lowers the residual enough to be proposed"
                                          : "the best candidate, " + best->effect +
@@ -164,7 +180,9 @@ std::string format_merge_json(const MergedFit& m, const std::vector<std::string>
                      std::abs(d.z) > kPoolDisagreementZ);
   }
   const MergeVerdict v = merge_verdict(m, explained_ratio);
-  o += "],\"not_evaluated\":" + json_strings(m.not_evaluated) + ",\"notes\":" + json_strings(m.notes) +
+  o += "],\"missing_pair\":" + json_strings(m.missing_pair) + ",\"missing_pair_params\":" +
+       json_params(m.missing_pair_params);
+  o += ",\"not_evaluated\":" + json_strings(m.not_evaluated) + ",\"notes\":" + json_strings(m.notes) +
        ",\"verdict\":" + json::str(v.word) + ",\"summary\":" + json::str(v.summary) + "}\n";
   return o;
 }

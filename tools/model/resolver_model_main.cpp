@@ -708,6 +708,7 @@ int run_stats(const Arguments& a, const Model& model, const resolver::ProgressMe
       merged.fit.notes.emplace_back("the candidates are not refitted: a log is not a regular file and cannot be read "
                                     "a second time (their scores are one linearised step)");
     }
+    if (a.command == Command::kExplain) resolver::note_pairs_not_fitted(merged.fit);
   }
   resolver::print_merged(merged, a.json, options);
   return 0;

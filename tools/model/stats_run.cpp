@@ -118,14 +118,16 @@ MergedFit merge_again(const MergedFiles& merged, std::span<const std::string> ef
 
 namespace {
 
-/// Where the runs' refits with `effect` start: the merged model settled, the candidate at
+/// Where the runs' refits with `added` start: the merged model settled, each candidate at
 /// its merged linearised step.
-FitStartValues merged_start(const MergedFit& fit, const std::string& effect) {
+FitStartValues merged_start(const MergedFit& fit, const std::vector<std::string>& added) {
   FitStartValues start;
   start.values = fit.params;
   start.settled = fit.effects;
   for (const Candidate& c : fit.candidates) {
-    if (c.effect == effect) start.values.insert(start.values.end(), c.params.begin(), c.params.end());
+    if (std::find(added.begin(), added.end(), c.effect) != added.end()) {
+      start.values.insert(start.values.end(), c.params.begin(), c.params.end());
+    }
   }
   return start;
 }
@@ -264,37 +266,126 @@ void relinearise_merge(MergedFiles& merged, const StatisticsWith& statistics_wit
                              "merged fit " + passes_note(p));
 }
 
+namespace {
+
+/// The merge with `added` candidates in the model, fitted exactly (merge_exactly).
+struct ExactMerge {
+  std::optional<MergedFiles> with;  ///< empty: not fitted, `why` says why
+  std::string why;
+  std::string passes;  ///< what Gauss-Newton over passes did; empty when one pass is the fit
+  bool held = false;   ///< some run's rows alone could not separate an added one
+};
+
+/// The logs' statistics made again with `added` in the model, each run's fit started at the
+/// merged fit (merged_start), and merged: the exact fit for a linear model or a single run.
+/// A nonlinear one of several runs, or one some run holds, is relinearised at the merged
+/// fit over passes (iterate_at_merged).
+ExactMerge merge_exactly(const MergedFiles& merged, const std::vector<std::string>& added,
+                         const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
+  ExactMerge out;
+  std::vector<std::string> effects = merged.fit.effects;
+  effects.insert(effects.end(), added.begin(), added.end());
+  FitStartValues start = merged_start(merged.fit, added);
+  start.held = added;
+  try {
+    // The first pass fits each run from the merged start (its own valley of the
+    // candidate); their merge is the fit only for a linear model or a single run.
+    MergedFiles with = merge_files(statistics_with(effects, false, start), merged.paths, effects, options);
+    if (with.runs.size() != merged.runs.size()) {
+      out.why = fmt::format("{} of the {} runs could be fitted with it", with.runs.size(), merged.runs.size());
+      return out;
+    }
+    out.held = std::any_of(with.runs.begin(), with.runs.end(), [](const RunStatistics& r) { return !r.held.empty(); });
+    if (out.held || needs_passes(with.fit, with.runs.size())) {
+      out.passes = passes_note(iterate_at_merged(with, effects, false, start, statistics_with, options));
+    }
+    out.with = std::move(with);
+  } catch (const std::invalid_argument& e) {
+    out.why = e.what();
+  } catch (const InputError& e) {
+    out.why = e.what();
+  }
+  return out;
+}
+
+/// Whether explain's two-effect search runs on `m`, and which: where its best candidate does
+/// not reach the floor (model_discovery.cpp), only the screen's first pairs where it removes
+/// most of the excess (named already). None where the merge is explained or not judged.
+std::optional<PairSearch> pair_search_of(const MergedFit& m) {
+  if (m.explained || m.untrusted || !m.linearised.empty() || m.candidates.empty()) return std::nullopt;
+  const Candidate& best = m.candidates.front();
+  if (!best.proposed || best.reaches_floor || m.screened_pairs.empty()) return std::nullopt;
+  std::int64_t rows = 0;
+  for (const SignalResidual& r : m.signals) rows += r.rows;
+  return removes_most_excess(m.signals, rows, m.rd, best.weighted_rss) ? PairSearch::kScreened : PairSearch::kEvery;
+}
+
+/// explain in memory's two-effect search (model_discovery.cpp, ranking.h find_missing_pair)
+/// on the merged statistics: where the best candidate does not reach the floor, the pairs
+/// whose joint linearised step fits best (MergedFit::screened_pairs) are fitted exactly, and
+/// the first whose merge is explained is the finding. Only the screened pairs: the search
+/// in memory tries the best three and classes of alike candidates first, which a pass
+/// over the logs per pair makes dear here.
+void find_missing_pair_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with,
+                                 const DiscoveryOptions& options) {
+  MergedFit& m = merged.fit;
+  const std::optional<PairSearch> search = pair_search_of(m);
+  if (!search) return;
+  const std::vector<ScreenedPair> screened = m.screened_pairs;  // m's notes grow below
+  int fits = 0;
+  for (const ScreenedPair& pair : screened) {
+    if (!fits_next_screened(fits, *search, pair.weighted_rss, screened.front().weighted_rss)) break;
+    ++fits;
+    const std::string& a = pair.a;
+    const std::string& b = pair.b;
+    ExactMerge e = merge_exactly(merged, {a, b}, statistics_with, options);
+    if (!e.with) {
+      m.notes.push_back(fmt::format("the pair {} and {} was not fitted: {}", a, b, e.why));
+      continue;
+    }
+    if (!e.with->fit.explained) continue;
+    m.missing_pair = {a, b};
+    for (const ModelParameter& p : e.with->fit.params) {
+      const bool model_param = std::any_of(m.params.begin(), m.params.end(),
+                                           [&](const ModelParameter& q) { return q.name == p.name; });
+      if (!model_param) m.missing_pair_params.push_back(p);
+    }
+    if (!e.passes.empty()) {
+      m.notes.push_back(fmt::format("{} and {}: Gauss-Newton with every run's statistics made again at the merged fit "
+                                    "with both {}", a, b, e.passes));
+    }
+    return;
+  }
+}
+
+}  // namespace
+
+void note_pairs_not_fitted(MergedFit& m) {
+  if (!pair_search_of(m)) return;
+  m.pair_search_skipped = true;
+  const ScreenedPair& first = m.screened_pairs.front();
+  m.notes.push_back(fmt::format("no candidate alone reaches the floor and two together may ({} and {} fit best "
+                                "together, linearised): pairs are fitted only over passes of the logs, which these "
+                                "are not (statistics files, or a log that is not a regular file); run "
+                                "resolver-model explain --chunk on the logs",
+                                first.a, first.b));
+}
+
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options) {
   for (const std::string& effect : candidates_to_refit(merged.fit, options)) {
-    const auto not_refitted = [&](const std::string& why) {
-      merged.fit.notes.push_back(fmt::format("{} not refitted (its score stays one linearised step): {}", effect, why));
-    };
-    std::vector<std::string> effects = merged.fit.effects;
-    effects.push_back(effect);
-    FitStartValues start = merged_start(merged.fit, effect);
-    start.held = {effect};
-    try {
-      // The first pass fits each run from the merged start (its own valley of the
-      // candidate); their merge is the fit only for a linear model or a single run.
-      MergedFiles with = merge_files(statistics_with(effects, false, start), merged.paths, effects, options);
-      if (with.runs.size() != merged.runs.size()) {
-        not_refitted(fmt::format("{} of the {} runs could be fitted with it", with.runs.size(), merged.runs.size()));
-        continue;
-      }
-      const bool held = std::any_of(with.runs.begin(), with.runs.end(), [](const RunStatistics& r) { return !r.held.empty(); });
-      if (held || needs_passes(with.fit, with.runs.size())) {
-        const Passes p = iterate_at_merged(with, effects, false, start, statistics_with, options);
-        merged.fit.notes.push_back(fmt::format(
-            "{}: Gauss-Newton with every run's statistics made again at the merged fit with it{} {}", effect,
-            held ? " (some runs' rows alone cannot separate it: held at the merged value there)" : "", passes_note(p)));
-      }
-      take_exact_refit(merged.fit, effect, with.fit, options);
-    } catch (const std::invalid_argument& e) {
-      not_refitted(e.what());
-    } catch (const InputError& e) {
-      not_refitted(e.what());
+    const ExactMerge e = merge_exactly(merged, {effect}, statistics_with, options);
+    if (!e.with) {
+      merged.fit.notes.push_back(fmt::format("{} not refitted (its score stays one linearised step): {}", effect, e.why));
+      continue;
     }
+    if (!e.passes.empty()) {
+      merged.fit.notes.push_back(fmt::format(
+          "{}: Gauss-Newton with every run's statistics made again at the merged fit with it{} {}", effect,
+          e.held ? " (some runs' rows alone cannot separate it: held at the merged value there)" : "", e.passes));
+    }
+    take_exact_refit(merged.fit, effect, e.with->fit, options);
   }
+  find_missing_pair_from_logs(merged, statistics_with, options);
 }
 
 void print_merged(const MergedFiles& merged, bool json, const DiscoveryOptions& options) {
@@ -304,7 +395,9 @@ void print_merged(const MergedFiles& merged, bool json, const DiscoveryOptions& 
 
 int print_merge(const std::vector<StatsFile>& files, const std::vector<std::string>& paths,
                 std::span<const std::string> effects, bool json, const DiscoveryOptions& options) {
-  print_merged(merge_files(files, paths, effects, options), json, options);
+  MergedFiles merged = merge_files(files, paths, effects, options);
+  note_pairs_not_fitted(merged.fit);
+  print_merged(merged, json, options);
   return 0;
 }
 

@@ -79,8 +79,15 @@ void relinearise_merge(MergedFiles& merged, const StatisticsWith& statistics_wit
 /// the model's converged fit. A nonlinear refit of several runs, or one some run holds
 /// (its rows alone cannot separate it), is then relinearised at the merged fit over
 /// passes as relinearise_merge. A refit that fails leaves the candidate linearised, with
-/// a note saying why.
+/// a note saying why. Then, where the best candidate does not reach the floor, explain's
+/// two-effect search on the merged statistics: the pairs whose joint linearised step fits
+/// best (MergedFit::screened_pairs; at most 3, 1 where the best alone removes most of the
+/// excess) fitted so, the first whose merge is explained named (MergedFit::missing_pair).
 void refit_from_logs(MergedFiles& merged, const StatisticsWith& statistics_with, const DiscoveryOptions& options);
+
+/// Where explain's two-effect search would run on `m` (refit_from_logs) but cannot (no logs
+/// to read again): a note naming the pair the screen puts first.
+void note_pairs_not_fitted(MergedFit& m);
 
 /// Prints `merged` as text or JSON on stdout.
 void print_merged(const MergedFiles& merged, bool json, const DiscoveryOptions& options);

@@ -578,7 +578,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     return ex;
   }
   Ranking ranking = rank_candidates(log, ex.fit, options);
-  const std::vector<std::pair<std::string, std::string>> screened_pairs = std::move(ranking.screened_pairs);
+  const std::vector<ScreenedPair> screened_pairs = std::move(ranking.screened_pairs);
   ex.candidates = std::move(ranking.candidates);
   ex.not_evaluated = std::move(ranking.not_evaluated);
   ex.fit.passes += ranking.passes;

@@ -658,22 +658,18 @@ constexpr double kScreenedResidualRatio = 100.0;
 /// mechanical 6x alone leaves, linearised, and reaches the floor fitted.
 constexpr double kScreenedGain = 0.8;
 
-/// Ranking::screened_pairs: each pair's joint linearised step, solved from the ranking
-/// pass's statistics on the pair's columns (no pass over the rows: 28 small solves);
-/// pairs far behind the best, or little better than the best candidate alone, are left out
-/// (kScreenedResidualRatio, kScreenedGain).
-/// Linearised, so only an order of which pairs to fit exactly: at real magnitudes an
-/// envelope effect's step from zero leaves its second-order terms far above the floor.
-std::vector<std::pair<std::string, std::string>> screen_pairs(const std::vector<Candidate>& ranked,
-                                                              const std::map<std::string, std::vector<int>>& columns_of,
-                                                              const PassStatistics& stats, const GroupFloors& floors,
-                                                              const std::vector<int>& base_cols) {
+}  // namespace
+
+std::vector<ScreenedPair> screen_pairs(const std::vector<Candidate>& ranked,
+                                       const std::map<std::string, std::vector<int>>& columns_of,
+                                       const std::vector<NormalEquations>& groups, const GroupFloors& floors,
+                                       const std::vector<int>& base_cols) {
   std::vector<const Candidate*> pool;
   for (const Candidate& c : ranked) {
     if (pool.size() == kScreenedCandidates) break;
     if (c.proposed && !c.family && c.replaces.empty() && columns_of.count(c.effect) > 0) pool.push_back(&c);
   }
-  std::vector<std::pair<double, std::pair<std::string, std::string>>> scored;
+  std::vector<ScreenedPair> scored;
   for (std::size_t i = 0; i < pool.size(); ++i) {
     for (std::size_t j = i + 1; j < pool.size(); ++j) {
       std::vector<int> cols = base_cols;
@@ -681,23 +677,20 @@ std::vector<std::pair<std::string, std::string>> screen_pairs(const std::vector<
         const std::vector<int>& own = columns_of.at(c->effect);
         cols.insert(cols.end(), own.begin(), own.end());
       }
-      const StepSolution s = solve_step(stats.all, floors, cols);
-      if (s.ok) scored.push_back({s.rss_w, {pool[i]->effect, pool[j]->effect}});
+      const StepSolution s = solve_step(groups, floors, cols);
+      if (s.ok) scored.push_back({pool[i]->effect, pool[j]->effect, s.rss_w});
     }
   }
-  std::stable_sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<std::pair<std::string, std::string>> out;
-  out.reserve(scored.size());
+  std::stable_sort(scored.begin(), scored.end(),
+                   [](const ScreenedPair& a, const ScreenedPair& b) { return a.weighted_rss < b.weighted_rss; });
   const double best_alone = ranked.empty() ? 0.0 : ranked.front().weighted_rss;
-  for (auto& [rss, pair] : scored) {
-    if (rss > kScreenedResidualRatio * scored.front().first) break;
-    if (rss > kScreenedGain * best_alone) break;
-    out.push_back(std::move(pair));
-  }
-  return out;
+  const auto kept = std::find_if(scored.begin(), scored.end(), [&](const ScreenedPair& p) {
+    return p.weighted_rss > kScreenedResidualRatio * scored.front().weighted_rss ||
+           p.weighted_rss > kScreenedGain * best_alone;
+  });
+  scored.erase(kept, scored.end());
+  return scored;
 }
-
-}  // namespace
 
 Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options) {
   Ranking out;
@@ -763,8 +756,30 @@ Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const Disco
   const std::size_t listed = out.candidates.size();
   offer_swaps(out, unseparated, log, fit, base, floors, options);
   if (out.candidates.size() > listed) order_ranked(out.candidates, options);
-  out.screened_pairs = screen_pairs(out.candidates, columns_of, stats, floors, base_cols);
+  out.screened_pairs = screen_pairs(out.candidates, columns_of, stats.all, floors, base_cols);
   return out;
+}
+
+namespace {
+
+/// Screened pairs the search fits at most after the others; one where a best candidate is
+/// named already (PairSearch::kScreened: does the screen's first pair do better?).
+constexpr int kMaxScreenedPairFits = 3;
+constexpr int kMaxScreenedPairFitsNamed = 1;
+/// Pairs whose steps leave within this share of the first fitted pair's residual are ones
+/// the screen cannot order: where two candidates fit the same order of the error
+/// linearised (a mechanical 6x and a phased K_3 at p_r = 3, both on 2 theta), their pairs
+/// with a quadrature tied to 1e-6 in memory and differed by 0.5 % merged from 2 s chunks,
+/// and only the exact fit tells the true one (K_3) from the other. Pairs of different
+/// effects lie far apart (the right pair of offsets and a quadrature: 1/97 of the next).
+constexpr double kScreenTie = 0.05;
+
+}  // namespace
+
+bool fits_next_screened(int fits, PairSearch search, double rss, double first_rss) {
+  if (fits >= kMaxScreenedPairFits) return false;
+  if (search == PairSearch::kEvery || fits < kMaxScreenedPairFitsNamed) return true;
+  return rss <= (1.0 + kScreenTie) * first_rss;
 }
 
 namespace {
@@ -782,11 +797,6 @@ bool told_alike(const Candidate& a, const Candidate& b) {
 constexpr int kMaxAlikePairFits = 9;
 /// Members of each of the three best classes of alike candidates the search pairs.
 constexpr std::size_t kAlikeClassMembers = 3;
-/// Screened pairs (Ranking::screened_pairs) the search fits at most after those; one where a
-/// best candidate is named already (PairSearch::kScreened: does the screen's first pair do
-/// better?).
-constexpr int kMaxScreenedPairFits = 3;
-constexpr int kMaxScreenedPairFitsNamed = 1;
 
 /// Whether the model with both candidates added explains the log (an exact fit of it).
 using PairExplains = std::function<bool(const Candidate&, const Candidate&)>;
@@ -846,12 +856,10 @@ bool tried_or_alike(const Candidate& a, const Candidate& b, const TriedPairs& tr
   });
 }
 
-/// The first explaining pair of the best `budget` screened pairs not `tried`
-/// (tried_or_alike).
-std::vector<std::string> screened_pair(const std::vector<const Candidate*>& pool,
-                                       std::span<const std::pair<std::string, std::string>> screened,
-                                       const TriedPairs& tried, int budget,
-                                       const PairExplains& explains) {
+/// The first explaining pair of the screened pairs not `tried` (tried_or_alike) that
+/// fits_next_screened lets the search fit.
+std::vector<std::string> screened_pair(const std::vector<const Candidate*>& pool, std::span<const ScreenedPair> screened,
+                                       const TriedPairs& tried, PairSearch search, const PairExplains& explains) {
   // Last, the pairs whose joint linearised step fits best, wherever each ranks alone: two
   // effects that share an order of the error (offsets 2 % and a 3 % quadrature under a 10 %
   // imbalance) each take part of the other's signature, so the second ranks below the
@@ -861,13 +869,15 @@ std::vector<std::string> screened_pair(const std::vector<const Candidate*>& pool
     return it == pool.end() ? nullptr : *it;
   };
   int fits = 0;
-  for (const auto& [a, b] : screened) {
-    if (fits == budget) break;
-    const Candidate* ca = in_pool(a);
-    const Candidate* cb = in_pool(b);
+  double first_rss = 0.0;
+  for (const ScreenedPair& p : screened) {
+    const Candidate* ca = in_pool(p.a);
+    const Candidate* cb = in_pool(p.b);
     if (ca == nullptr || cb == nullptr || tried_or_alike(*ca, *cb, tried)) continue;
+    if (fits == 0) first_rss = p.weighted_rss;
+    if (!fits_next_screened(fits, search, p.weighted_rss, first_rss)) break;
     ++fits;
-    if (explains(*ca, *cb)) return {a, b};
+    if (explains(*ca, *cb)) return {p.a, p.b};
   }
   return {};
 }
@@ -876,8 +886,7 @@ std::vector<std::string> screened_pair(const std::vector<const Candidate*>& pool
 
 std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
                                            const std::vector<Candidate>& candidates, const DiscoveryOptions& options,
-                                           std::span<const std::pair<std::string, std::string>> screened,
-                                           PairSearch search) {
+                                           std::span<const ScreenedPair> screened, PairSearch search) {
   // Effects, not families: a pair is two findings, a family already many orders.
   std::vector<const Candidate*> pool;
   for (const Candidate& c : candidates) {
@@ -898,8 +907,7 @@ std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFi
   if (search == PairSearch::kEvery) {
     if (std::vector<std::string> found = best_or_alike_pair(pool, explains); !found.empty()) return found;
   }
-  return screened_pair(pool, screened, tried,
-                       search == PairSearch::kEvery ? kMaxScreenedPairFits : kMaxScreenedPairFitsNamed, explains);
+  return screened_pair(pool, screened, tried, search, explains);
 }
 
 }  // namespace resolver

@@ -10,6 +10,7 @@
 // collinear here, e.g. K_2 and offsets without sin/cos) are listed together.
 #pragma once
 
+#include <map>
 #include <span>
 #include <string>
 #include <utility>
@@ -21,6 +22,12 @@
 
 namespace resolver {
 
+/// Two candidates and what their joint linearised step leaves (screen_pairs).
+struct ScreenedPair {
+  std::string a, b;
+  double weighted_rss = 0.0;  ///< each signal over its floor squared
+};
+
 struct Ranking {
   std::vector<Candidate> candidates;     ///< best first
   std::vector<std::string> not_evaluated;
@@ -28,7 +35,7 @@ struct Ranking {
   /// Pairs of the first proposed candidates (effects, not families; none in place of a model
   /// term), the pair whose joint linearised step leaves the least weighted residual first:
   /// the two-effect search's last resort (find_missing_pair).
-  std::vector<std::pair<std::string, std::string>> screened_pairs;
+  std::vector<ScreenedPair> screened_pairs;
 };
 
 /// What the log's motion (or signals) lacks for `e` to be identifiable, as advice
@@ -95,6 +102,18 @@ void flag_one_step(Candidate& c, const DiscoveryOptions& options);
 /// apart simplest first (fits_as_well), a family first only when nothing smaller does.
 void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& options);
 
+/// Ranking::screened_pairs: each pair of the best proposed candidates of `ranked` (effects,
+/// not families, none in place of a model term), its joint linearised step solved from
+/// `groups` (the normal equations of the model's `base_cols` and every candidate's
+/// `columns_of`: no pass over the rows, 28 small solves). Pairs far behind the best, or
+/// little better than the best candidate alone, are left out. Linearised, so only an order
+/// of which pairs to fit exactly: at real magnitudes an envelope effect's step from zero
+/// leaves its second-order terms far above the floor. The same on a log and on merged
+/// statistics.
+[[nodiscard]] std::vector<ScreenedPair> screen_pairs(
+    const std::vector<Candidate>& ranked, const std::map<std::string, std::vector<int>>& columns_of,
+    const std::vector<NormalEquations>& groups, const GroupFloors& floors, const std::vector<int>& base_cols);
+
 /// Ranks the candidates for the fitted model `fit` on `log`.
 [[nodiscard]] Ranking rank_candidates(const PreparedLog& log, const ModelFit& fit, const DiscoveryOptions& options);
 
@@ -104,12 +123,20 @@ void order_ranked(std::vector<Candidate>& candidates, const DiscoveryOptions& op
 /// one class of aliases), the first members of the three best classes across classes;
 /// then the best `screened` pairs (Ranking::screened_pairs) not tried yet. With
 /// PairSearch::kScreened only those: a best candidate is named already, and the search asks
-/// only whether the pair the screen puts first does better (one fit).
+/// only whether the pair the screen puts first does better (one fit, more only where the
+/// next pairs tie with it: fits_next_screened).
 enum class PairSearch { kEvery, kScreened };
+
+/// Whether a two-effect search that has fitted `fits` screened pairs, the first leaving
+/// `first_rss`, fits the next one, leaving `rss` linearised: at most 3; with
+/// PairSearch::kScreened 1, and beyond it only pairs the screen cannot order against the
+/// first (within 5 % of its residual). The same rule on a log and on merged statistics.
+[[nodiscard]] bool fits_next_screened(int fits, PairSearch search, double rss, double first_rss);
+
 [[nodiscard]] std::vector<std::string> find_missing_pair(const PreparedLog& log, const ModelFit& fit,
                                                          const std::vector<Candidate>& candidates,
                                                          const DiscoveryOptions& options,
-                                                         std::span<const std::pair<std::string, std::string>> screened = {},
+                                                         std::span<const ScreenedPair> screened = {},
                                                          PairSearch search = PairSearch::kEvery);
 
 }  // namespace resolver

@@ -178,7 +178,7 @@ std::vector<std::string> linearised_from_zero(const Design& d, const std::vector
 /// runs separate when the whole set is not (ranking.h solve_candidate, as explain).
 void score_merged(const Design& d, std::size_t i, const ModelTerm& asked, const MergedStatistics& stats,
                   const StepSolution& base, const GroupFloors& floors, bool rd, const DiscoveryOptions& options,
-                  MergedFit& out) {
+                  MergedFit& out, std::map<std::string, std::vector<int>>& columns_of) {
   const DesignTerm& t = d.terms()[i];
   std::vector<int> set_cols;
   for (int p : asked.params) {
@@ -197,6 +197,10 @@ void score_merged(const Design& d, std::size_t i, const ModelTerm& asked, const 
   }
   const std::string reference = set.reference();
   if (already_listed(out.candidates, reference)) return;
+  std::vector<int>& own = columns_of[reference];  // narrowed: only the parameters kept
+  for (std::size_t k = 0; k < asked.params.size(); ++k) {
+    if (std::find(set.params.begin(), set.params.end(), asked.params[k]) != set.params.end()) own.push_back(set_cols[k]);
+  }
   Candidate c;
   c.effect = reference;
   c.family = is_family(set);
@@ -215,10 +219,11 @@ void score_merged(const Design& d, std::size_t i, const ModelTerm& asked, const 
 /// Every candidate term of `d` (after the model's) scored against `base`: an effect's
 /// sets as the reference run's fit asked for them (RunStatistics::candidate_sets), else
 /// its whole term. What the runs' motion together lacks for candidates (motion_missing):
-/// every run's speeds and reversals, and a log's between its chunks.
+/// every run's speeds and reversals, and a log's between its chunks. `columns_of`: each
+/// scored candidate's columns (the pair screen's, ranking.h screen_pairs).
 void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolution& base, const GroupFloors& floors,
                  const std::vector<RunStatistics>& runs, const RunsByLog& logs, std::size_t ref,
-                 const DiscoveryOptions& options, MergedFit& out) {
+                 const DiscoveryOptions& options, MergedFit& out, std::map<std::string, std::vector<int>>& columns_of) {
   MotionSummary motion;
   for (std::size_t r = 0; r < runs.size(); ++r) add_motion(motion, runs[r].motion, r == 0);
   // A log's chunks share its reference zero: a log that went both ways, one direction per
@@ -245,9 +250,9 @@ void rank_merged(const Design& d, const MergedStatistics& stats, const StepSolut
       const ModelSpec one = ModelSpec::parse(std::vector<std::string>{name}, options.customs);
       if (one.terms.front().effect != term.effect) continue;
       by_sets = true;
-      score_merged(d, i, one.terms.front(), stats, base, floors, rd, options, out);
+      score_merged(d, i, one.terms.front(), stats, base, floors, rd, options, out, columns_of);
     }
-    if (!by_sets) score_merged(d, i, term, stats, base, floors, rd, options, out);
+    if (!by_sets) score_merged(d, i, term, stats, base, floors, rd, options, out, columns_of);
   }
   order_ranked(out.candidates, options);
 }
@@ -502,7 +507,8 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
                                     fmt::join(stepped, ", "), stepped.size() == 1 ? "is" : "are"));
   }
   take_run_flags(runs, names, out);
-  rank_merged(d, stats, s, gf, runs, logs, ref, options, out);
+  std::map<std::string, std::vector<int>> columns_of;
+  rank_merged(d, stats, s, gf, runs, logs, ref, options, out, columns_of);
   for (Candidate& c : out.candidates) flag_one_step(c, options);
   if (out.explained || out.untrusted || !out.linearised.empty()) {
     // As explain: a model at the floor needs nothing; a candidate's BIC drop there is noise
@@ -510,6 +516,7 @@ MergedFit merge_runs(const std::vector<RunStatistics>& runs, const std::vector<s
     // to faulty signals a candidate names the fault's shape, not the resolver's physics.
     for (Candidate& c : out.candidates) c.proposed = false;
   }
+  out.screened_pairs = screen_pairs(out.candidates, columns_of, stats.all, gf, cols);
   if (runs.size() > 1) {
     ModelFit merged;
     merged.params = out.params;

@@ -30,6 +30,7 @@
 #include "daemon/core/discovery/model_discovery.h"
 #include "daemon/core/discovery/pool.h"
 #include "daemon/core/discovery/prepare.h"
+#include "daemon/core/discovery/ranking.h"
 #include "daemon/core/model/least_squares.h"
 
 namespace resolver {
@@ -116,6 +117,16 @@ struct MergedFit {
   /// refitted candidates those: fitted by Gauss-Newton steps of merges over passes, not
   /// to convergence on each run.
   std::vector<std::string> held;
+  /// Pairs of proposed candidates, the best joint linearised step first (ranking.h
+  /// screen_pairs, from the merged statistics): what the two-effect search fits.
+  std::vector<ScreenedPair> screened_pairs;
+  /// Two candidates whose merged exact fit together reaches the floor where neither alone
+  /// does (stats_run.h find_missing_pair_from_logs), with their fitted parameters.
+  std::vector<std::string> missing_pair;
+  std::vector<ModelParameter> missing_pair_params;
+  /// The two-effect search would run but could not (no logs to read again): a candidate
+  /// named alone short of the floor may be the wrong one, and the verdict says so.
+  bool pair_search_skipped = false;
   bool untrusted = false;  ///< some run's signals were faulty for long: never explained, nothing proposed
   /// The model's prediction is not linear in its parameters (least_squares.h
   /// strictly_linear): the merge is one Gauss-Newton step from the runs' points, exact
