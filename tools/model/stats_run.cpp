@@ -331,7 +331,7 @@ void find_missing_pair_from_logs(MergedFiles& merged, const StatisticsWith& stat
   MergedFit& m = merged.fit;
   const std::optional<PairSearch> search = pair_search_of(m);
   if (!search) return;
-  const std::vector<ScreenedPair> screened = m.screened_pairs;  // m's notes grow below
+  const std::vector<ScreenedPair>& screened = m.screened_pairs;  // the search adds only notes and the pair
   int fits = 0;
   for (const ScreenedPair& pair : screened) {
     if (!fits_next_screened(fits, *search, pair.weighted_rss, screened.front().weighted_rss)) break;
