@@ -17,6 +17,14 @@
 // on the same frequency as the resolver's amplitude imbalance (Hwang eq. 15-16):
 // only the resolver signals tell them apart (docs/ARCHITECTURE.md §7).
 // Compensation: divide the measured a, b currents by (1 + gain).
+//
+// In the fit the operating current is the MEASURED mean (SignatureRow::i_d0, the d and q
+// constants): I (1 + c) with c the DC factor above, not the machine's I. Taking the ripple
+// at the measured mean, as a first-order column does, scales and turns it by 1 + c: at
+// gains of 3 % and -2 % that biased gain_a by 1.8 % (0.0295 for 0.03, 9 standard errors).
+// The fit's prediction solves I from the measured mean at the current gains instead
+// (current_gain_mismatch_operating_point), exact at any magnitude, and its columns are
+// the derivatives of that prediction.
 #pragma once
 
 #include <array>
@@ -42,6 +50,11 @@ using CurrentGainMismatchParams = ParamSet<kCurrentGainMismatchParams>;
 /// (i_d, i_q) [A] in that frame (ideal currents). Exact.
 [[nodiscard]] DqCurrents current_gain_mismatch_dq_error(const CurrentGainMismatchParams& p, double i_d,
                                                         double i_q, double theta_e);
+
+/// The machine's operating current (i_d, i_q) [A] whose measured mean, DC error of the
+/// gains included, is `measured` [A]: solves measured = I + DC(I), a 2x2 linear system.
+[[nodiscard]] DqCurrents current_gain_mismatch_operating_point(const CurrentGainMismatchParams& p,
+                                                               DqCurrents measured);
 
 /// [A] amplitude A_2 of the 2x theta_e ripple on i_d (and on i_q) at current (i_d, i_q) [A].
 [[nodiscard]] double current_gain_mismatch_ripple_2x(const CurrentGainMismatchParams& p, double i_d, double i_q);
