@@ -90,7 +90,7 @@ class Parser {
         std::string key = string_body();
         skip_space();
         expect(':');
-        v.members.emplace_back(std::move(key), value());
+        v.members.push_back({std::move(key), value()});
         if (next() == ',') {
           ++pos_;
           continue;

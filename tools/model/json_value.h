@@ -13,13 +13,17 @@
 
 namespace resolver::json {
 
+struct JsonMember;
+
 struct Json {
   enum class Kind { kNull, kBool, kNumber, kString, kArray, kObject };
   Kind kind = Kind::kNull;
   bool boolean = false;
   std::string text;  ///< number text or decoded string
   std::vector<Json> items;
-  std::vector<std::pair<std::string, Json>> members;  ///< in document order
+  /// In document order. Not a std::pair<std::string, Json>: a pair needs Json complete,
+  /// which only GCC's library lets pass inside Json itself (clang refuses it).
+  std::vector<JsonMember> members;
 
   bool is_null() const { return kind == Kind::kNull; }
   double number() const;
@@ -29,6 +33,11 @@ struct Json {
   const Json& operator[](std::size_t index) const { return items.at(index); }
   bool has(std::string_view key) const;
   std::vector<std::string> keys() const;
+};
+
+struct JsonMember {
+  std::string name;
+  Json value;
 };
 
 /// Parses exactly one JSON value filling `text`; throws std::runtime_error

@@ -77,7 +77,7 @@ class Parser {
       while (true) {
         std::string key = string_body();
         expect(':');
-        v.members.emplace_back(std::move(key), value());
+        v.members.push_back({std::move(key), value()});
         if (peek() == ',') {
           ++pos_;
           continue;
