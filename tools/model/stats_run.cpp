@@ -292,7 +292,8 @@ ExactMerge merge_exactly(const MergedFiles& merged, const std::vector<std::strin
     // candidate); their merge is the fit only for a linear model or a single run.
     MergedFiles with = merge_files(statistics_with(effects, false, start), merged.paths, effects, options);
     if (with.runs.size() != merged.runs.size()) {
-      out.why = fmt::format("{} of the {} runs could be fitted with it", with.runs.size(), merged.runs.size());
+      out.why = fmt::format("{} of the {} runs could be fitted with {}", with.runs.size(), merged.runs.size(),
+                            fmt::join(added, " and "));
       return out;
     }
     out.held = std::any_of(with.runs.begin(), with.runs.end(), [](const RunStatistics& r) { return !r.held.empty(); });
