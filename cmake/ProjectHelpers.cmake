@@ -15,6 +15,14 @@ endif()
 
 include(GoogleTest)
 
+# resolver_unit_test_uses(target ...): these targets are what a test labelled "unit"
+# runs. The target unit_tests (top CMakeLists.txt) builds them all and nothing else: the
+# sanitizer stage of tools/run-tests.sh runs only the unit label, and building every
+# program, benchmark and integration helper there cost it minutes for no test.
+function(resolver_unit_test_uses)
+  set_property(GLOBAL APPEND PROPERTY RESOLVER_UNIT_TEST_TARGETS ${ARGN})
+endfunction()
+
 # add_unit_test(NAME SOURCES a.cpp ... [LIBS lib ...] [LABELS label ...])
 # Builds a GoogleTest executable and registers each TEST with ctest.
 # The default label is "unit"; integration tests pass LABELS integration.
@@ -24,6 +32,9 @@ function(add_unit_test name)
     set(ARG_LABELS unit)
   endif()
   add_executable(${name} ${ARG_SOURCES})
+  if("unit" IN_LIST ARG_LABELS)
+    resolver_unit_test_uses(${name})
+  endif()
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main resolver_build_flags)
   target_compile_definitions(${name} PRIVATE
     RESOLVER_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
