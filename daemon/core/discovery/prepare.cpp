@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "daemon/core/angles.h"
+#include "daemon/core/discovery/current_operating_point.h"
 #include "daemon/core/discovery/self_calibration.h"
 #include "daemon/core/estimation/dq_transform.h"
 
@@ -400,24 +401,23 @@ void build_rows(const DiscoveryInput& in, const std::vector<const Sample*>& s, c
   }
 }
 
-/// The operating point of the currents: i_d, i_q averaged over the moving rows,
-/// given to every row. Sets p.currents to whether any row has them.
+/// The operating point of the currents: the constant of i_d, i_q over the moving rows
+/// with the effects' ripple fitted out (current_operating_point.h), given to every row.
+/// Sets p.currents to whether any row has them.
 void set_current_operating_point(PreparedLog& p) {
-  double i_d0 = 0.0, i_q0 = 0.0;
-  std::int64_t n_cur = 0;
+  CurrentOperatingPointFit fit;
+  bool any = false;
   for (const FitRow& r : p.rows) {
     if (!r.has(FitRow::kHasCur) || !r.has(FitRow::kMoving)) continue;
-    i_d0 += r.y_d;
-    i_q0 += r.y_q;
-    ++n_cur;
+    fit.add(r.sig.theta_e, r.y_d, r.y_q);
+    any = true;
   }
-  p.currents = n_cur > 0;
-  if (n_cur == 0) return;
-  i_d0 /= static_cast<double>(n_cur);
-  i_q0 /= static_cast<double>(n_cur);
+  p.currents = any;
+  if (!any) return;
+  const CurrentOperatingPoint op = fit.result();
   for (FitRow& r : p.rows) {
-    r.sig.i_d0 = i_d0;
-    r.sig.i_q0 = i_q0;
+    r.sig.i_d0 = op.i_d;
+    r.sig.i_q0 = op.i_q;
   }
 }
 
