@@ -17,7 +17,8 @@ bash tools/build.sh -DRESOLVER_WERROR=ON -DRESOLVER_BUILD_TESTS=ON
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 if [ "${RESOLVER_SANITIZE:-0}" = "1" ]; then
   echo "== sanitizer build (ASan + UBSan)"
-  cmake -S . -B build-asan -DRESOLVER_WERROR=ON -DRESOLVER_BUILD_TESTS=ON -DRESOLVER_SANITIZE=ON \
+  # RESOLVER_FUZZ_COVERAGE: the fuzzers can be built here too (.ci/run fuzzes in this tree).
+  cmake -S . -B build-asan -DRESOLVER_WERROR=ON -DRESOLVER_BUILD_TESTS=ON -DRESOLVER_SANITIZE=ON -DRESOLVER_FUZZ_COVERAGE=ON \
     -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Debug \
     "-DCMAKE_CXX_FLAGS_DEBUG=-gline-tables-only -O1" "-DCMAKE_C_FLAGS_DEBUG=-gline-tables-only -O1" >/dev/null
   cmake --build build-asan -j"$(nproc)" --target unit_tests

@@ -10,6 +10,9 @@
 #                           daemon_config asc_reader csv_reader (default: all)
 #   environment:
 #       FUZZ_BUILD_DIR  build folder (default <repo>/build-fuzz)
+#       FUZZ_USE_BUILD  1: FUZZ_BUILD_DIR is an existing clang sanitizer build configured
+#                       with -DRESOLVER_FUZZ_COVERAGE=ON (CI's build-asan); only the fuzz
+#                       targets are built in it, it is not configured again
 #       FUZZ_JOBS       parallel compile jobs (default: nproc)
 #       FUZZ_RUNS       also stop after this many executions per target
 #       FUZZ_ARGS       extra libFuzzer flags, e.g. "-jobs=2 -workers=2"
@@ -53,8 +56,19 @@ fi
 san="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
 cmake_args=(-S "$repo" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++
             -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRESOLVER_BUILD_TESTS=ON "-DCMAKE_C_FLAGS=$san" "-DCMAKE_CXX_FLAGS=$san")
-echo "== configuring $build (clang, ASan + UBSan + libFuzzer)"
-cmake "${cmake_args[@]}" >"$build.configure.log" 2>&1 || { cat "$build.configure.log" >&2; exit 2; }
+if [[ ${FUZZ_USE_BUILD:-0} == 1 ]]; then
+  cache=$build/CMakeCache.txt
+  if ! grep -q '^RESOLVER_FUZZ_COVERAGE:BOOL=ON' "$cache" 2>/dev/null ||
+     ! grep -q '^CMAKE_CXX_COMPILER:[A-Z]*=.*clang++' "$cache"; then
+    echo "run_fuzzers.sh: FUZZ_USE_BUILD=1 needs $build configured by clang with -DRESOLVER_FUZZ_COVERAGE=ON" \
+         "and sanitizers (see tools/run-tests.sh); $cache is not" >&2
+    exit 2
+  fi
+  echo "== using $build (configured with RESOLVER_FUZZ_COVERAGE)"
+else
+  echo "== configuring $build (clang, ASan + UBSan + libFuzzer)"
+  cmake "${cmake_args[@]}" >"$build.configure.log" 2>&1 || { cat "$build.configure.log" >&2; exit 2; }
+fi
 echo "== building ${targets[*]}"
 build_targets=()
 for t in "${targets[@]}"; do build_targets+=(--target "fuzz_$t"); done
