@@ -415,6 +415,11 @@ void set_current_operating_point(PreparedLog& p) {
   p.currents = any;
   if (!any) return;
   const CurrentOperatingPoint op = fit.result();
+  if (!op.ripple_separated) {
+    p.notes.emplace_back(
+        "the moving samples cover too little of the motor's electrical angle to tell the currents' ripple from "
+        "their operating point: it is their mean, and current-side effects' values may carry part of the ripple");
+  }
   for (FitRow& r : p.rows) {
     r.sig.i_d0 = op.i_d;
     r.sig.i_q0 = op.i_q;
