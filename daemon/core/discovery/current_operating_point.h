@@ -20,7 +20,7 @@ struct CurrentOperatingPoint {
 /// mean; where the angle is not covered evenly (a reversal's slow crossing of zero speed,
 /// a ramp ending mid-turn) the mean takes a share of the ripple, which the sensor gains'
 /// exact prediction (current_gain_mismatch.h) would read as a wrong machine current:
-/// ~1e-3 of 10 A on a bench-like log, 3-5 standard errors of the gains.
+/// ~1e-3 of 10 A on a bench-like log, 3-8 standard errors of the gains (docs/ACCURACY.md).
 class CurrentOperatingPointFit {
  public:
   static constexpr int kColumns = 9;  ///< the constant, then cos and sin of each order
