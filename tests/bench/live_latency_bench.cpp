@@ -305,6 +305,11 @@ RunResult run_once(const Options& o) {
   r.frames_decoded = pipeline.intake().stats().frames_decoded;
   r.rejects = pipeline.intake().rejects().total();
   r.lcm_failures = lcm.publish_failures();
+  if (const resolver::LiveModelFit* fit = pipeline.model_fit()) {
+    r.windows_fitted = fit->counters().windows_fitted;
+    r.windows_insufficient = fit->counters().windows_insufficient;
+    r.windows_skipped = fit->counters().windows_skipped;
+  }
   r.sample_rate_hz = feed.sample_rate_hz();
   r.rpm = feed.rpm();
   return r;

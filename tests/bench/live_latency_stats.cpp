@@ -106,7 +106,9 @@ void print_table(std::ostream& out, const Setup& s, std::vector<RunResult>& runs
         << "), read " << r.frames_read << ", kernel drops " << r.kernel_drops << " (+ " << r.iface_drops
         << " before any socket, rx_dropped), frames_seen " << r.frames_seen
         << ", decoded " << r.frames_decoded << ", rejects " << r.rejects << ", LCM publish failures " << r.lcm_failures
-        << ", CPU " << fmt("%.3f", r.cpu_s) << " s over " << fmt("%.2f", r.wall_s) << " s\n";
+        << ", CPU " << fmt("%.3f", r.cpu_s) << " s over " << fmt("%.2f", r.wall_s) << " s; model fit windows: "
+        << r.windows_fitted << " fitted, " << r.windows_insufficient << " insufficient, " << r.windows_skipped
+        << " skipped (the fit was still running)\n";
   }
   if (m.published == 0) {
     out << "targets: not applicable, nothing was published (--read-only measures the read path's floor)\n";
@@ -145,7 +147,9 @@ void write_json(std::ostream& out, const Setup& s, std::vector<RunResult>& runs)
     const RunResult& r = runs[i];
     out << (i ? ", " : "") << "{\"row\": " << row_json(rows[i]) << ", \"sent\": " << r.sent.sent
         << ", \"read\": " << r.frames_read << ", \"kernel_drops\": " << r.kernel_drops << ", \"iface_drops\": " << r.iface_drops
-        << ", \"frames_seen\": " << r.frames_seen << ", \"rejects\": " << r.rejects << "}";
+        << ", \"frames_seen\": " << r.frames_seen << ", \"rejects\": " << r.rejects
+        << ", \"windows_fitted\": " << r.windows_fitted << ", \"windows_insufficient\": " << r.windows_insufficient
+        << ", \"windows_skipped\": " << r.windows_skipped << "}";
   }
   out << "], \"median\": " << row_json(median_row(rows))
       << ", \"all_frames_accounted\": " << (all_frames_accounted(runs) ? "true" : "false") << "}\n";

@@ -36,6 +36,11 @@ struct RunResult {
   std::int64_t frames_decoded = 0;
   std::int64_t rejects = 0;
   std::uint64_t lcm_failures = 0;
+  /// The live model fit's windows over the whole run (LiveModelFit::Counters): what the
+  /// fit thread's CPU bought; all 0 with the fit off.
+  std::int64_t windows_fitted = 0;
+  std::int64_t windows_insufficient = 0;
+  std::int64_t windows_skipped = 0;
   double sample_rate_hz = 0.0;
   double rpm = 0.0;
 };

@@ -74,11 +74,10 @@ SignalValues Model::predict_with_shift(const SignatureRow& row, double shift) co
     scratch_ = Design(spec_, values_, {});
     scratch_valid_ = true;
   }
-  AngleBasis basis;
   FitRow r;
   r.sig = row;
   scratch_.set_frame_shift(shift);
-  return scratch_.predict(r, basis);
+  return scratch_.predict(r, basis_);
 }
 
 bool Model::has_angle_terms() const {

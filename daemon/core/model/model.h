@@ -71,6 +71,10 @@ class Model {
   std::shared_ptr<const CustomEffects> customs_;
   mutable Design scratch_;
   mutable bool scratch_valid_ = false;
+  /// The basis of the last predicted row, kept so that its series' buffers are not
+  /// allocated again for every sample the compensator corrects (a third of a replay's
+  /// compensation time was malloc and free).
+  mutable AngleBasis basis_;
 };
 
 }  // namespace resolver
