@@ -65,6 +65,7 @@
 #include "daemon/core/discovery/prepare.h"
 #include "daemon/core/effects/registry.h"
 #include "daemon/core/model/least_squares.h"
+#include "daemon/core/model/normal_equations.h"
 #include "daemon/core/estimation/dq_transform.h"
 #include "daemon/core/estimation/angle_error_fourier.h"
 #include "daemon/core/estimation/hwang_integral.h"
@@ -587,6 +588,24 @@ void BM_DesignPass(benchmark::State& state) {
   state.counters["columns"] = d.columns();
 }
 BENCHMARK(BM_DesignPass)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
+/// NormalEquations::add per row, by column count: the sums every fit pass, floor and
+/// breakdown accumulates (6-10 columns for a model's group, 37 for the floors' basis).
+void BM_NormalEquationsAdd(benchmark::State& state) {
+  const int columns = static_cast<int>(state.range(0));
+  constexpr int kRows = 4096;  // a live window's rows at 10 kHz, 781 r/min
+  Eigen::MatrixXd x(columns, kRows);
+  for (int r = 0; r < kRows; ++r) {
+    for (int c = 0; c < columns; ++c) x(c, r) = std::sin(0.37 * r + 1.3 * c);
+  }
+  for (auto _ : state) {
+    resolver::NormalEquations ne(columns);
+    for (int r = 0; r < kRows; ++r) ne.add(x.col(r), x(0, r));
+    benchmark::DoNotOptimize(ne.m().data());
+  }
+  state.SetItemsProcessed(state.iterations() * kRows);
+}
+BENCHMARK(BM_NormalEquationsAdd)->Arg(4)->Arg(8)->Arg(16)->Arg(26)->Arg(37);
 
 }  // namespace
 
