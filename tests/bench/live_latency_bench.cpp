@@ -204,6 +204,7 @@ RunResult run_once(const Options& o) {
     pace.quiet_fd = ends.quiet_writer.get();
     pace.wake_ids = o.wake_ids;
   }
+  constexpr std::uint32_t kEndMarkerId = 0x7FF;  // vcan: the last frame of a run (an unknown ID)
   std::thread writer([&] {
     sent = resolver::bench_live::send_paced(ends.writer_fd(), feed, pace, stop);
     if (ends.writer_can) {
@@ -212,7 +213,7 @@ RunResult run_once(const Options& o) {
       // carries the final count.
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
       resolver::CanFrame marker;
-      marker.id = 0x7FF;
+      marker.id = kEndMarkerId;
       marker.len = 1;
       resolver::bench_live::send_one(ends.writer_fd(), marker, sent);
     }
@@ -239,8 +240,14 @@ RunResult run_once(const Options& o) {
   rusage ru_start{};
   getrusage(RUSAGE_THREAD, &ru_start);
   resolver::CanFrame frame;
-  constexpr int kQuietReadsAtEnd = 5;
+  // The end of a vcan run is its end marker: one interface delivers in order, so every
+  // frame sent before it has been read or counted as a drop once it is read. Quiet reads
+  // only end a run whose marker never came (dropped itself; 10 s): 100 ms each, and a starved
+  // TCG guest held its transmit queue for 2.4 s in a CI run, so 5 of them ended the run
+  // with 4464 frames still queued ("LOST FRAMES").
+  const int quiet_reads_at_end = ends.writer_can ? 100 : 5;
   int quiet_after_end = 0;
+  bool end_marker = false;
   for (;;) {
     const resolver::ReadStatus status = ends.reader.read(frame);
     if (status == resolver::ReadStatus::kFrame) {
@@ -272,17 +279,19 @@ RunResult run_once(const Options& o) {
           r.publish_read_us.push_back(static_cast<float>(static_cast<double>(sink.last_return_ns() - read_ns) * 1e-3));
         }
       }
+      end_marker = ends.writer_can && frame.id == kEndMarkerId;
     } else if (status == resolver::ReadStatus::kDeviceGone) {  // socket pair closed by the writer
       break;
     } else if (status == resolver::ReadStatus::kTimeout && writer_done.load()) {
-      // vcan: quiet after the end. Frames the sender handed over may still sit in
-      // the interface's transmit queue (txqueuelen) of a starved guest: the end is
-      // several read timeouts of quiet in a row, not the first.
-      if (++quiet_after_end >= kQuietReadsAtEnd) break;
+      // vcan whose end marker was lost: frames the sender handed over may still sit in
+      // the interface's transmit queue (txqueuelen) of a starved guest, so the end is
+      // many read timeouts of quiet in a row (above), not the first.
+      if (++quiet_after_end >= quiet_reads_at_end) break;
     }
     if (status != resolver::ReadStatus::kTimeout) quiet_after_end = 0;
     pipeline.set_kernel_drops(static_cast<std::int64_t>(ends.reader.stats().kernel_drops));
     pipeline.tick(realtime_ns() / 1000);
+    if (end_marker) break;  // its drop count is in the pipeline's now
   }
   const double cpu_end = thread_cpu_s();
   // Before the join: the sender's clock is valid only while it runs, and it
