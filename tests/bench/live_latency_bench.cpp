@@ -205,23 +205,26 @@ RunResult run_once(const Options& o) {
     pace.wake_ids = o.wake_ids;
   }
   constexpr std::uint32_t kEndMarkerId = 0x7FF;  // vcan: the last frame of a run (an unknown ID)
+  std::atomic<bool> marker_wanted{false};
   std::thread writer([&] {
     sent = resolver::bench_live::send_paced(ends.writer_fd(), feed, pace, stop);
-    if (ends.writer_can) {
-      // The kernel reports receive-queue drops (SO_RXQ_OVFL) only with a
-      // delivered frame: one end marker (ID 0x7FF, an unknown_id reject)
-      // carries the final count.
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      resolver::CanFrame marker;
-      marker.id = kEndMarkerId;
-      marker.len = 1;
-      resolver::bench_live::send_one(ends.writer_fd(), marker, sent);
-    }
     // Socket pair: closing the writing end is the end of stream for the reader
     // (0-byte read + POLLHUP -> kDeviceGone); shutdown(SHUT_WR) would give no POLLHUP.
     ends.quiet_writer.reset();
     ends.writer_owned.reset();
     writer_done.store(true);
+    if (ends.writer_can) {
+      // The kernel reports receive-queue drops (SO_RXQ_OVFL) only with a delivered
+      // frame: one end marker (an unknown_id reject) carries the final count. It is
+      // sent once the reader has found its queue empty: sent at once, a reader far
+      // behind (a starved guest) had its queue full and the marker was dropped with
+      // the last frames, whose loss then went uncounted (CI: 4464 frames "LOST").
+      while (!marker_wanted.load() && !stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      resolver::CanFrame marker;
+      marker.id = kEndMarkerId;
+      marker.len = 1;
+      if (!stop.load()) resolver::bench_live::send_one(ends.writer_fd(), marker, sent);
+    }
     // Stay alive until the reader has read this thread's CPU clock, which is
     // invalid once the thread has exited.
     while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -240,11 +243,11 @@ RunResult run_once(const Options& o) {
   rusage ru_start{};
   getrusage(RUSAGE_THREAD, &ru_start);
   resolver::CanFrame frame;
-  // The end of a vcan run is its end marker: one interface delivers in order, so every
-  // frame sent before it has been read or counted as a drop once it is read. Quiet reads
-  // only end a run whose marker never came (dropped itself; 10 s): 100 ms each, and a starved
-  // TCG guest held its transmit queue for 2.4 s in a CI run, so 5 of them ended the run
-  // with 4464 frames still queued ("LOST FRAMES").
+  // The end of a vcan run is its end marker, asked for at the first quiet read after the
+  // sender finished (the receive queue is empty then, so it cannot be dropped): one
+  // interface delivers in order, so every frame sent before it has been read or counted
+  // as a drop once it is read. Quiet reads end only a run whose marker never came (10 s
+  // on vcan; a socket pair ends when the writer closes it).
   const int quiet_reads_at_end = ends.writer_can ? 100 : 5;
   int quiet_after_end = 0;
   bool end_marker = false;
@@ -283,9 +286,7 @@ RunResult run_once(const Options& o) {
     } else if (status == resolver::ReadStatus::kDeviceGone) {  // socket pair closed by the writer
       break;
     } else if (status == resolver::ReadStatus::kTimeout && writer_done.load()) {
-      // vcan whose end marker was lost: frames the sender handed over may still sit in
-      // the interface's transmit queue (txqueuelen) of a starved guest, so the end is
-      // many read timeouts of quiet in a row (above), not the first.
+      marker_wanted.store(true);
       if (++quiet_after_end >= quiet_reads_at_end) break;
     }
     if (status != resolver::ReadStatus::kTimeout) quiet_after_end = 0;
