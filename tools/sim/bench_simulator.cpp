@@ -213,6 +213,16 @@ bool BenchSimulator::next(SimSample& out) {
       sin_counts += uniform(engine_) < 0.5 ? -imp.outlier_size : imp.outlier_size;
     }
   }
+  if (imp.current_outlier_rate > 0.0) {
+    // Drawn after everything above, and only with the effect on: a seed's log without it is
+    // unchanged. The spike is added to the sample as the ADC read it (saturating at int16).
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    if (uniform(engine_) < imp.current_outlier_rate / config_.sample_rate_hz) {
+      const double spike = uniform(engine_) < imp.current_outlier_positive ? imp.current_outlier_size
+                                                                           : -imp.current_outlier_size;
+      s.i_a_ma = to_i16(s.i_a_ma + spike * ma_per_amp);
+    }
+  }
   s.sin_counts = to_i16(sin_counts);
   s.cos_counts = to_i16(cos_counts);
   // Rounding can give exactly 2^32 just below 2pi: that is angle 0 again.

@@ -99,6 +99,9 @@ struct Impairments {
   double sigma_i = 0.0;          ///< [A] white noise on each phase current sample
   double outlier_rate = 0.0;     ///< [1/s] impulsive samples on the sin channel
   double outlier_size = 0.0;     ///< [counts] their size (sign random)
+  double current_outlier_rate = 0.0;      ///< [1/s] impulsive samples on phase current a
+  double current_outlier_size = 0.0;      ///< [A] their size
+  double current_outlier_positive = 0.5;  ///< share of them that are positive
 };
 
 /// The highest harmonic orders an effect's columns use, of the resolver angle theta,

@@ -53,6 +53,36 @@ class OutliersEffect final : public BasicEffect {
   }
 };
 
+constexpr std::array kCurrentOutlierParams{
+    ParamInfo{.name = "rate", .unit = "[1/s]", .description = "impulsive samples (EMI spikes) on phase current a",
+              .min = 0.0, .max = 1e5},
+    ParamInfo{.name = "size", .unit = "[A]", .description = "size of each spike", .min = 0.0, .max = 1000.0},
+    ParamInfo{.name = "positive", .unit = "[1]",
+              .description = "share of spikes that are positive (0.5: random sign; 1: an ADC that glitches high)",
+              .min = 0.0, .max = 1.0, .neutral = 0.5},
+};
+using CurrentOutlierParams = ParamSet<kCurrentOutlierParams>;
+
+/// The currents' spikes: an inverter's switching edges coupling into one phase current
+/// sensor's ADC. One-sided spikes (a glitch that reads high) do not average out: a fit that
+/// took them in would shift the currents' operating point by rate x size / sample rate.
+class CurrentOutliersEffect final : public BasicEffect {
+ public:
+  CurrentOutliersEffect()
+      : BasicEffect({"current_outliers",
+                     "impulsive samples on phase current a (switching EMI on its ADC): never part of a model",
+                     "docs/ARCHITECTURE.md section 7",
+                     "impulsive samples: found by a robust test on i_d, i_q and kept out of the fit"},
+                    kCurrentOutlierParams, EffectStage::kNoise) {}
+  [[nodiscard]] bool fittable() const override { return false; }
+  void impairments(Values v, Impairments& imp) const override {
+    const CurrentOutlierParams p(v);
+    imp.current_outlier_rate += p["rate"];
+    imp.current_outlier_size = p["size"];
+    imp.current_outlier_positive = p["positive"];
+  }
+};
+
 }  // namespace
 
 const Effect& noise_effect() {
@@ -62,6 +92,11 @@ const Effect& noise_effect() {
 
 const Effect& outliers_effect() {
   static const OutliersEffect effect;
+  return effect;
+}
+
+const Effect& current_outliers_effect() {
+  static const CurrentOutliersEffect effect;
   return effect;
 }
 

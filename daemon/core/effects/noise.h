@@ -39,5 +39,7 @@ class Effect;
 [[nodiscard]] const Effect& noise_effect();
 /// Impulsive samples (EMI spikes, bit errors): a simulator impairment the fit must keep out.
 [[nodiscard]] const Effect& outliers_effect();
+/// The same on phase current a (switching EMI on a current sensor's ADC).
+[[nodiscard]] const Effect& current_outliers_effect();
 
 }  // namespace resolver

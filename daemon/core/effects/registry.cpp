@@ -53,6 +53,7 @@ const std::vector<const Effect*>& registry() {
       &dead_time_effect(),
       &noise_effect(),
       &outliers_effect(),
+      &current_outliers_effect(),
   };
   return effects;
 }

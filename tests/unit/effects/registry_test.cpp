@@ -54,6 +54,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>>& stable_name
       {"dead_time", {"t_d"}},
       {"noise", {"sigma_sc", "sigma_i"}},
       {"outliers", {"rate", "size"}},
+      {"current_outliers", {"rate", "size", "positive"}},
   };
   return names;
 }
@@ -197,6 +198,7 @@ TEST(ChainValues, SpecsSetTheParameters) {
   c.apply_spec("current_gain_mismatch:gain_a=0.01,gain_b=-0.005");
   c.apply_spec("dead_time:t_d=2e-6");
   c.apply_spec("outliers:rate=5,size=3000");
+  c.apply_spec("current_outliers:rate=20,size=8,positive=1");
   EXPECT_DOUBLE_EQ(c.get("sampling_skew", "tau"), 2e-6);
   EXPECT_DOUBLE_EQ(c.get("channel_delay", "tau"), -3e-6);
   EXPECT_DOUBLE_EQ(c.get("backlash", "h"), 0.01);
@@ -213,6 +215,9 @@ TEST(ChainValues, SpecsSetTheParameters) {
   EXPECT_DOUBLE_EQ(c.get("dead_time", "t_d"), 2e-6);
   EXPECT_DOUBLE_EQ(c.get("outliers", "rate"), 5.0);
   EXPECT_DOUBLE_EQ(c.get("outliers", "size"), 3000.0);
+  EXPECT_DOUBLE_EQ(c.get("current_outliers", "rate"), 20.0);
+  EXPECT_DOUBLE_EQ(c.get("current_outliers", "size"), 8.0);
+  EXPECT_DOUBLE_EQ(c.get("current_outliers", "positive"), 1.0);
   // A later spec of the same parameter wins, the others stay.
   c.apply_spec("offsets:o_c=0.004");
   EXPECT_DOUBLE_EQ(c.get("offsets", "o_s"), 0.001);

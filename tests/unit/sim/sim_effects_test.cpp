@@ -58,6 +58,7 @@ TEST(SimEffects, EverySpecChangesExactlyTheSignalsItReaches) {
       {"dead_time", {"dead_time:t_d=2e-6", kCurrents}},
       {"noise", {"noise:sigma_sc=5", kSinCos}},
       {"outliers", {"outliers:rate=200,size=3000", kSinCos}},
+      {"current_outliers", {"current_outliers:rate=200,size=5", kCurrents}},
   };
   SimConfig base;  // default chain: noise and tracking loop on, same seed for every run
   // A hold and a ramp: at constant speed a type-II loop tracks an ideal resolver
@@ -75,7 +76,7 @@ TEST(SimEffects, EverySpecChangesExactlyTheSignalsItReaches) {
   for (const Effect* e : effect_registry()) {
     const auto it = table.find(std::string(e->name()));
     ASSERT_NE(it, table.end()) << "add a spec for the new registry effect " << e->name();
-    const bool draws = e->name() == "outliers";
+    const bool draws = e->name() == "outliers" || e->name() == "current_outliers";
     SimConfig c = draws ? noise_free : base;
     ASSERT_NO_THROW(c.chain.apply_spec(it->second.first));
     EXPECT_EQ(changed_signals(draws ? noise_free_baseline : baseline, run(c)), it->second.second) << it->second.first;
