@@ -401,19 +401,22 @@ void build_rows(const DiscoveryInput& in, const std::vector<const Sample*>& s, c
   }
 }
 
+/// Whether any moving row has the currents (what the fit and the outlier scan use).
+bool moving_currents(const PreparedLog& p) {
+  return std::any_of(p.rows.begin(), p.rows.end(),
+                     [](const FitRow& r) { return r.has(FitRow::kHasCur) && r.has(FitRow::kMoving); });
+}
+
 /// The operating point of the currents: the constant of i_d, i_q over the moving rows
 /// with the effects' ripple fitted out (current_operating_point.h), given to every row.
-/// Sets p.currents to whether any row has them.
+/// Outliers left out: one-sided spikes (a current ADC that glitches high) would shift it
+/// by their rate x size / sample rate, a current offset the gains' prediction then carries.
 void set_current_operating_point(PreparedLog& p) {
   CurrentOperatingPointFit fit;
-  bool any = false;
   for (const FitRow& r : p.rows) {
-    if (!r.has(FitRow::kHasCur) || !r.has(FitRow::kMoving)) continue;
+    if (!r.has(FitRow::kHasCur) || !r.has(FitRow::kMoving) || r.has(FitRow::kOutlier)) continue;
     fit.add(r.sig.theta_e, r.y_d, r.y_q);
-    any = true;
   }
-  p.currents = any;
-  if (!any) return;
   const CurrentOperatingPoint op = fit.result();
   if (!op.ripple_separated) {
     p.notes.emplace_back(
@@ -448,21 +451,22 @@ void flag_outliers(const std::vector<double>& t, PreparedLog& p) {
   const std::size_t n = p.rows.size();
   std::vector<bool> flags(n, false), ok(n);
   std::vector<double> y(n);
+  auto merge = [&](OutlierSignal o) {
+    if (o.count == 0) return;
+    for (OutlierSignal& e : p.outliers) {
+      if (e.signal != o.signal) continue;
+      e.count += o.count;
+      e.largest = std::max(e.largest, o.largest);
+      return;
+    }
+    p.outliers.push_back(std::move(o));
+  };
   auto scan = [&](FitRow::Flag has, double FitRow::*field, const std::string& name) {
     for (std::size_t i = 0; i < n; ++i) {
       ok[i] = p.rows[i].has(has) && !p.rows[i].has(FitRow::kExcluded);
       y[i] = p.rows[i].*field;
     }
-    OutlierSignal o = find_outliers(t, y, ok, flags, name);
-    if (o.count == 0) return;
-    bool merged = false;
-    for (OutlierSignal& e : p.outliers) {
-      if (e.signal != o.signal) continue;
-      e.count += o.count;
-      e.largest = std::max(e.largest, o.largest);
-      merged = true;
-    }
-    if (!merged) p.outliers.push_back(std::move(o));
+    merge(find_outliers(t, y, ok, flags, name));
   };
   if (p.rd) scan(FitRow::kHasRd, &FitRow::y_rd, "position_error");
   if (p.sincos) {
@@ -470,8 +474,16 @@ void flag_outliers(const std::vector<double>& t, PreparedLog& p) {
     scan(FitRow::kHasSc, &FitRow::y_sr, "sin_cos");
   }
   if (p.currents) {
-    scan(FitRow::kHasCur, &FitRow::y_d, "i_dq");
-    scan(FitRow::kHasCur, &FitRow::y_q, "i_dq");
+    // The currents' spikes (switching EMI on their ADCs) come in bursts and at runs' ends
+    // (outliers.h); a missed 10 A spike is 500 times their floor.
+    std::vector<double> yd(n), yq(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      ok[i] = p.rows[i].has(FitRow::kHasCur) && !p.rows[i].has(FitRow::kExcluded);
+      yd[i] = p.rows[i].y_d;
+      yq[i] = p.rows[i].y_q;
+    }
+    const std::array<std::span<const double>, 2> dq{yd, yq};
+    merge(find_outlier_bursts(t, dq, ok, flags, "i_dq"));
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (flags[i]) p.rows[i].flags |= FitRow::kOutlier;
@@ -535,10 +547,11 @@ PreparedLog prepare_log(const DiscoveryInput& in, const PrepareOptions& opt) {
   if (p.sincos) measure_amplitude(s, opt, p);
   const TrueAngles angles = true_angles(s, t, opt, p);
   build_rows(in, s, t, angles, currents, opt, p);
-  set_current_operating_point(p);
+  p.currents = moving_currents(p);
   if (p.rd) recenter(p, FitRow::kHasRd, &FitRow::y_rd);
   if (p.sincos) recenter(p, FitRow::kHasSc, &FitRow::y_sa);
   flag_outliers(t, p);
+  if (p.currents) set_current_operating_point(p);
   p.fold_rule = assign_folds(p.rows, p);
   measure_floors(s, opt, p);
   return p;
