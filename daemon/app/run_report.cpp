@@ -218,6 +218,11 @@ void print_ripple(std::ostream& out, const RunSummary& s) {
   } else {
     out << "  dq ripple  not measured (no phase currents, or no converged estimate)\n";
   }
+  if (s.current_spikes > 0) {
+    out << fmt::format("  dq ripple  {} phase-current sample(s) were spikes (off the line of their neighbours by over "
+                       "12 robust sigmas): the ripple took the line's value for them\n",
+                       s.current_spikes);
+  }
 }
 
 /// The live model fit, reloads, the calibration and the latency.
@@ -335,6 +340,7 @@ std::string run_report_json(const Pipeline& p, const RunInfo& info) {
        ",\"i_d_ripple_ref\":" + arr(r.ref.d, r.ref_valid) + ",";
   j += "\"i_q_ripple_raw\":" + arr(r.raw.q, r.raw_valid) + ",\"i_q_ripple_comp\":" + arr(r.comp.q, r.comp_valid) +
        ",\"i_q_ripple_ref\":" + arr(r.ref.q, r.ref_valid);
+  j += fmt::format(",\"ripple_current_spikes\":{}", s.current_spikes);
   j += "," + signal_health_json(p.signal_health().summary(), p.signal_health().monitor().config());
   if (const LiveModelFit* mf = p.model_fit()) {
     const auto& c = mf->counters();

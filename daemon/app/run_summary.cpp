@@ -21,6 +21,7 @@ void RunSummary::add(const SampleOutput& out, const SampleProcessor& proc, doubl
       compared_comp.add(wrap_pi(out.eps_ref - out.eps_hat), t);
     }
   }
+  current_spikes = proc.current_spikes();
   if (!proc.compensating()) return;
   if (out.ripple_updated()) {
     ripple = proc.ripple();

@@ -48,6 +48,8 @@ struct RunSummary {
   // once the estimator has converged, so "compensated" is compensated.
   RippleSet ripple;
   bool have_ripple = false;
+  /// Phase-current samples the ripple took from their neighbours' line (spikes; over the run).
+  std::int64_t current_spikes = 0;
 
   /// Accumulates one processed sample at time t [s].
   void add(const SampleOutput& out, const SampleProcessor& proc, double t);

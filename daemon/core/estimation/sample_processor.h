@@ -23,6 +23,7 @@
 #include "daemon/core/estimation/hwang_integral.h"
 #include "daemon/core/estimation/sincos_compensation.h"
 #include "daemon/core/estimation/sincos_least_squares.h"
+#include "daemon/core/estimation/current_spike_gate.h"
 #include "daemon/core/estimation/revolution_ripple.h"
 #include "daemon/core/estimation/speed_estimator.h"
 #include "daemon/core/model/calibration_table.h"
@@ -127,6 +128,8 @@ class SampleProcessor {
   /// True once the compensation uses a converged (or seeded) estimate.
   [[nodiscard]] bool compensating() const;
   [[nodiscard]] const RippleSet& ripple() const { return ripple_; }
+  /// Phase-current samples left out of the ripple as spikes (current_spike_gate.h).
+  [[nodiscard]] std::int64_t current_spikes() const { return spike_gate_.rejected(); }
   /// Compensates with `model` from now on: method kModel's live window fit (also its
   /// estimate), or a persisted calibration at start or a reload's carried-over model,
   /// which an older method's own estimate replaces once it has one (estimator_models.h).
@@ -171,6 +174,7 @@ class SampleProcessor {
   AngleUnwrapper ref_unwrap_;
   double ref_cont_ = 0.0;  ///< [rad, mechanical] the reference unwrapped at the current sample (NaN without)
   RevolutionRipple ripple_raw_, ripple_comp_, ripple_ref_;
+  CurrentSpikeGate spike_gate_;
   // Motion gate (SampleOutput::moving).
   static constexpr std::size_t kTravelSpan = 10;
   double recent_[kTravelSpan + 1] = {};
