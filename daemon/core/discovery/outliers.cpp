@@ -95,9 +95,9 @@ class LineTest {
 
 /// The robust sigma of the second differences d over consecutive usable samples: their
 /// MAD, bounded below by half the mean |d| (a quantized, slow signal has a zero MAD). With
-/// `trimmed` and a nonzero MAD the mean is over the |d| the test passes only: one-sided
-/// 10 A spikes at 50/s put the plain mean at 14x the noise's and the limit above a pair's
-/// half-size. Zero with fewer than 16 differences.
+/// `trimmed` and a nonzero MAD the mean is over the |d| below kThreshold MADs: one-sided
+/// 10 A spikes at 50/s put the scale from the plain mean at 10x the noise's (0.44 A for
+/// 0.045) and the limit above a pair's half-size. Zero with fewer than 16 differences.
 double robust_scale(std::span<const double> y, const std::vector<bool>& usable, bool trimmed) {
   const std::size_t n = y.size();
   std::vector<double> mags;

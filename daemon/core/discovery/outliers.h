@@ -11,17 +11,26 @@
 // (k omega dt)^2 of its amplitude and enters the scale, not the test.
 //
 // find_outlier_bursts (the phase currents: prepare.cpp): spikes come in bursts too (a
-// switching edge's ringing, a bus glitch over a few frames). Two spikes one or two samples apart tie or mask each other's patterns: on
-// a resolver-sim log with one-sided 10 A spikes on a phase current (50/s, 2 kHz), the
-// single pass missed 8 of ~500 and flagged clean samples between them, and the missed
-// ones (10 A against a 0.02 A floor) put i_dq at 9x its floor and its standstill floor
-// at 24x. So the test is repeated with the flagged samples taken out: d_i becomes twice
-// the distance of y_i from the line through its nearest unflagged neighbours (at most
-// kMaxGap samples away, so a smooth signal's curvature enters at most kMaxGap^2 / 4
-// times; the same d for neighbours 1 apart), until a pass flags nothing new. A
-// flagged sample that sits on the line through its unflagged neighbours at the end
-// (a clean one between two spikes) is unflagged. A burst longer than about
-// 2 kMaxGap - 1 samples is a level step, not a spike (signal health's job).
+// switching edge's ringing, a bus glitch over a few frames) and at a run's ends. Two
+// spikes side by side or a sample apart tie or mask each other's patterns, and a run's
+// last sample has no d: on a resolver-sim log with one-sided 10 A spikes on a phase
+// current (50/s, 2 kHz) the single pass missed 8 of ~440 and flagged clean samples
+// between them, and the missed ones (10 A against a 0.02 A floor) put i_dq at 9x its
+// floor and its standstill floor at 24x. So:
+//   - the test is twice the distance of y_i from the line through its nearest
+//     unflagged neighbours (the same d for neighbours one apart; at most kMaxGap
+//     samples away, so a smooth signal's curvature enters at most kMaxGap^2 / 4 times),
+//     or at a run's end the line through the two on one side, extrapolated, its limit
+//     widened by its noise;
+//   - first-pass peaks are ranked also by the line that skips one sample each side
+//     (beside a pair it misses both spikes);
+//   - later passes take the flagged samples out and test again beside the large ones
+//     (outliers.cpp kPeelAbove), until nothing new is flagged;
+//   - the scale's mean |d| is over the |d| below 12 MADs (with the spikes in, the plain
+//     mean put the scale at 10x the noise's);
+//   - i_d and i_q are judged together, and a flagged sample on the line through its
+//     unflagged neighbours in both at the end (a clean one between spikes) is unflagged.
+// A burst longer than about 2 kMaxGap - 1 samples is a level step, not a spike.
 #pragma once
 
 #include <cstdint>
@@ -44,9 +53,9 @@ struct OutlierSignal {
 OutlierSignal find_outliers(std::span<const double> t, std::span<const double> y, const std::vector<bool>& usable,
                             std::vector<bool>& flags, const std::string& signal);
 
-/// The same with the later passes, the runs' ends and the scale over the |d| the test
-/// passes (above), over the components `ys` of one signal together (i_d and i_q: a
-/// sample is clean again only where it is on the line in both). For the phase currents;
+/// The same with the later passes, the runs' ends and the trimmed scale (above), over
+/// the components `ys` of one signal together (i_d and i_q: a sample is clean again only
+/// where it is on the line in both). For the phase currents;
 /// the resolver's signals keep the one pass: their physical transients (an instant
 /// stop's loop ringing, a backlash take-up: steps the later passes peel sample by
 /// sample, and whose large |d| the trimmed scale leaves out) moved a chunked backlash
