@@ -6,6 +6,7 @@
 
 #include "daemon/core/angles.h"
 #include "daemon/core/effects/amplitude_imbalance.h"
+#include "daemon/core/estimation/current_spike_gate.h"
 #include "drivers/text/json_string.h"
 
 namespace resolver {
@@ -220,8 +221,8 @@ void print_ripple(std::ostream& out, const RunSummary& s) {
   }
   if (s.current_spikes > 0) {
     out << fmt::format("  dq ripple  {} phase-current sample(s) were spikes (off the line of their neighbours by over "
-                       "12 robust sigmas): the ripple took the line's value for them\n",
-                       s.current_spikes);
+                       "{:g} robust sigmas): the ripple took the line's value for them\n",
+                       s.current_spikes, CurrentSpikeGate::kThreshold);
   }
 }
 

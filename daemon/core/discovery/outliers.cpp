@@ -124,10 +124,10 @@ double robust_scale(std::span<const double> y, const std::vector<bool>& usable, 
   return std::max(mad, 0.5 * 1.2533 * sum / count);
 }
 
-/// The test of one pass (header): spikes alone, the signals whose transients (a stop's
-/// loop ringing, a backlash take-up) the later passes would peel sample by sample.
-OutlierSignal single_pass(std::span<const double> t, std::span<const double> y, const std::vector<bool>& usable,
-                          std::vector<bool>& flags, const std::string& signal) {
+}  // namespace
+
+OutlierSignal find_outliers(std::span<const double> t, std::span<const double> y, const std::vector<bool>& usable,
+                            std::vector<bool>& flags, const std::string& signal) {
   OutlierSignal out;
   out.signal = signal;
   const std::size_t n = y.size();
@@ -154,13 +154,6 @@ OutlierSignal single_pass(std::span<const double> t, std::span<const double> y, 
     }
   }
   return out;
-}
-
-}  // namespace
-
-OutlierSignal find_outliers(std::span<const double> t, std::span<const double> y, const std::vector<bool>& usable,
-                            std::vector<bool>& flags, const std::string& signal) {
-  return single_pass(t, y, usable, flags, signal);
 }
 
 OutlierSignal find_outlier_bursts(std::span<const double> t, std::span<const std::span<const double>> ys,
