@@ -233,6 +233,7 @@ class SignalHealthMonitor {
     std::int64_t index_first = 0;
     AmplitudeStats r_all;        ///< every sin/cos sample
     AmplitudeStats r_clean;      ///< without outliers (the DOS swing must not be a spike)
+    std::vector<double> r_clean_values;  ///< their radii, for the swing's trimmed range
     std::int64_t lot_checked = 0, lot_beyond = 0;
     double lot_worst = 0.0;      ///< [rad]
     double travel = 0.0;         ///< [rad] electrical, summed wrapped steps
