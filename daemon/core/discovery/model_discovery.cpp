@@ -601,8 +601,7 @@ Explanation explain_steps(const PreparedLog& log, std::span<const std::string> e
     if (r.rms > options.explained_ratio * r.floor) in_sample_ok = false;
   }
   if (outliers_matter && in_sample_ok) {
-    std::int64_t count = 0;
-    for (const OutlierSignal& o : ex.fit.outliers) count += o.count;
+    const std::int64_t count = ex.fit.account.outliers;  // rows: one with spikes on two signals is one sample
     ex.verdict = Verdict::kUnexplained;
     double worst = 0.0;
     for (const SignalResidual& r : ex.fit.signals) worst = std::max(worst, r.rms_with_outliers / r.floor);

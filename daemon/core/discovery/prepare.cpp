@@ -446,10 +446,16 @@ void recenter(PreparedLog& p, FitRow::Flag has, double FitRow::*field) {
   }
 }
 
-/// Outliers, per signal over consecutive samples: flagged rows, counted per signal.
+/// Outliers, per signal over consecutive samples: flagged rows, counted per signal. Each
+/// signal is tested on its own (a row one flagged is a clean neighbour to the others: a
+/// spike on sin leaves the currents of its row as they were) and counts every spike it
+/// has; a row any flags is out of the fit.
 void flag_outliers(const std::vector<double>& t, PreparedLog& p) {
   const std::size_t n = p.rows.size();
-  std::vector<bool> flags(n, false), ok(n);
+  std::vector<bool> flags(n, false), own(n), ok(n);
+  auto take = [&] {
+    for (std::size_t i = 0; i < n; ++i) flags[i] = flags[i] || own[i];
+  };
   std::vector<double> y(n);
   auto merge = [&](OutlierSignal o) {
     if (o.count == 0) return;
@@ -466,25 +472,30 @@ void flag_outliers(const std::vector<double>& t, PreparedLog& p) {
       ok[i] = p.rows[i].has(has) && !p.rows[i].has(FitRow::kExcluded);
       y[i] = p.rows[i].*field;
     }
-    merge(find_outliers(t, y, ok, flags, name));
+    own.assign(n, false);
+    merge(find_outliers(t, y, ok, own, name));
+    take();
   };
   if (p.rd) scan(FitRow::kHasRd, &FitRow::y_rd, "position_error");
-  if (p.sincos) {
-    scan(FitRow::kHasSc, &FitRow::y_sa, "sin_cos");
-    scan(FitRow::kHasSc, &FitRow::y_sr, "sin_cos");
-  }
-  if (p.currents) {
-    // The currents' spikes (switching EMI on their ADCs) come in bursts and at runs' ends
-    // (outliers.h); a missed 10 A spike is 500 times their floor.
-    std::vector<double> yd(n), yq(n);
+  // Two components of one signal judged together by the burst test (outliers.h).
+  std::vector<double> y2(n);
+  auto scan_bursts = [&](FitRow::Flag has, double FitRow::*a, double FitRow::*b, const std::string& name) {
     for (std::size_t i = 0; i < n; ++i) {
-      ok[i] = p.rows[i].has(FitRow::kHasCur) && !p.rows[i].has(FitRow::kExcluded);
-      yd[i] = p.rows[i].y_d;
-      yq[i] = p.rows[i].y_q;
+      ok[i] = p.rows[i].has(has) && !p.rows[i].has(FitRow::kExcluded);
+      y[i] = p.rows[i].*a;
+      y2[i] = p.rows[i].*b;
     }
-    const std::array<std::span<const double>, 2> dq{yd, yq};
-    merge(find_outlier_bursts(t, dq, ok, flags, "i_dq"));
-  }
+    const std::array<std::span<const double>, 2> ys{y, y2};
+    own.assign(n, false);
+    merge(find_outlier_bursts(t, ys, ok, own, name));
+    take();
+  };
+  // The sin/cos ADC's spikes (EMI on the resolver's cable) come in bursts and at runs'
+  // ends like the currents' (outliers.h); a missed 15 % spike is ~1000 times the floor.
+  if (p.sincos) scan_bursts(FitRow::kHasSc, &FitRow::y_sa, &FitRow::y_sr, "sin_cos");
+  // The currents' spikes (switching EMI on their ADCs); a missed 10 A spike is 500 times
+  // their floor.
+  if (p.currents) scan_bursts(FitRow::kHasCur, &FitRow::y_d, &FitRow::y_q, "i_dq");
   for (std::size_t i = 0; i < n; ++i) {
     if (flags[i]) p.rows[i].flags |= FitRow::kOutlier;
   }
