@@ -370,13 +370,9 @@ void Pipeline::on_sample(const Sample& sample, std::uint8_t counter) {
   signal_health_.add(sample);
   if (model_fit_) {
     const ProcessorConfig& pc = processor_.config();
-    // The faults active at this sample: a window mostly under one is never "explained".
-    std::uint8_t active = 0;
-    const auto& faults = signal_health_.monitor().faults();
-    for (std::size_t i = 0; i < kSignalFaultCount; ++i) {
-      if (faults[i].active) active = static_cast<std::uint8_t>(active | (1U << i));
-    }
-    model_fit_->add(sample, pc.p_r, pc.p, {sample.utime, sample.index, counter}, active);
+    // The faults this sample is under: a window mostly under one is never "explained".
+    model_fit_->add(sample, pc.p_r, pc.p, {sample.utime, sample.index, counter},
+                    signal_health_.monitor().last_sample_faults());
     adopt_live_fit();
   }
   summary_.add(out, processor_, sample.t);

@@ -284,6 +284,8 @@ void SignalHealthMonitor::add(const Sample& s) {
 
   bool sincos_usable = false;
   double sincos_angle = 0.0;
+  last_clipped_ = false;
+  last_outlier_ = false;
   if (s.has_sincos) {
     const double r = radius(s);
     amplitude_window_.add(r);
@@ -291,6 +293,7 @@ void SignalHealthMonitor::add(const Sample& s) {
     block_.r_all.add(r);
     const double clip_at = config_.full_scale - config_.clip_margin;
     if (config_.full_scale > 0.0 && (std::abs(s.sin) >= clip_at || std::abs(s.cos) >= clip_at)) {
+      last_clipped_ = true;
       if (block_.clipped++ == 0) {
         block_.clipped_t = s.t;
         block_.clipped_index = s.index;
@@ -300,6 +303,7 @@ void SignalHealthMonitor::add(const Sample& s) {
     if (sincos_usable) {
       sincos_angle = std::atan2(s.sin, s.cos);
       if (is_outlier(s, r, sincos_angle)) {
+        last_outlier_ = true;
         if (block_.outliers++ == 0) {
           block_.outlier_t = s.t;
           block_.outlier_index = s.index;
@@ -318,6 +322,18 @@ void SignalHealthMonitor::add(const Sample& s) {
     }
   }
   add_speed(s, sincos_usable, sincos_angle);
+}
+
+std::uint8_t SignalHealthMonitor::last_sample_faults() const {
+  std::uint8_t mask = 0;
+  for (std::size_t i = 0; i < kSignalFaultCount; ++i) {
+    const auto f = static_cast<SignalFault>(i);
+    bool on = faults_[i].active;
+    if (f == SignalFault::kClipping) on = last_clipped_;
+    if (f == SignalFault::kOutliers) on = last_outlier_;
+    if (on) mask = static_cast<std::uint8_t>(mask | (1U << i));
+  }
+  return mask;
 }
 
 void SignalHealthMonitor::finish() {

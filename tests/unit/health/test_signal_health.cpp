@@ -225,6 +225,28 @@ TEST(SignalHealth, SpikesOnASensorWithLargeOffsetsAreNoDegradation) {
   }
 }
 
+TEST(SignalHealth, ASamplesOwnFaultsAreItsImpulseNotTheEpisode) {
+  // The live fit counts each sample's faults (pipeline.cpp): an outlier episode lasts from its
+  // first impulse to a block without one, but only the impulses are outliers.
+  const std::vector<std::int64_t> spikes{500, 520, 2000};
+  Bench b;
+  b.damage = [&spikes](std::int64_t k, double, Sample& s) {
+    if (std::find(spikes.begin(), spikes.end(), k) != spikes.end()) s.sin += 3000.0;
+  };
+  SignalHealthMonitor m({}, kPr, kRate);
+  const auto outlier_bit = static_cast<std::uint8_t>(1U << static_cast<unsigned>(SignalFault::kOutliers));
+  std::int64_t flagged = 0, in_episode = 0;
+  for (const Sample& s : make_samples(b)) {
+    m.add(s);
+    const bool own = (m.last_sample_faults() & outlier_bit) != 0;
+    EXPECT_EQ(own, std::find(spikes.begin(), spikes.end(), s.index) != spikes.end()) << s.index;
+    flagged += own ? 1 : 0;
+    in_episode += m.fault(SignalFault::kOutliers).active ? 1 : 0;
+  }
+  EXPECT_EQ(flagged, 3);
+  EXPECT_GT(in_episode, 100);  // the episode: what the live fit counted before
+}
+
 TEST(SignalHealth, WeakAmplitudeIsDegradation) {
   Bench b;
   b.amplitude = 0.15 * 32767;  // between LOS (5 %) and the DOS low line (25 %)
