@@ -45,6 +45,25 @@ def run(cmd, **kw):
     return proc
 
 
+def bench_log(name, effects, args=()):
+    """A resolver-sim log of 8 s at 601.7 r/min (seed 3) with these --effect specs and options."""
+    log = os.path.join(ARGS.work, f"{name}.log")
+    cmd = [f"{ARGS.bin}/resolver-sim", "--out", log, "--rpm", "601.7", "--duration", "8", "--seed", "3", *args]
+    for e in effects:
+        cmd += ["--effect", e]
+    run(cmd)
+    return log
+
+
+def replay_report(log, name, config=None):
+    """resolverd --replay LOG --once --fast's run report (JSON)."""
+    rep = os.path.join(ARGS.work, f"{name}.json")
+    run([f"{ARGS.bin}/resolverd", "--replay", log, "--once", "--fast", "--quiet", "--lcm", "memq://", "--report", rep] +
+        (["--config", config] if config else []))
+    with open(rep) as f:
+        return json.load(f)
+
+
 class ReplayPipeline(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -131,15 +150,10 @@ class CurrentSpikes(unittest.TestCase):
     def setUpClass(cls):
         os.makedirs(ARGS.work, exist_ok=True)
         cls.rep = {}
-        for name, extra in (("clean", []), ("spikes", ["--effect", "current_outliers:rate=50,size=10,positive=1"])):
-            log = os.path.join(ARGS.work, f"current_spikes_{name}.log")
-            run([f"{ARGS.bin}/resolver-sim", "--out", log, "--rpm", "601.7", "--duration", "8", "--seed", "3",
-                 "--effect", "amplitude_imbalance:alpha=0.003", "--effect", "current_gain_mismatch:gain_a=0.1"] + extra)
-            rep = os.path.join(ARGS.work, f"current_spikes_{name}.json")
-            run([f"{ARGS.bin}/resolverd", "--replay", log, "--once", "--fast", "--quiet", "--lcm", "memq://",
-                 "--report", rep])
-            with open(rep) as f:
-                cls.rep[name] = json.load(f)
+        for name, extra in (("clean", []), ("spikes", ["current_outliers:rate=50,size=10,positive=1"])):
+            log = bench_log(f"current_spikes_{name}",
+                            ["amplitude_imbalance:alpha=0.003", "current_gain_mismatch:gain_a=0.1"] + extra)
+            cls.rep[name] = replay_report(log, f"current_spikes_{name}")
             if name == "spikes":
                 cls.in_log = spikes_in_log(log)  # the log's own count (run_magnitude_sweep.py)
 
@@ -174,20 +188,15 @@ class SinSpikes(unittest.TestCase):
     def setUpClass(cls):
         os.makedirs(ARGS.work, exist_ok=True)
         cls.rep = {}
-        for name, extra in (("clean", []), ("spikes", ["--effect", "outliers:rate=50,size=3000"])):
-            log = os.path.join(ARGS.work, f"sin_spikes_{name}.log")
-            run([f"{ARGS.bin}/resolver-sim", "--out", log, "--rpm", "601.7", "--duration", "8", "--seed", "3",
-                 "--amplitude", "20000", "--effect", "amplitude_imbalance:alpha=0.003",
-                 "--effect", "offsets:o_s=0.15,o_c=-0.09", "--effect", "tracking_loop:omega_n=0"] + extra)
+        for name, extra in (("clean", []), ("spikes", ["outliers:rate=50,size=3000"])):
+            log = bench_log(f"sin_spikes_{name}", ["amplitude_imbalance:alpha=0.003", "offsets:o_s=0.15,o_c=-0.09",
+                                                   "tracking_loop:omega_n=0"] + extra,
+                            ("--amplitude", "20000"))  # 15 % offsets and a 15 % spike stay below full scale
             for model, effects in (("seed", '["amplitude_imbalance"]'), ("true", '["amplitude_imbalance", "offsets"]')):
                 cfg = os.path.join(ARGS.work, f"sin_spikes_{model}.toml")
                 with open(cfg, "w") as f:
                     f.write(f"[model]\neffects = {effects}\n")
-                rep = os.path.join(ARGS.work, f"sin_spikes_{name}_{model}.json")
-                run([f"{ARGS.bin}/resolverd", "--replay", log, "--once", "--fast", "--quiet", "--lcm", "memq://",
-                     "--config", cfg, "--report", rep])
-                with open(rep) as f:
-                    cls.rep[(name, model)] = json.load(f)
+                cls.rep[(name, model)] = replay_report(log, f"sin_spikes_{name}_{model}", cfg)
 
     def test_the_live_windows_name_the_missing_effect_as_without_spikes(self):
         for name in ("clean", "spikes"):  # the clean bench is the control: the answer is its
