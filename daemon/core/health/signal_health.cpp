@@ -406,8 +406,8 @@ void SignalHealthMonitor::evaluate_block() {
       why = fmt::format("sin/cos amplitude {:.0f}, above {:g} % of full scale {:.0f} (no headroom)", mean,
                         100.0 * config_.degradation_high_fraction, fs);
     } else if (swing > config_.degradation_mismatch) {
-      why = fmt::format("sin/cos amplitude swings {:.0f} .. {:.0f} over the block ({:.1f} % of its mean, limit {:g} %): "
-                        "the channels are imbalanced, or one is weak or open",
+      why = fmt::format("sin/cos amplitude swings {:.0f} .. {:.0f} over the block (5-95 % of its samples without "
+                        "outliers; {:.1f} % of its mean, limit {:g} %): the channels are imbalanced, or one is weak or open",
                         low, high, 100.0 * swing, 100.0 * config_.degradation_mismatch);
     }
     set_fault(SignalFault::kDegradationOfSignal, !why.empty(), b.n, t0, i0, why);
